@@ -1,0 +1,65 @@
+#pragma once
+// Robot geometry, limits and sensor layout (config/robot.yaml), shared by
+// robot_client and mcu_sim. Defaults are the paper's robot (PAPER_DIGEST.md).
+#include <array>
+#include <string>
+
+#include "shared/config/config_node.hpp"
+
+namespace inspect::config {
+
+/// Paper geometry (Fig 2): r, L, L1, L2, L3.
+struct RobotGeometry {
+  double wheel_radius_m = 0.200;
+  double track_m = 0.438;
+  double l1_m = 0.214;   // front axle to centre of mass
+  double l2_m = 0.172;   // centre of mass to rear axle
+  double l3_m = 0.046;   // rear axle to rear wheel rotating shaft
+  double mass_kg = 34.0;
+  double body_radius_m = 0.35;  // collision circle around the axle midpoint
+};
+
+/// Motion limits enforced by robot_client (and by the MCU on wheel speed).
+struct RobotLimits {
+  double max_wheel_speed_rad_s = 5.0;   // 1.0 m/s at r = 0.2 m
+  double max_wheel_accel_rad_s2 = 10.0;
+  double max_v_m_s = 1.0;
+  double max_w_rad_s = 2.0;
+};
+
+/// Hub motor + driver as a first-order plant (used by the simulator and the tuner).
+struct MotorModel {
+  double time_constant_s = 0.10;
+  double speed_noise_m_s = 0.002;    // encoder speed error (paper: +-0.002 m/s)
+  double heading_noise_rad = 0.002;  // heading sensor error (paper: +-0.002 rad)
+};
+
+/// One ultrasonic transducer's mounting pose in the robot frame.
+struct UltrasonicMount {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double yaw_rad = 0.0;
+};
+
+/// The 4 ultrasonic sensors (front-left, front-right, left, right).
+struct UltrasonicConfig {
+  double min_range_m = 0.02;
+  double max_range_m = 4.5;
+  double beam_width_rad = 0.52;   // full cone angle (30 deg)
+  double noise_m = 0.03;          // paper: +-0.03 m
+  std::array<UltrasonicMount, 4> mounts{{{0.30, 0.12, 0.0}, {0.30, -0.12, 0.0}, {0.0, 0.25, 1.5707963267948966},
+                                         {0.0, -0.25, -1.5707963267948966}}};
+};
+
+struct RobotConfig {
+  RobotGeometry geometry;
+  RobotLimits limits;
+  MotorModel motor;
+  UltrasonicConfig ultrasonic;
+};
+
+/// Reads a robot config; missing keys take the defaults above. Throws ConfigError.
+RobotConfig loadRobotConfig(const ConfigNode& root);
+RobotConfig loadRobotConfigFile(const std::string& path);
+
+}  // namespace inspect::config
