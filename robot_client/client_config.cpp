@@ -1,0 +1,48 @@
+#include "robot_client/client_config.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+namespace inspect::client {
+
+bool validRobotId(const std::string& id) {
+  return !id.empty() && id.size() <= 64 &&
+         std::all_of(id.begin(), id.end(), [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-'; });
+}
+
+ClientConfig loadClientConfig(const config::ConfigNode& root) {
+  ClientConfig c;
+  c.robot_id = root.string("robot_id", c.robot_id);
+  if (!validRobotId(c.robot_id)) root.fail("robot_id", "'" + c.robot_id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
+  const auto s = root.optChild("server");
+  c.server_host = s.string("host", c.server_host);
+  if (c.server_host.empty()) s.fail("host", "must not be empty");
+  c.server_port = static_cast<int>(s.integer("port", c.server_port, 1, 65535));
+  c.reconnect_min_s = s.number("reconnect_min_s", c.reconnect_min_s, 0.01, 60);
+  c.reconnect_max_s = s.number("reconnect_max_s", c.reconnect_max_s, c.reconnect_min_s, 600);
+  c.handshake_timeout_s = s.number("handshake_timeout_s", c.handshake_timeout_s, 0.1, 60);
+  c.server_heartbeat_period_s = s.number("heartbeat_period_s", c.server_heartbeat_period_s, 0.01, 5);
+  c.telemetry_hz = s.number("telemetry_hz", c.telemetry_hz, 1, 100);
+  const auto ser = root.optChild("serial");
+  c.serial_device = ser.string("device", c.serial_device);
+  c.baud = static_cast<int>(ser.integer("baud", c.baud, 1200, 4000000));
+  static constexpr int kRates[] = {9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600};
+  if (std::find(std::begin(kRates), std::end(kRates), c.baud) == std::end(kRates))
+    ser.fail("baud", std::to_string(c.baud) + " is not a standard rate (9600 ... 921600)");
+  c.serial_reopen_period_s = ser.number("reopen_period_s", c.serial_reopen_period_s, 0.1, 60);
+  c.mcu_heartbeat_period_s = ser.number("heartbeat_period_s", c.mcu_heartbeat_period_s, 0.01, 0.4);
+  const auto sa = root.optChild("safety");
+  c.safety.link_timeout_s = sa.number("link_timeout_s", c.safety.link_timeout_s, 0.05, 10);
+  c.safety.command_timeout_s = sa.number("command_timeout_s", c.safety.command_timeout_s, 0.05, 10);
+  c.safety.sensor_timeout_s = sa.number("sensor_timeout_s", c.safety.sensor_timeout_s, 0.02, 5);
+  return c;
+}
+
+ClientConfig loadClientConfigFile(const std::string& path) {
+  const auto root = config::ConfigNode::loadFile(path);
+  ClientConfig c = loadClientConfig(root);
+  root.checkKnown();
+  return c;
+}
+
+}  // namespace inspect::client

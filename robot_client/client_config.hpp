@@ -1,0 +1,39 @@
+#pragma once
+// robot_client settings (config/client.yaml) and their loader.
+#include <string>
+
+#include "shared/config/config_node.hpp"
+
+namespace inspect::client {
+
+/// Safety timeouts of the control core.
+struct SafetyParams {
+  double link_timeout_s = 0.3;
+  double command_timeout_s = 0.3;
+  double sensor_timeout_s = 0.1;
+};
+
+struct ClientConfig {
+  std::string robot_id = "robot1";
+  std::string server_host = "127.0.0.1";
+  int server_port = 7600;
+  double reconnect_min_s = 0.2;
+  double reconnect_max_s = 3.0;
+  double handshake_timeout_s = 3.0;
+  double server_heartbeat_period_s = 0.1;
+  double telemetry_hz = 50.0;
+  std::string serial_device = "/dev/serial0";
+  int baud = 115200;
+  double serial_reopen_period_s = 1.0;
+  double mcu_heartbeat_period_s = 0.1;
+  SafetyParams safety;
+};
+
+/// True for ids made of [A-Za-z0-9_-], 1 to 64 characters.
+bool validRobotId(const std::string& id);
+
+/// Reads and validates a client config. Throws config::ConfigError.
+ClientConfig loadClientConfig(const config::ConfigNode& root);
+ClientConfig loadClientConfigFile(const std::string& path);
+
+}  // namespace inspect::client

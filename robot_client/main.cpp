@@ -1,0 +1,124 @@
+// robot_client: the Raspberry Pi process. Bridges the MCU serial line, runs the
+// 100 Hz control loop and keeps the link to pc_server.
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+
+#include "robot_client/client_config.hpp"
+#include "robot_client/robot_app.hpp"
+#include "shared/config/config_node.hpp"
+#include "shared/util/log.hpp"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: robot_client [options]
+
+Runs on the robot's Raspberry Pi: talks to the MCU over serial, runs the
+100 Hz control loop, and keeps a TCP link to pc_server.
+
+options:
+  --config FILE        client settings (default: config/client.yaml if present)
+  --robot-config FILE  robot geometry and limits (default: config/robot.yaml if present)
+  --serial PATH        serial device of the MCU (overrides serial.device),
+                       e.g. /dev/serial0, or the pty printed by mcu_sim
+  --server HOST:PORT   pc_server address (overrides server.host/port)
+  --id ROBOT_ID        robot id (overrides robot_id)
+  --cmd-log FILE       write every wheel command sent to the MCU (CSV; for tests)
+  --version            print the version and exit
+  --help               print this help and exit
+
+exit status: 0 after SIGINT/SIGTERM, 2 on a bad option or configuration.
+)";
+
+bool fileExists(const char* p) {
+  struct stat st {};
+  return ::stat(p, &st) == 0;
+}
+
+[[noreturn]] void usageError(const std::string& msg) {
+  std::fprintf(stderr, "robot_client: %s (see --help)\n", msg.c_str());
+  std::exit(2);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace inspect;
+  std::string config_path = fileExists("config/client.yaml") ? "config/client.yaml" : "";
+  std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
+  std::string serial_dev, server, id, cmd_log;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usageError(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "--version") {
+      std::printf("robot_client %s\n", INSPECT_VERSION);
+      return 0;
+    } else if (a == "--config") {
+      config_path = value();
+    } else if (a == "--robot-config") {
+      robot_path = value();
+    } else if (a == "--serial") {
+      serial_dev = value();
+    } else if (a == "--server") {
+      server = value();
+    } else if (a == "--id") {
+      id = value();
+    } else if (a == "--cmd-log") {
+      cmd_log = value();
+    } else {
+      usageError("unknown option '" + a + "'");
+    }
+  }
+
+  try {
+    client::ClientConfig cfg;
+    if (!config_path.empty()) cfg = client::loadClientConfigFile(config_path);
+    config::RobotConfig robot;
+    if (!robot_path.empty()) robot = config::loadRobotConfigFile(robot_path);
+    if (!serial_dev.empty()) cfg.serial_device = serial_dev;
+    if (!id.empty()) {
+      if (!client::validRobotId(id)) usageError("--id '" + id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
+      cfg.robot_id = id;
+    }
+    if (!server.empty()) {
+      const auto colon = server.rfind(':');
+      if (colon == std::string::npos || colon == 0) usageError("--server '" + server + "' must be HOST:PORT");
+      cfg.server_host = server.substr(0, colon);
+      char* end = nullptr;
+      const long port = std::strtol(server.c_str() + colon + 1, &end, 10);
+      if (*end != '\0' || port < 1 || port > 65535) usageError("--server '" + server + "': bad port");
+      cfg.server_port = static_cast<int>(port);
+    }
+
+    boost::asio::io_context io(1);
+    client::RobotApp app(io, cfg, robot, cmd_log);
+    boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+    signals.async_wait([&](const boost::system::error_code&, int sig) {
+      log::info("main", "signal ", sig, ": stopping");
+      app.stop();
+      // Let the final zero command reach the serial line, then leave.
+      io.poll();
+      io.stop();
+    });
+    log::info("main", "robot_client ", INSPECT_VERSION, " id=", cfg.robot_id, " serial=", cfg.serial_device,
+              " server=", cfg.server_host, ":", cfg.server_port);
+    app.start();
+    io.run();
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "robot_client: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

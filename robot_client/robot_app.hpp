@@ -1,0 +1,50 @@
+#pragma once
+// robot_client's wiring: serial line + server link + control core on one
+// io_context thread. The 100 Hz loop is driven by the MCU's sensor frames.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "robot_client/client_config.hpp"
+#include "robot_client/robot_core.hpp"
+#include "robot_client/serial_link.hpp"
+#include "robot_client/server_link.hpp"
+#include "shared/config/robot_config.hpp"
+
+namespace inspect::client {
+
+class RobotApp {
+ public:
+  RobotApp(boost::asio::io_context& io, const ClientConfig& cfg, const config::RobotConfig& robot,
+           const std::string& cmd_log_path);
+  ~RobotApp();
+  void start();
+  void stop();
+
+ private:
+  double now() const;
+  void onSerialMessage(const serial::Message& m);
+  void onServerMessage(const v1::Envelope& env);
+  void sendWheels(const serial::WheelCommand& c);
+  void flushEvents();
+  void tick10ms();
+  void sendTelemetry();
+  void mcuHeartbeat();
+
+  boost::asio::io_context& io_;
+  ClientConfig cfg_;
+  RobotCore core_;
+  SerialLink serial_;
+  ServerLink link_;
+  boost::asio::steady_timer tick_timer_;
+  boost::asio::steady_timer telemetry_timer_;
+  boost::asio::steady_timer mcu_hb_timer_;
+  int64_t t0_ns_;
+  std::FILE* cmd_log_ = nullptr;
+  v1::Envelope telemetry_env_;  // reused to avoid reallocating repeated fields
+};
+
+}  // namespace inspect::client

@@ -1,0 +1,293 @@
+#include "robot_client/robot_core.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace inspect::client {
+namespace {
+
+std::string faultName(uint32_t f) {
+  switch (f) {
+    case v1::FAULT_LINK_LOST: return "link lost";
+    case v1::FAULT_SENSOR_STALE: return "sensor frames stale";
+    case v1::FAULT_SERIAL_DOWN: return "serial device down";
+    case v1::FAULT_MCU: return "MCU fault";
+    case v1::FAULT_COMMAND_STALE: return "teleop set-point stale";
+    default: return "fault";
+  }
+}
+
+int16_t toMrad(double rad_s) {
+  const double v = std::clamp(std::round(rad_s * 1000.0), -32767.0, 32767.0);
+  return static_cast<int16_t>(v);
+}
+
+// Moves `cur` toward `target` by at most `step`.
+double slew(double cur, double target, double step) {
+  if (target > cur + step) return cur + step;
+  if (target < cur - step) return cur - step;
+  return target;
+}
+
+}  // namespace
+
+RobotCore::RobotCore(const config::RobotConfig& robot, const SafetyParams& safety)
+    : robot_(robot), safety_(safety) {
+  events_.reserve(16);
+}
+
+void RobotCore::setMode(v1::Mode m, const std::string& why) {
+  if (m == mode_) return;
+  mode_ = m;
+  events_.push_back({v1::Event::MODE_CHANGE, std::string(v1::Mode_Name(m)) + ": " + why});
+}
+
+void RobotCore::raise(uint32_t fault, const std::string& why) {
+  if (faults_ & fault) return;
+  faults_ |= fault;
+  events_.push_back({v1::Event::FAULT_RAISED, faultName(fault) + (why.empty() ? "" : ": " + why)});
+}
+
+void RobotCore::clear(uint32_t fault, const std::string& why) {
+  if (!(faults_ & fault)) return;
+  faults_ &= ~fault;
+  events_.push_back({v1::Event::FAULT_CLEARED, faultName(fault) + (why.empty() ? "" : ": " + why)});
+}
+
+void RobotCore::latchFailsafe(const std::string& why) {
+  setpoint_ = {};
+  setpoint_time_s_ = -1.0;
+  if (mode_ == v1::ESTOP || mode_ == v1::FAILSAFE) return;
+  latch_reason_ = why;
+  setMode(v1::FAILSAFE, why + "; needs resume");
+}
+
+void RobotCore::onLinkUp(double now_s) {
+  link_up_ = true;
+  last_link_activity_s_ = now_s;
+  clear(v1::FAULT_LINK_LOST, "link restored");
+}
+
+void RobotCore::onLinkDown(double /*now_s*/, const std::string& why) {
+  link_up_ = false;
+  raise(v1::FAULT_LINK_LOST, why);
+  if (moving()) latchFailsafe("link lost");
+  setpoint_ = {};
+  setpoint_time_s_ = -1.0;
+}
+
+void RobotCore::onLinkActivity(double now_s) {
+  last_link_activity_s_ = now_s;
+  if (link_up_) clear(v1::FAULT_LINK_LOST, "link restored");
+}
+
+void RobotCore::onSerialState(bool open, double /*now_s*/) {
+  serial_open_ = open;
+  if (open) {
+    clear(v1::FAULT_SERIAL_DOWN, "");
+  } else {
+    raise(v1::FAULT_SERIAL_DOWN, "");
+    have_frame_ = false;
+    if (moving()) latchFailsafe("serial device down");
+  }
+}
+
+void RobotCore::setSerialCounters(const serial::DecoderCounters& rx, uint64_t bytes_tx, uint64_t frames_tx) {
+  serial_rx_ = rx;
+  bytes_tx_ = bytes_tx;
+  frames_tx_ = frames_tx;
+}
+
+v1::Ack RobotCore::onCommand(const v1::Command& cmd, double now_s) {
+  onLinkActivity(now_s);
+  v1::Ack ack;
+  ack.set_command_id(cmd.id());
+  last_command_id_ = cmd.id();
+  auto reject = [&](const std::string& why) {
+    ack.set_status(v1::Ack::REJECTED);
+    ack.set_reason(why);
+    return ack;
+  };
+  switch (cmd.kind_case()) {
+    case v1::Command::kTeleop: {
+      const double v = cmd.teleop().v_m_s(), w = cmd.teleop().w_rad_s();
+      if (!std::isfinite(v) || !std::isfinite(w)) return reject("non-finite velocity");
+      if (mode_ == v1::ESTOP) return reject("e-stop latched: resume first");
+      if (mode_ == v1::FAILSAFE) return reject("failsafe latched (" + latch_reason_ + "): resume first");
+      if (faults_ & v1::FAULT_SENSOR_STALE) return reject("sensor frames stale");
+      if (faults_ & v1::FAULT_SERIAL_DOWN) return reject("serial device down");
+      setpoint_ = {std::clamp(v, -robot_.limits.max_v_m_s, robot_.limits.max_v_m_s),
+                   std::clamp(w, -robot_.limits.max_w_rad_s, robot_.limits.max_w_rad_s)};
+      setpoint_time_s_ = now_s;
+      clear(v1::FAULT_COMMAND_STALE, "");
+      setMode(v1::TELEOP, "teleop set-point");
+      ack.set_status(v1::Ack::ACCEPTED);
+      if (setpoint_.v_m_s != v || setpoint_.w_rad_s != w) ack.set_reason("clamped to the robot's limits");
+      return ack;
+    }
+    case v1::Command::kStop:
+      setpoint_ = {};
+      setpoint_time_s_ = -1.0;
+      if (mode_ == v1::TELEOP) setMode(v1::IDLE, "stop");
+      ack.set_status(v1::Ack::ACCEPTED);
+      return ack;
+    case v1::Command::kEstop:
+      setpoint_ = {};
+      setpoint_time_s_ = -1.0;
+      latch_reason_ = "e-stop";
+      setMode(v1::ESTOP, "e-stop from operator; needs resume");
+      ack.set_status(v1::Ack::ACCEPTED);
+      return ack;
+    case v1::Command::kResume:
+      if (mode_ == v1::ESTOP || mode_ == v1::FAILSAFE) {
+        if (faults_ & v1::FAULT_SENSOR_STALE) return reject("sensor frames still stale");
+        if (faults_ & v1::FAULT_SERIAL_DOWN) return reject("serial device still down");
+        latch_reason_.clear();
+        setMode(v1::IDLE, "resumed by operator");
+      }
+      ack.set_status(v1::Ack::ACCEPTED);
+      return ack;
+    case v1::Command::KIND_NOT_SET: break;
+  }
+  return reject("unknown or empty command");
+}
+
+void RobotCore::checkTimeouts(double now_s) {
+  // Each check tests the bit first so that no string is built on every tick.
+  if (link_up_ && !(faults_ & v1::FAULT_LINK_LOST) && now_s - last_link_activity_s_ > safety_.link_timeout_s) {
+    raise(v1::FAULT_LINK_LOST, "no heartbeat or command for " +
+                                   std::to_string(static_cast<int>(safety_.link_timeout_s * 1000)) + " ms");
+    if (moving()) latchFailsafe("link lost");
+  }
+  if (mode_ == v1::TELEOP && setpoint_time_s_ >= 0 && now_s - setpoint_time_s_ > safety_.command_timeout_s) {
+    raise(v1::FAULT_COMMAND_STALE, "");
+    setpoint_ = {};
+    setpoint_time_s_ = -1.0;
+    setMode(v1::IDLE, "teleop set-point stale");
+  }
+  if (have_frame_ && !(faults_ & v1::FAULT_SENSOR_STALE) && now_s - last_frame_s_ > safety_.sensor_timeout_s) {
+    raise(v1::FAULT_SENSOR_STALE, "");
+    if (moving()) latchFailsafe("sensor frames stale");
+  }
+}
+
+serial::WheelCommand RobotCore::computeCommand(double dt_s) {
+  const bool latched = mode_ == v1::ESTOP || mode_ == v1::FAILSAFE;
+  control::Twist target = mode_ == v1::TELEOP ? setpoint_ : control::Twist{};
+  target = control::limitTwist(target, robot_.geometry.wheel_radius_m, robot_.geometry.track_m,
+                               robot_.limits.max_wheel_speed_rad_s);
+  const auto want = control::wheelsFromTwist(target, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
+  if (mode_ != v1::TELEOP || latched || (faults_ & v1::FAULT_SENSOR_STALE)) {
+    cmd_wheels_ = {};  // stops are immediate, not slew-limited
+  } else {
+    const double step = robot_.limits.max_wheel_accel_rad_s2 * std::clamp(dt_s, 0.0, 0.05);
+    cmd_wheels_.left_rad_s = slew(cmd_wheels_.left_rad_s, want.left_rad_s, step);
+    cmd_wheels_.right_rad_s = slew(cmd_wheels_.right_rad_s, want.right_rad_s, step);
+  }
+  cmd_twist_ = control::twistFromWheels(cmd_wheels_, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
+  serial::WheelCommand c;
+  c.left_mrad_s = toMrad(cmd_wheels_.left_rad_s);
+  c.right_mrad_s = toMrad(cmd_wheels_.right_rad_s);
+  c.flags = latched ? 0 : serial::WheelCommand::kEnable;
+  return c;
+}
+
+serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, double now_s) {
+  double dt_s = 0.01;
+  if (!have_frame_) {
+    // First frame after start or after the serial line came back: re-anchor
+    // displacement; the heading reference is taken once per process.
+    if (last_frame_s_ < 0) heading0_ = f.heading_0p1mrad;
+    last_disp_ = f.wheel_disp_0p1mm;
+  } else {
+    dt_s = static_cast<double>(static_cast<uint32_t>(f.mcu_time_ms - last_mcu_ms_)) / 1000.0;
+    const double dl = static_cast<int32_t>(static_cast<uint32_t>(f.wheel_disp_0p1mm[0]) -
+                                           static_cast<uint32_t>(last_disp_[0])) * 1e-4;
+    const double dr = static_cast<int32_t>(static_cast<uint32_t>(f.wheel_disp_0p1mm[1]) -
+                                           static_cast<uint32_t>(last_disp_[1])) * 1e-4;
+    last_disp_ = f.wheel_disp_0p1mm;
+    // Position from wheel travel, heading from the MCU's heading sensor.
+    const double th = control::wrapAngle((f.heading_0p1mrad - heading0_) * 1e-4);
+    const double mid = pose_.theta_rad + control::wrapAngle(th - pose_.theta_rad) / 2.0;
+    const double ds = (dl + dr) / 2.0;
+    pose_.x_m += ds * std::cos(mid);
+    pose_.y_m += ds * std::sin(mid);
+    pose_.theta_rad = th;
+  }
+  have_frame_ = true;
+  last_frame_s_ = now_s;
+  last_mcu_ms_ = f.mcu_time_ms;
+  last_frame_ = f;
+  measured_ = {f.wheel_speed_mrad_s[0] * 1e-3, f.wheel_speed_mrad_s[1] * 1e-3};
+  clear(v1::FAULT_SENSOR_STALE, "");
+  constexpr uint16_t kSerious = serial::kFaultMotorDriver | serial::kFaultEStopButton;
+  if ((f.faults & kSerious) && !(faults_ & v1::FAULT_MCU)) {
+    raise(v1::FAULT_MCU, "MCU fault flags 0x" + std::to_string(f.faults));
+    if (moving()) latchFailsafe("MCU fault");
+  } else if (!(f.faults & kSerious)) {
+    clear(v1::FAULT_MCU, "");
+  }
+  if (++rate_count_, now_s - rate_window_start_s_ >= 1.0) {
+    sensor_rate_hz_ = rate_count_ / (now_s - rate_window_start_s_);
+    rate_window_start_s_ = now_s;
+    rate_count_ = 0;
+  }
+  checkTimeouts(now_s);
+  return computeCommand(dt_s);
+}
+
+serial::WheelCommand RobotCore::commandNow() { return computeCommand(0.0); }
+
+std::optional<serial::WheelCommand> RobotCore::onTimer(double now_s) {
+  checkTimeouts(now_s);
+  if (faults_ & v1::FAULT_SENSOR_STALE) return computeCommand(0.01);
+  return std::nullopt;
+}
+
+void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
+  t.set_robot_time_us(static_cast<uint64_t>(now_s * 1e6));
+  auto* p = t.mutable_pose();
+  p->set_x_m(pose_.x_m);
+  p->set_y_m(pose_.y_m);
+  p->set_theta_rad(pose_.theta_rad);
+  t.set_wheel_left_rad_s(measured_.left_rad_s);
+  t.set_wheel_right_rad_s(measured_.right_rad_s);
+  t.set_cmd_wheel_left_rad_s(cmd_wheels_.left_rad_s);
+  t.set_cmd_wheel_right_rad_s(cmd_wheels_.right_rad_s);
+  const auto tw = control::twistFromWheels(measured_, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
+  t.set_v_m_s(tw.v_m_s);
+  t.set_w_rad_s(tw.w_rad_s);
+  t.set_cmd_v_m_s(cmd_twist_.v_m_s);
+  t.set_cmd_w_rad_s(cmd_twist_.w_rad_s);
+  t.clear_ultrasonic_m();
+  for (uint16_t mm : last_frame_.ultrasonic_mm) t.add_ultrasonic_m(mm == serial::kNoEcho ? -1.0 : mm * 1e-3);
+  t.set_grayscale(last_frame_.grayscale);
+  t.clear_gas();
+  for (uint16_t g : last_frame_.gas_raw) t.add_gas(g * 0.01);
+  t.set_battery_v(last_frame_.battery_mv * 1e-3);
+  t.set_mode(mode_);
+  t.set_faults(faults_);
+  t.set_mcu_faults(last_frame_.faults);
+  auto* s = t.mutable_serial();
+  s->set_frames_ok(serial_rx_.frames_ok);
+  s->set_bad_cobs(serial_rx_.bad_cobs);
+  s->set_bad_crc(serial_rx_.bad_crc);
+  s->set_bad_length(serial_rx_.bad_length);
+  s->set_unknown_id(serial_rx_.unknown_id);
+  s->set_seq_gaps(serial_rx_.seq_gaps);
+  s->set_overflow(serial_rx_.overflow);
+  s->set_bytes_rx(serial_rx_.bytes_rx);
+  s->set_bytes_tx(bytes_tx_);
+  s->set_frames_tx(frames_tx_);
+  t.set_sensor_rate_hz(have_frame_ ? sensor_rate_hz_ : 0.0);
+  t.set_last_command_id(last_command_id_);
+}
+
+std::vector<CoreEvent> RobotCore::takeEvents() {
+  std::vector<CoreEvent> out;
+  out.swap(events_);
+  events_.reserve(16);
+  return out;
+}
+
+}  // namespace inspect::client

@@ -1,0 +1,108 @@
+#pragma once
+// The robot's decision core: modes, safety latches, teleop set-point, odometry
+// and wheel commands. Pure: every input carries its time (`now_s`, monotonic
+// seconds); no I/O, no clock reads, no allocation in the per-tick path.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "inspect/v1/link.pb.h"
+#include "robot_client/client_config.hpp"
+#include "shared/config/robot_config.hpp"
+#include "shared/control/diff_drive.hpp"
+#include "shared/serial/frame_codec.hpp"
+
+namespace inspect::client {
+
+/// What the core wants announced to the server as an Event.
+struct CoreEvent {
+  v1::Event::Kind kind = v1::Event::INFO;
+  std::string text;
+};
+
+class RobotCore {
+ public:
+  RobotCore(const config::RobotConfig& robot, const SafetyParams& safety);
+
+  /// A valid sensor frame arrived (100 Hz): updates the estimate, runs the
+  /// tick, returns the wheel command to send.
+  serial::WheelCommand onSensorFrame(const serial::SensorFrame& f, double now_s);
+  /// Periodic check (every ~10 ms). Returns a command to send when sensor
+  /// frames are stale (the loop is then timer-driven and commands zero).
+  std::optional<serial::WheelCommand> onTimer(double now_s);
+
+  /// The command for the current state, to send at once after a command or
+  /// link change (no slew step is taken).
+  serial::WheelCommand commandNow();
+
+  /// The TCP link came up (handshake accepted) / went down.
+  void onLinkUp(double now_s);
+  void onLinkDown(double now_s, const std::string& why);
+  /// Any heartbeat or command from the server.
+  void onLinkActivity(double now_s);
+  /// A command from the server; returns the Ack to send.
+  v1::Ack onCommand(const v1::Command& cmd, double now_s);
+  /// Serial device state.
+  void onSerialState(bool open, double now_s);
+  /// Records the serial decoder counters for telemetry.
+  void setSerialCounters(const serial::DecoderCounters& rx, uint64_t bytes_tx, uint64_t frames_tx);
+
+  void fillTelemetry(v1::Telemetry& t, double now_s) const;
+  /// Moves out the events raised since the last call.
+  std::vector<CoreEvent> takeEvents();
+
+  v1::Mode mode() const { return mode_; }
+  uint32_t faults() const { return faults_; }
+  const control::Pose2& pose() const { return pose_; }
+  control::Twist commandedTwist() const { return cmd_twist_; }
+
+ private:
+  bool moving() const { return mode_ == v1::TELEOP; }
+  void setMode(v1::Mode m, const std::string& why);
+  void raise(uint32_t fault, const std::string& why);
+  void clear(uint32_t fault, const std::string& why);
+  void latchFailsafe(const std::string& why);
+  void checkTimeouts(double now_s);
+  serial::WheelCommand computeCommand(double dt_s);
+
+  config::RobotConfig robot_;
+  SafetyParams safety_;
+  v1::Mode mode_ = v1::IDLE;
+  uint32_t faults_ = 0;
+  std::string latch_reason_;
+
+  // Link.
+  bool link_up_ = false;
+  double last_link_activity_s_ = 0.0;
+
+  // Teleop set-point.
+  control::Twist setpoint_;
+  double setpoint_time_s_ = -1.0;
+  uint64_t last_command_id_ = 0;
+
+  // Sensors and estimate.
+  bool have_frame_ = false;
+  bool serial_open_ = false;
+  double last_frame_s_ = -1.0;
+  serial::SensorFrame last_frame_;
+  std::array<int32_t, 2> last_disp_{};
+  int16_t heading0_ = 0;
+  uint32_t last_mcu_ms_ = 0;
+  control::Pose2 pose_;
+  control::WheelSpeeds measured_;
+  double rate_window_start_s_ = 0.0;
+  int rate_count_ = 0;
+  double sensor_rate_hz_ = 0.0;
+
+  // Output.
+  control::Twist cmd_twist_;
+  control::WheelSpeeds cmd_wheels_;
+  serial::DecoderCounters serial_rx_;
+  uint64_t bytes_tx_ = 0;
+  uint64_t frames_tx_ = 0;
+
+  std::vector<CoreEvent> events_;
+};
+
+}  // namespace inspect::client

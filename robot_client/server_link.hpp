@@ -1,0 +1,73 @@
+#pragma once
+// TCP link to pc_server: connect with backoff, handshake, delimited protobuf
+// envelopes both ways, heartbeats, a bounded write queue.
+#include <array>
+#include <deque>
+#include <functional>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "inspect/v1/link.pb.h"
+#include "robot_client/client_config.hpp"
+#include "shared/net/delimited_codec.hpp"
+
+namespace inspect::client {
+
+class ServerLink {
+ public:
+  struct Handlers {
+    std::function<void()> on_up;                              // handshake accepted
+    std::function<void(const std::string& why)> on_down;      // link lost (after being up)
+    std::function<void(const v1::Envelope&)> on_message;      // any message after the handshake
+  };
+
+  ServerLink(boost::asio::io_context& io, const ClientConfig& cfg);
+
+  void start(Handlers h);
+  void stop();
+
+  /// Queues an envelope (seq and send time are filled in). Dropped when the
+  /// link is down or the queue is full (telemetry must never block the loop).
+  void send(v1::Envelope& env);
+
+  bool isUp() const { return up_; }
+  uint64_t connects() const { return connects_; }
+  uint64_t dropped() const { return dropped_; }
+
+ private:
+  void connect();
+  void onConnected();
+  void scheduleReconnect();
+  void doRead();
+  void doWrite();
+  void close(const std::string& why);
+  void heartbeat();
+
+  boost::asio::io_context& io_;
+  ClientConfig cfg_;
+  Handlers h_;
+  boost::asio::ip::tcp::resolver resolver_;
+  boost::asio::ip::tcp::socket socket_;
+  boost::asio::steady_timer retry_timer_;
+  boost::asio::steady_timer handshake_timer_;
+  boost::asio::steady_timer heartbeat_timer_;
+  net::DelimitedDecoder decoder_;
+  std::array<char, 16384> rx_buf_{};
+  std::deque<std::string> tx_queue_;
+  bool connected_ = false;  // TCP up
+  bool up_ = false;         // handshake accepted
+  bool stopped_ = false;
+  double backoff_s_;
+  uint64_t next_seq_ = 1;
+  uint64_t connects_ = 0;
+  uint64_t dropped_ = 0;
+  uint64_t generation_ = 0;
+  int64_t last_rx_ns_ = 0;
+  static constexpr double kDeadAfterS = 1.0;  // invalidates handlers of an old connection
+  std::string last_error_;
+};
+
+}  // namespace inspect::client

@@ -1,0 +1,183 @@
+// RobotCore: modes, latches, timeouts and commands, driven with explicit time.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "robot_client/robot_core.hpp"
+
+using namespace inspect;
+using client::RobotCore;
+
+namespace {
+
+v1::Command teleop(uint64_t id, double v, double w) {
+  v1::Command c;
+  c.set_id(id);
+  c.mutable_teleop()->set_v_m_s(v);
+  c.mutable_teleop()->set_w_rad_s(w);
+  return c;
+}
+v1::Command simple(uint64_t id, char kind) {
+  v1::Command c;
+  c.set_id(id);
+  if (kind == 's') c.mutable_stop();
+  if (kind == 'e') c.mutable_estop();
+  if (kind == 'r') c.mutable_resume();
+  return c;
+}
+
+// Drives the core with sensor frames at 100 Hz; the frames report whatever
+// the core commanded (an ideal MCU), so odometry integrates the commands.
+struct Harness {
+  config::RobotConfig robot;
+  client::SafetyParams safety;
+  RobotCore core{robot, safety};
+  serial::SensorFrame f;
+  double t = 0.0;
+  double disp_l = 0, disp_r = 0;
+  serial::WheelCommand last;
+
+  Harness() {
+    core.onSerialState(true, 0.0);
+    core.onLinkUp(0.0);
+  }
+  void step(bool heartbeat = true) {
+    t += 0.01;
+    if (heartbeat) core.onLinkActivity(t);
+    f.mcu_time_ms = static_cast<uint32_t>(std::lround(t * 1000));
+    disp_l += last.left_mrad_s * 1e-3 * robot.geometry.wheel_radius_m * 0.01;
+    disp_r += last.right_mrad_s * 1e-3 * robot.geometry.wheel_radius_m * 0.01;
+    f.wheel_disp_0p1mm = {static_cast<int32_t>(std::lround(disp_l * 1e4)), static_cast<int32_t>(std::lround(disp_r * 1e4))};
+    f.wheel_speed_mrad_s = {last.left_mrad_s, last.right_mrad_s};
+    last = core.onSensorFrame(f, t);
+  }
+  void run(double seconds, bool heartbeat = true) {
+    const int n = static_cast<int>(std::lround(seconds / 0.01));
+    for (int i = 0; i < n; ++i) step(heartbeat);
+  }
+};
+
+}  // namespace
+
+TEST(RobotCore, TeleopDrivesAndSlewLimits) {
+  Harness h;
+  ASSERT_EQ(h.core.onCommand(teleop(1, 0.5, 0.0), h.t).status(), v1::Ack::ACCEPTED);
+  h.step();
+  // 10 rad/s^2 * 10 ms = 0.1 rad/s per tick; the target is 2.5 rad/s.
+  EXPECT_EQ(h.last.left_mrad_s, 100);
+  EXPECT_EQ(h.last.flags, serial::WheelCommand::kEnable);
+  for (int i = 0; i < 20; ++i) {
+    h.core.onCommand(teleop(2 + i, 0.5, 0.0), h.t);
+    h.run(0.05);
+  }
+  EXPECT_EQ(h.last.left_mrad_s, 2500);
+  EXPECT_EQ(h.last.right_mrad_s, 2500);
+  EXPECT_EQ(h.core.mode(), v1::TELEOP);
+  EXPECT_GT(h.core.pose().x_m, 0.3);
+  EXPECT_NEAR(h.core.pose().y_m, 0.0, 1e-9);
+}
+
+TEST(RobotCore, LimitsAreClampedAndSaid) {
+  Harness h;
+  const auto ack = h.core.onCommand(teleop(1, 9.0, 0.0), h.t);
+  EXPECT_EQ(ack.status(), v1::Ack::ACCEPTED);
+  EXPECT_NE(ack.reason().find("clamped"), std::string::npos);
+  const auto bad = h.core.onCommand(teleop(2, std::nan(""), 0.0), h.t);
+  EXPECT_EQ(bad.status(), v1::Ack::REJECTED);
+}
+
+TEST(RobotCore, StaleSetpointStopsWithin300ms) {
+  Harness h;
+  h.core.onCommand(teleop(1, 0.3, 0.0), h.t);
+  h.run(0.29);
+  EXPECT_EQ(h.core.mode(), v1::TELEOP);
+  EXPECT_NE(h.last.left_mrad_s, 0);
+  h.run(0.03);
+  EXPECT_EQ(h.core.mode(), v1::IDLE);
+  EXPECT_EQ(h.last.left_mrad_s, 0);
+  EXPECT_TRUE(h.core.faults() & v1::FAULT_COMMAND_STALE);
+}
+
+TEST(RobotCore, SilentLinkLatchesFailsafeUntilResume) {
+  Harness h;
+  for (int i = 0; i < 10; ++i) {
+    h.core.onCommand(teleop(i + 1, 0.3, 0.0), h.t);
+    h.run(0.05);
+  }
+  // Heartbeats stop; the set-point keeps being fresh only until it does not.
+  h.core.onCommand(teleop(100, 0.3, 0.0), h.t);
+  const double t_loss = h.t;
+  while (h.core.mode() == v1::TELEOP && h.t - t_loss < 1.0) h.step(false);
+  EXPECT_EQ(h.core.mode(), v1::FAILSAFE);
+  EXPECT_LE(h.t - t_loss, 0.31);
+  EXPECT_EQ(h.last.left_mrad_s, 0);
+  EXPECT_EQ(h.last.flags, 0);  // brake
+  // Link back: commands refused until resume.
+  h.core.onLinkActivity(h.t);
+  EXPECT_EQ(h.core.onCommand(teleop(101, 0.3, 0.0), h.t).status(), v1::Ack::REJECTED);
+  EXPECT_EQ(h.core.onCommand(simple(102, 'r'), h.t).status(), v1::Ack::ACCEPTED);
+  EXPECT_EQ(h.core.mode(), v1::IDLE);
+  EXPECT_EQ(h.core.onCommand(teleop(103, 0.3, 0.0), h.t).status(), v1::Ack::ACCEPTED);
+}
+
+TEST(RobotCore, LinkDownWhileIdleDoesNotLatch) {
+  Harness h;
+  h.core.onLinkDown(h.t, "closed");
+  EXPECT_EQ(h.core.mode(), v1::IDLE);
+  EXPECT_TRUE(h.core.faults() & v1::FAULT_LINK_LOST);
+  h.core.onLinkUp(h.t);
+  EXPECT_FALSE(h.core.faults() & v1::FAULT_LINK_LOST);
+}
+
+TEST(RobotCore, EStopIsLatched) {
+  Harness h;
+  h.core.onCommand(teleop(1, 0.3, 0.0), h.t);
+  h.run(0.1);
+  EXPECT_EQ(h.core.onCommand(simple(2, 'e'), h.t).status(), v1::Ack::ACCEPTED);
+  EXPECT_EQ(h.core.commandNow().left_mrad_s, 0);
+  const auto r = h.core.onCommand(teleop(3, 0.3, 0.0), h.t);
+  EXPECT_EQ(r.status(), v1::Ack::REJECTED);
+  EXPECT_NE(r.reason().find("e-stop"), std::string::npos);
+  h.run(1.0);
+  EXPECT_EQ(h.core.mode(), v1::ESTOP) << "no automatic restart";
+  h.core.onCommand(simple(4, 's'), h.t);
+  EXPECT_EQ(h.core.mode(), v1::ESTOP) << "stop does not clear an e-stop";
+  h.core.onCommand(simple(5, 'r'), h.t);
+  EXPECT_EQ(h.core.mode(), v1::IDLE);
+}
+
+TEST(RobotCore, StaleSensorFramesStopFromTheTimer) {
+  Harness h;
+  h.core.onCommand(teleop(1, 0.3, 0.0), h.t);
+  h.run(0.1);
+  // No frames from now on; the 10 ms timer notices after sensor_timeout.
+  std::optional<serial::WheelCommand> c;
+  double t = h.t;
+  for (int i = 0; i < 20 && !c; ++i) {
+    t += 0.01;
+    h.core.onLinkActivity(t);
+    c = h.core.onTimer(t);
+  }
+  ASSERT_TRUE(c.has_value());
+  EXPECT_LE(t - h.t, 0.111);
+  EXPECT_EQ(c->left_mrad_s, 0);
+  EXPECT_EQ(h.core.mode(), v1::FAILSAFE);
+  EXPECT_EQ(h.core.onCommand(simple(2, 'r'), t).status(), v1::Ack::REJECTED) << "cannot resume while stale";
+}
+
+TEST(RobotCore, TelemetryReportsState) {
+  Harness h;
+  h.f.ultrasonic_mm = {1000, serial::kNoEcho, 250, 4000};
+  for (int i = 0; i < 5; ++i) {
+    h.core.onCommand(teleop(7, 0.2, 0.1), h.t);
+    h.run(0.1);
+  }
+  v1::Telemetry t;
+  h.core.fillTelemetry(t, h.t);
+  EXPECT_EQ(t.mode(), v1::TELEOP);
+  ASSERT_EQ(t.ultrasonic_m_size(), 4);
+  EXPECT_DOUBLE_EQ(t.ultrasonic_m(0), 1.0);
+  EXPECT_DOUBLE_EQ(t.ultrasonic_m(1), -1.0);
+  EXPECT_EQ(t.last_command_id(), 7u);
+  EXPECT_NEAR(t.cmd_v_m_s(), 0.2, 0.01);
+}
