@@ -219,3 +219,12 @@ TEST(SerialFrame, RandomGarbageNeverDecodesAsAWheelCommand) {
   EXPECT_EQ(foreign, 0u);
   EXPECT_GT(dec.counters().errors(), 1000u);
 }
+
+TEST(SerialFrame, DocumentedHeartbeatExample) {
+  // docs/serial-protocol.md, "Example".
+  FrameEncoder enc;
+  for (int i = 0; i < 3; ++i) enc.encode(Heartbeat{0});
+  const auto f = enc.encode(Heartbeat{1000});
+  const std::vector<uint8_t> want = {0x05, 0x21, 0x03, 0xE8, 0x03, 0x01, 0x03, 0x13, 0xC8, 0x00};
+  EXPECT_EQ(std::vector<uint8_t>(f.span().begin(), f.span().end()), want);
+}

@@ -1,0 +1,118 @@
+#include "tests/integration/stack.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+namespace inspect::test {
+
+std::string binPath(const std::string& prog) { return std::string(INSPECT_BIN_DIR) + "/" + prog; }
+std::string srcPath(const std::string& rel) { return std::string(INSPECT_SOURCE_DIR) + "/" + rel; }
+
+Truth readTruth(const std::string& path) {
+  Truth t;
+  std::istringstream in(readFile(path));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.size() < 2 || line[0] == '#' || line[1] != ',') continue;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) f.push_back(cell);
+    try {
+      if (line[0] == 'T' && f.size() >= 11) {
+        TruthRow r;
+        r.mono_ns = std::stoll(f[1]);
+        r.t = std::stod(f[2]);
+        r.x = std::stod(f[3]);
+        r.y = std::stod(f[4]);
+        r.theta = std::stod(f[5]);
+        r.wheel_l = std::stod(f[6]);
+        r.wheel_r = std::stod(f[7]);
+        r.set_l = std::stod(f[8]);
+        r.set_r = std::stod(f[9]);
+        r.flags = static_cast<unsigned>(std::stoul(f[10]));
+        t.rows.push_back(r);
+      } else if (line[0] == 'C' && f.size() >= 7) {
+        t.commands.push_back({std::stoll(f[1]), std::stod(f[2]), std::stoi(f[3]), std::stoi(f[4]), std::stoi(f[5]),
+                              std::stoi(f[6])});
+      } else if (line[0] == 'E' && f.size() >= 4) {
+        t.events.push_back({std::stoll(f[1]), std::stod(f[2]), f[3], f.size() > 4 ? f[4] : ""});
+      }
+    } catch (const std::exception&) {
+      // A line being written while we read it: skip.
+    }
+  }
+  return t;
+}
+
+Stack::~Stack() {
+  // Client first, so the simulator's watchdog is not what a test sees at teardown.
+  server_.terminate();
+  for (auto& r : robots_) {
+    r->client.terminate();
+    r->sim.terminate();
+  }
+  for (auto& [id, p] : relays_) p.terminate();
+}
+
+bool Stack::startServer(const std::string& script, const std::vector<std::string>& extra) {
+  writeFile(dir_ / "script.txt", script);
+  std::vector<std::string> argv = {binPath("pc_server"), "--config", srcPath("config/server.yaml"),
+                                   "--bind",            "127.0.0.1", "--port",
+                                   "0",                 "--port-file", dir_ / "port",
+                                   "--script",          dir_ / "script.txt"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  server_ = Process::spawn(argv, dir_ / "server.out", dir_ / "server.err");
+  if (!waitUntil([&] { return exists(dir_ / "port"); }, 10.0)) return false;
+  port_ = std::atoi(readFile(dir_ / "port").c_str());
+  return port_ > 0;
+}
+
+RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
+                              const std::vector<std::string>& relay_args) {
+  auto r = std::make_unique<RobotProcs>();
+  r->id = id;
+  r->truth = dir_ / (id + "-truth.csv");
+  r->cmd_log = dir_ / (id + "-cmds.csv");
+  const std::string sim_pty = dir_ / (id + "-mcu");
+  r->sim = Process::spawn({binPath("mcu_sim"), "--world", srcPath("config/worlds/" + world), "--robot",
+                           srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth},
+                          dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
+  waitUntil([&] { return exists(sim_pty); }, 10.0);
+  r->pty = sim_pty;
+  if (!relay_args.empty()) {
+    r->pty = dir_ / (id + "-relay");
+    std::vector<std::string> argv = {binPath("serial_relay"), "--mcu", sim_pty, "--pty-link", r->pty};
+    argv.insert(argv.end(), relay_args.begin(), relay_args.end());
+    relays_.emplace(id, Process::spawn(argv, dir_ / (id + "-relay.out"), dir_ / (id + "-relay.err")));
+    waitUntil([&] { return exists(r->pty); }, 10.0);
+  }
+  r->client = Process::spawn({binPath("robot_client"), "--config", srcPath("config/client.yaml"), "--robot-config",
+                              srcPath("config/robot.yaml"), "--serial", r->pty, "--server",
+                              "127.0.0.1:" + std::to_string(port_), "--id", id, "--cmd-log", r->cmd_log},
+                             dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
+  robots_.push_back(std::move(r));
+  return *robots_.back();
+}
+
+std::string Stack::logs() const {
+  std::string out;
+  auto add = [&](const std::string& name) {
+    const std::string text = readFile(dir_ / name);
+    if (text.empty()) return;
+    out += "---- " + name + " ----\n" + (text.size() > 6000 ? "...\n" + text.substr(text.size() - 6000) : text);
+  };
+  add("server.out");
+  add("server.err");
+  for (const auto& r : robots_) {
+    add(r->id + "-sim.out");
+    add(r->id + "-sim.err");
+    add(r->id + "-client.err");
+    add(r->id + "-relay.out");
+    add(r->id + "-relay.err");
+  }
+  return out;
+}
+
+}  // namespace inspect::test

@@ -1,0 +1,81 @@
+#pragma once
+// The three real programs wired together on loopback for integration tests,
+// plus a reader of mcu_sim's ground-truth log.
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tests/integration/process.hpp"
+
+namespace inspect::test {
+
+/// One `T` row of the truth log (100 Hz).
+struct TruthRow {
+  int64_t mono_ns = 0;
+  double t = 0, x = 0, y = 0, theta = 0, wheel_l = 0, wheel_r = 0, set_l = 0, set_r = 0;
+  unsigned flags = 0;
+};
+/// One `C` row: a wheel command the simulated MCU accepted.
+struct TruthCommand {
+  int64_t mono_ns = 0;
+  double t = 0;
+  int seq = 0, left = 0, right = 0, flags = 0;
+};
+/// One `E` row.
+struct TruthEvent {
+  int64_t mono_ns = 0;
+  double t = 0;
+  std::string name, detail;
+};
+struct Truth {
+  std::vector<TruthRow> rows;
+  std::vector<TruthCommand> commands;
+  std::vector<TruthEvent> events;
+};
+Truth readTruth(const std::string& path);
+
+std::string binPath(const std::string& prog);
+std::string srcPath(const std::string& rel);
+
+/// A simulated robot: mcu_sim + robot_client.
+struct RobotProcs {
+  std::string id;
+  std::string pty;      // symlink to the pty robot_client opens
+  std::string truth;    // mcu_sim's truth log
+  std::string cmd_log;  // robot_client's sent wheel commands
+  Process sim;
+  Process client;
+};
+
+class Stack {
+ public:
+  explicit Stack(const std::string& tag) : dir_(tag) {}
+  ~Stack();
+
+  const TempDir& dir() const { return dir_; }
+
+  /// Starts pc_server on an ephemeral port running `script` (console commands).
+  /// Returns false if it did not report its port within 10 s.
+  bool startServer(const std::string& script, const std::vector<std::string>& extra = {});
+  /// Starts mcu_sim (world file under config/worlds) and a robot_client.
+  /// `relay_args` non-empty puts tests' serial_relay between them.
+  RobotProcs& startRobot(const std::string& id, const std::string& world = "square_room.yaml",
+                         const std::vector<std::string>& relay_args = {});
+  Process& server() { return server_; }
+  int port() const { return port_; }
+  std::string serverOutput() const { return readFile(dir_ / "server.out"); }
+  /// Everything the processes printed, for failure messages.
+  std::string logs() const;
+
+  Process& relay(const std::string& id) { return relays_.at(id); }
+
+ private:
+  TempDir dir_;
+  Process server_;
+  int port_ = 0;
+  std::vector<std::unique_ptr<RobotProcs>> robots_;
+  std::map<std::string, Process> relays_;
+};
+
+}  // namespace inspect::test

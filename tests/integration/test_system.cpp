@@ -1,0 +1,237 @@
+// The three real programs on loopback: mcu_sim on a real pty, robot_client,
+// pc_server driven by a console script. Ground truth comes from mcu_sim.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <tuple>
+
+#include "tests/integration/stack.hpp"
+
+using namespace inspect::test;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double wrap(double a) { return std::remainder(a, 2 * kPi); }
+
+struct Rel {
+  double x, y, th;
+};
+
+// Pose of `r` in the frame of the robot's start pose `s`.
+Rel relative(const TruthRow& s, const TruthRow& r) {
+  const double dx = r.x - s.x, dy = r.y - s.y, c = std::cos(s.theta), sn = std::sin(s.theta);
+  return {c * dx + sn * dy, -sn * dx + c * dy, wrap(r.theta - s.theta)};
+}
+
+// The last row of every period of >= 0.5 s in which the wheels stood still.
+std::vector<TruthRow> restPoses(const Truth& t) {
+  std::vector<TruthRow> out;
+  std::size_t start = 0;
+  bool in_rest = false;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const auto& r = t.rows[i];
+    const bool still = std::abs(r.wheel_l) < 0.01 && std::abs(r.wheel_r) < 0.01 && r.set_l == 0 && r.set_r == 0;
+    if (still && !in_rest) {
+      start = i;
+      in_rest = true;
+    }
+    if ((!still || i + 1 == t.rows.size()) && in_rest) {
+      const std::size_t end = still ? i : i - 1;
+      if (t.rows[end].t - t.rows[start].t >= 0.5) out.push_back(t.rows[end]);
+      in_rest = false;
+    }
+  }
+  return out;
+}
+
+// First truth row at or after `after_ns` satisfying pred; nullptr if none.
+template <class P>
+const TruthRow* firstAfter(const Truth& t, int64_t after_ns, P pred) {
+  for (const auto& r : t.rows)
+    if (r.mono_ns >= after_ns && pred(r)) return &r;
+  return nullptr;
+}
+
+bool atSpeed(const std::string& truth, double wheel_rad_s) {
+  const auto t = readTruth(truth);
+  if (t.rows.size() < 20) return false;
+  for (std::size_t i = t.rows.size() - 20; i < t.rows.size(); ++i)
+    if (std::abs(t.rows[i].wheel_l) < wheel_rad_s || std::abs(t.rows[i].wheel_r) < wheel_rad_s) return false;
+  return true;
+}
+
+const char* kConnect = "expect robots >= 1 within 15\nexpect sensor_hz > 50 within 5\nexpect mode == IDLE\n";
+
+}  // namespace
+
+TEST(System, ScriptedSquareDriveReachesExpectedPoses) {
+  Stack s("square");
+  std::ostringstream script;
+  script << kConnect << "wait 1\n";
+  // Four legs of 1.0 m (0.4 m/s for 2.5 s) and four left turns of 90 deg
+  // (0.8 rad/s for pi/2/0.8 s), stopping in between.
+  const double turn_s = kPi / 2 / 0.8;
+  const double corners[4][3] = {{1, 0, 0}, {1, 1, kPi / 2}, {0, 1, kPi}, {0, 0, -kPi / 2}};
+  for (int leg = 0; leg < 4; ++leg) {
+    script << "drive 0.4 0\nwait 2.5\nstop\nwait 1\n";
+    script << "expect x ~ " << corners[leg][0] << " 0.05\nexpect y ~ " << corners[leg][1] << " 0.05\n";
+    script << "drive 0 0.8\nwait " << turn_s << "\nstop\nwait 1\n";
+  }
+  script << "expect x ~ 0 0.05\nexpect y ~ 0 0.05\nexpect theta ~ 0 0.05\nstatus\n";
+  ASSERT_TRUE(s.startServer(script.str())) << s.logs();
+  auto& r = s.startRobot("robot1");
+  const auto rc = s.server().wait(90);
+  ASSERT_TRUE(rc.has_value()) << "script did not finish\n" << s.logs();
+  EXPECT_EQ(*rc, 0) << "a console expect failed (telemetry pose)\n" << s.serverOutput();
+
+  const auto truth = readTruth(r.truth);
+  const auto rest = restPoses(truth);
+  ASSERT_GE(rest.size(), 9u) << s.logs();
+  // rest[0] is the start; then one rest after every leg and every turn.
+  const Rel expected[9] = {{0, 0, 0},         {1, 0, 0},         {1, 0, kPi / 2}, {1, 1, kPi / 2}, {1, 1, kPi},
+                           {0, 1, kPi},       {0, 1, -kPi / 2},  {0, 0, -kPi / 2}, {0, 0, 0}};
+  double worst_pos = 0, worst_ang = 0;
+  for (int i = 0; i < 9; ++i) {
+    const Rel got = relative(rest[0], rest[static_cast<std::size_t>(i)]);
+    const double dp = std::hypot(got.x - expected[i].x, got.y - expected[i].y);
+    const double da = std::abs(wrap(got.th - expected[i].th));
+    worst_pos = std::max(worst_pos, dp);
+    worst_ang = std::max(worst_ang, da);
+    EXPECT_LE(dp, 0.05) << "pose " << i << ": (" << got.x << ", " << got.y << ")";
+    EXPECT_LE(da, 0.05) << "pose " << i << ": theta " << got.th;
+  }
+  std::printf("SQUARE worst position error %.4f m, worst heading error %.4f rad over 9 poses\n", worst_pos, worst_ang);
+}
+
+TEST(System, EStopHoldsUntilResume) {
+  Stack s("estop");
+  std::string script = kConnect;
+  script +=
+      "drive 0.2 0\nexpect v ~ 0.2 0.03 within 3\n"
+      "estop\nexpect mode == ESTOP within 1\nexpect v ~ 0 0.01 within 1\n"
+      "drive 0.2 0\nwait 1\nexpect v ~ 0 0.01\nexpect mode == ESTOP\n"
+      "stop\nwait 0.5\nexpect mode == ESTOP\n"
+      "resume\nexpect mode == IDLE within 1\n"
+      "drive 0.2 0\nexpect v ~ 0.2 0.03 within 3\nstop\nexpect v ~ 0 0.01 within 2\n";
+  ASSERT_TRUE(s.startServer(script)) << s.logs();
+  s.startRobot("robot1");
+  const auto rc = s.server().wait(60);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  EXPECT_EQ(*rc, 0) << s.serverOutput();
+}
+
+TEST(System, KillingTheServerStopsTheWheels) {
+  Stack s("killserver");
+  ASSERT_TRUE(s.startServer(std::string(kConnect) + "drive 0.3 0\nwait 60\n")) << s.logs();
+  auto& r = s.startRobot("robot1");
+  ASSERT_TRUE(waitUntil([&] { return atSpeed(r.truth, 1.4); }, 20)) << s.logs();
+  const int64_t t_kill = nowNs();
+  s.server().signal(SIGKILL);
+  sleepS(1.5);
+  const auto truth = readTruth(r.truth);
+  const auto* zero = firstAfter(truth, t_kill, [](const TruthRow& x) { return x.set_l == 0 && x.set_r == 0; });
+  const auto* still = firstAfter(truth, t_kill, [](const TruthRow& x) {
+    return std::abs(x.wheel_l) < 0.05 && std::abs(x.wheel_r) < 0.05;
+  });
+  ASSERT_NE(zero, nullptr) << s.logs();
+  ASSERT_NE(still, nullptr) << s.logs();
+  const double set_ms = (zero->mono_ns - t_kill) / 1e6, still_ms = (still->mono_ns - t_kill) / 1e6;
+  std::printf("LINK_LOSS_STOP server SIGKILL -> wheel set-points zero %.1f ms, wheels < 0.05 rad/s %.1f ms\n", set_ms,
+              still_ms);
+  EXPECT_LE(set_ms, 300.0);
+  // The robot latched a failsafe: it must not restart by itself.
+  EXPECT_NE(readFile(s.dir() / "robot1-client.err").find("FAILSAFE"), std::string::npos);
+  const auto later = readTruth(r.truth);
+  EXPECT_LT(std::abs(later.rows.back().set_l), 1e-9);
+}
+
+TEST(System, KillingTheClientTripsTheMcuWatchdog) {
+  Stack s("killclient");
+  ASSERT_TRUE(s.startServer(std::string(kConnect) + "drive 0.3 0\nwait 60\n")) << s.logs();
+  auto& r = s.startRobot("robot1");
+  ASSERT_TRUE(waitUntil([&] { return atSpeed(r.truth, 1.4); }, 20)) << s.logs();
+  const int64_t t_kill = nowNs();
+  r.client.signal(SIGKILL);
+  sleepS(1.0);
+  const auto truth = readTruth(r.truth);
+  const auto* zero = firstAfter(truth, t_kill, [](const TruthRow& x) { return x.set_l == 0 && x.set_r == 0; });
+  ASSERT_NE(zero, nullptr) << s.logs();
+  const double ms = (zero->mono_ns - t_kill) / 1e6;
+  const TruthEvent* trip = nullptr;
+  for (const auto& e : truth.events)
+    if (e.name == "watchdog_trip" && e.mono_ns >= t_kill - 20'000'000) trip = &e;
+  ASSERT_NE(trip, nullptr) << s.logs();
+  std::printf("MCU_WATCHDOG client SIGKILL -> set-points zero %.1f ms (trip %s ms after the last command)\n", ms,
+              trip->detail.c_str());
+  EXPECT_LE(ms, 200.0 + 10.0 + 5.0);  // 200 ms + one 10 ms frame + scheduling slack
+  EXPECT_LE(std::stod(trip->detail), 201.0);
+}
+
+TEST(System, SerialGarbageNeverBecomesAWheelCommand) {
+  Stack s("garbage");
+  std::string script = kConnect;
+  script += "drive 0.2 0.3\nwait 5\nexpect serial_bad_crc > 0\nstop\nwait 0.5\n";
+  ASSERT_TRUE(s.startServer(script)) << s.logs();
+  auto& r = s.startRobot("robot1", "square_room.yaml",
+                         {"--garbage-per-s", "30", "--ber-up", "2e-4", "--ber-down", "2e-4", "--seed", "7"});
+  const auto rc = s.server().wait(60);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  EXPECT_EQ(*rc, 0) << s.serverOutput();
+  s.relay("robot1").terminate();
+
+  std::set<std::tuple<int, int, int, int>> sent;
+  std::istringstream in(readFile(r.cmd_log));
+  std::string line;
+  while (std::getline(in, line)) {
+    int seq, l, rr, f;
+    if (std::sscanf(line.c_str(), "%d,%d,%d,%d", &seq, &l, &rr, &f) == 4) sent.insert({seq, l, rr, f});
+  }
+  const auto truth = readTruth(r.truth);
+  ASSERT_GT(sent.size(), 100u);
+  ASSERT_GT(truth.commands.size(), 100u);
+  std::size_t foreign = 0;
+  for (const auto& c : truth.commands)
+    if (!sent.count({c.seq, c.left, c.right, c.flags})) ++foreign;
+  std::printf("GARBAGE %zu commands sent, %zu applied by the MCU, %zu not sent by robot_client\n%s", sent.size(),
+              truth.commands.size(), foreign, readFile(s.dir() / "robot1-relay.out").c_str());
+  EXPECT_EQ(foreign, 0u);
+  EXPECT_LT(truth.commands.size(), sent.size()) << "some commands must have been corrupted and dropped";
+}
+
+TEST(System, SecondRobotConnectsWhileFirstDrives) {
+  Stack s("tworobots");
+  std::string script =
+      "select robot1\nexpect robots >= 1 within 15\nexpect sensor_hz > 50 within 5\n"
+      "drive 0 0.5\nexpect w ~ 0.5 0.1 within 3\n"
+      "expect robots == 2 within 20\n"
+      "expect w ~ 0.5 0.1\n"
+      "select robot2\nexpect connected == 1\nexpect sensor_hz > 50 within 5\n"
+      "drive 0 -0.5\nexpect w ~ -0.5 0.1 within 3\n"
+      "select robot1\nexpect w ~ 0.5 0.1\nstop\n"
+      "select robot2\nstop\nexpect w ~ 0 0.02 within 2\n";
+  ASSERT_TRUE(s.startServer(script)) << s.logs();
+  auto& r1 = s.startRobot("robot1");
+  ASSERT_TRUE(waitUntil([&] { return atSpeed(r1.truth, 0.4); }, 20)) << s.logs();
+  const int64_t t2 = nowNs();
+  s.startRobot("robot2");
+  const auto rc = s.server().wait(60);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  EXPECT_EQ(*rc, 0) << s.serverOutput();
+  // robot1 never stopped while robot2 connected and drove.
+  const auto truth = readTruth(r1.truth);
+  std::size_t checked = 0;
+  for (const auto& row : truth.rows) {
+    if (row.mono_ns < t2 || row.mono_ns > t2 + 3'000'000'000LL) continue;
+    ++checked;
+    EXPECT_GT(std::abs(row.set_r), 0.4) << "robot1 slowed at t=" << row.t;
+  }
+  EXPECT_GT(checked, 200u);
+}

@@ -1,0 +1,181 @@
+// serial_relay: sits on the serial line between mcu_sim and robot_client and
+// damages it on purpose: random bit errors at a given bit error rate and
+// bursts of random garbage bytes, in either direction. For tests only.
+#include <fcntl.h>
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <array>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "sim/pty_port.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+
+constexpr const char* kUsage = R"(usage: serial_relay --mcu PATH --pty-link PATH [options]
+
+Relays bytes between the MCU's serial device (PATH, e.g. mcu_sim's pty) and a
+new pseudo-terminal (linked at --pty-link) for robot_client, injecting errors.
+
+options:
+  --ber-up X          bit error rate towards the MCU (default 0)
+  --ber-down X        bit error rate towards robot_client (default 0)
+  --garbage-per-s N   bursts of 1-24 random bytes per second, each direction (default 0)
+  --seed N            random seed (default 1)
+  --help
+)";
+
+struct Direction {
+  const char* name;
+  int idx;  // 0 = down (to robot_client), 1 = up (to the MCU)
+  double ber = 0.0;
+  uint64_t bytes = 0, flipped_bits = 0, garbage_bytes = 0, dropped = 0;
+};
+
+class Damage {
+ public:
+  explicit Damage(unsigned seed) : rng_(seed) {}
+  // Flips bits with probability `ber` each (geometric skipping keeps it cheap).
+  void corrupt(std::vector<uint8_t>& buf, Direction& d) {
+    d.bytes += buf.size();
+    if (d.ber <= 0.0) return;
+    std::geometric_distribution<uint64_t> gap(d.ber);
+    const uint64_t bits = buf.size() * 8;
+    uint64_t pos = carry_[d.idx];
+    while (pos < bits) {
+      buf[pos / 8] ^= static_cast<uint8_t>(1u << (pos % 8));
+      ++d.flipped_bits;
+      pos += 1 + gap(rng_);
+    }
+    carry_[d.idx] = pos - bits;
+  }
+  void garbage(std::vector<uint8_t>& buf, Direction& d) {
+    std::uniform_int_distribution<int> len(1, 24), byte(0, 255);
+    const int n = len(rng_);
+    for (int i = 0; i < n; ++i) buf.push_back(static_cast<uint8_t>(byte(rng_)));
+    d.garbage_bytes += static_cast<uint64_t>(n);
+  }
+  bool chance(double p) { return std::uniform_real_distribution<double>(0, 1)(rng_) < p; }
+  void seedCarry(double ber_up, double ber_down) {
+    if (ber_down > 0) carry_[0] = std::geometric_distribution<uint64_t>(ber_down)(rng_);
+    if (ber_up > 0) carry_[1] = std::geometric_distribution<uint64_t>(ber_up)(rng_);
+  }
+
+ private:
+  std::mt19937_64 rng_;
+  uint64_t carry_[2] = {0, 0};
+};
+
+[[noreturn]] void die(const std::string& msg) {
+  std::fprintf(stderr, "serial_relay: %s\n", msg.c_str());
+  std::exit(2);
+}
+
+double number(const char* s, const std::string& flag) {
+  char* end = nullptr;
+  const double v = std::strtod(s, &end);
+  if (*end != '\0' || v < 0) die(flag + ": '" + s + "' is not a non-negative number");
+  return v;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string mcu_path, link_path;
+  Direction up{"up", 1}, down{"down", 0};
+  double garbage_per_s = 0;
+  unsigned seed = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) die(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "--mcu") {
+      mcu_path = value();
+    } else if (a == "--pty-link") {
+      link_path = value();
+    } else if (a == "--ber-up") {
+      up.ber = number(value(), a);
+    } else if (a == "--ber-down") {
+      down.ber = number(value(), a);
+    } else if (a == "--garbage-per-s") {
+      garbage_per_s = number(value(), a);
+    } else if (a == "--seed") {
+      seed = static_cast<unsigned>(number(value(), a));
+    } else {
+      die("unknown option '" + a + "'");
+    }
+  }
+  if (mcu_path.empty() || link_path.empty()) die("--mcu and --pty-link are required");
+  if (up.ber > 0.5 || down.ber > 0.5) die("bit error rates must be <= 0.5");
+
+  const int mcu = ::open(mcu_path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+  if (mcu < 0) die("cannot open " + mcu_path + ": " + std::strerror(errno));
+  termios tio{};
+  if (::tcgetattr(mcu, &tio) == 0) {
+    ::cfmakeraw(&tio);
+    ::tcsetattr(mcu, TCSANOW, &tio);
+  }
+  inspect::sim::PtyPort host(link_path);
+  std::printf("serial_relay: serial device %s\n", host.slavePath().c_str());
+  std::fflush(stdout);
+
+  std::signal(SIGINT, [](int) { g_stop = 1; });
+  std::signal(SIGTERM, [](int) { g_stop = 1; });
+
+  Damage dmg(seed);
+  dmg.seedCarry(up.ber, down.ber);
+  std::array<uint8_t, 4096> buf{};
+  std::vector<uint8_t> chunk;
+  const double poll_s = 0.005;
+  while (!g_stop) {
+    pollfd fds[2] = {{mcu, POLLIN, 0}, {host.fd(), POLLIN, 0}};
+    ::poll(fds, 2, static_cast<int>(poll_s * 1000));
+    // MCU -> robot_client.
+    chunk.clear();
+    for (;;) {
+      const ssize_t n = ::read(mcu, buf.data(), buf.size());
+      if (n <= 0) break;
+      chunk.insert(chunk.end(), buf.begin(), buf.begin() + n);
+    }
+    if (garbage_per_s > 0 && dmg.chance(garbage_per_s * poll_s)) dmg.garbage(chunk, down);
+    if (!chunk.empty()) {
+      dmg.corrupt(chunk, down);
+      const std::size_t w = host.write(chunk);
+      down.dropped += chunk.size() - w;
+    }
+    // robot_client -> MCU.
+    chunk.clear();
+    for (;;) {
+      const std::size_t n = host.read(buf);
+      if (n == 0) break;
+      chunk.insert(chunk.end(), buf.begin(), buf.begin() + static_cast<long>(n));
+    }
+    if (garbage_per_s > 0 && dmg.chance(garbage_per_s * poll_s)) dmg.garbage(chunk, up);
+    if (!chunk.empty()) {
+      dmg.corrupt(chunk, up);
+      const ssize_t w = ::write(mcu, chunk.data(), chunk.size());
+      up.dropped += chunk.size() - static_cast<std::size_t>(w > 0 ? w : 0);
+    }
+  }
+  for (const Direction* d : {&down, &up})
+    std::printf("serial_relay %-4s: %llu bytes, %llu bits flipped (BER %.2g), %llu garbage bytes, %llu dropped\n",
+                d->name, static_cast<unsigned long long>(d->bytes), static_cast<unsigned long long>(d->flipped_bits),
+                d->bytes ? static_cast<double>(d->flipped_bits) / (8.0 * static_cast<double>(d->bytes)) : 0.0,
+                static_cast<unsigned long long>(d->garbage_bytes), static_cast<unsigned long long>(d->dropped));
+  ::close(mcu);
+  return 0;
+}
