@@ -1,0 +1,42 @@
+// robot_client configuration: shipped file, overrides, and errors.
+#include <gtest/gtest.h>
+
+#include "robot_client/client_config.hpp"
+
+using namespace inspect;
+
+namespace {
+std::string errorOf(const std::string& yaml) {
+  try {
+    const auto root = config::ConfigNode::loadString(yaml, "client.yaml");
+    (void)client::loadClientConfig(root);
+    root.checkKnown();
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(ClientConfig, ShippedFileLoads) {
+  const auto c = client::loadClientConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/client.yaml");
+  EXPECT_EQ(c.server_port, 7600);
+  EXPECT_DOUBLE_EQ(c.safety.link_timeout_s, 0.3);
+  EXPECT_EQ(c.baud, 115200);
+}
+
+TEST(ClientConfig, Errors) {
+  EXPECT_NE(errorOf("robot_id: 'bad id!'").find("robot_id"), std::string::npos);
+  EXPECT_NE(errorOf("server:\n  port: 70000\n").find("server.port: 70000 is out of range"), std::string::npos);
+  EXPECT_NE(errorOf("serial:\n  baud: 115201\n").find("not a standard rate"), std::string::npos);
+  EXPECT_NE(errorOf("safety:\n  link_timeout_s: 0\n").find("safety.link_timeout_s"), std::string::npos);
+  EXPECT_NE(errorOf("server:\n  prot: 1\n").find("server.prot: unknown key"), std::string::npos);
+  EXPECT_NE(errorOf("server:\n  port: 7600.5\n").find("not a whole number"), std::string::npos);
+}
+
+TEST(ClientConfig, RobotIds) {
+  EXPECT_TRUE(client::validRobotId("robot_1-A"));
+  EXPECT_FALSE(client::validRobotId(""));
+  EXPECT_FALSE(client::validRobotId(std::string(65, 'a')));
+  EXPECT_FALSE(client::validRobotId("a b"));
+}
