@@ -177,9 +177,11 @@ serial::WheelCommand RobotCore::computeCommand(double dt_s) {
   target = control::limitTwist(target, robot_.geometry.wheel_radius_m, robot_.geometry.track_m,
                                robot_.limits.max_wheel_speed_rad_s);
   const auto want = control::wheelsFromTwist(target, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
-  if (mode_ != v1::TELEOP || latched || (faults_ & v1::FAULT_SENSOR_STALE)) {
-    cmd_wheels_ = {};  // stops are immediate, not slew-limited
+  if (latched || (faults_ & v1::FAULT_SENSOR_STALE)) {
+    cmd_wheels_ = {};  // safety stops are immediate, not slew-limited
   } else {
+    // Normal starts and stops ramp symmetrically, so a timed teleop segment
+    // covers exactly v * T.
     const double step = robot_.limits.max_wheel_accel_rad_s2 * std::clamp(dt_s, 0.0, 0.05);
     cmd_wheels_.left_rad_s = slew(cmd_wheels_.left_rad_s, want.left_rad_s, step);
     cmd_wheels_.right_rad_s = slew(cmd_wheels_.right_rad_s, want.right_rad_s, step);

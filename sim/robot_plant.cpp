@@ -1,0 +1,66 @@
+#include "sim/robot_plant.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace inspect::sim {
+namespace {
+
+struct MotorStep {
+  double speed_rad_s;  // speed at the end of the step
+  double angle_rad;    // angle turned during the step
+};
+
+// Exact solution of tau * w' = sp - w over dt: speed and its integral, so the
+// wheel travel is exact whatever the step size.
+MotorStep motorStep(double w0, double sp, double tau_s, double dt_s) {
+  const double decay = std::exp(-dt_s / tau_s);
+  return {sp + (w0 - sp) * decay, sp * dt_s + (w0 - sp) * tau_s * (1.0 - decay)};
+}
+
+}  // namespace
+
+RobotPlant::RobotPlant(const config::RobotConfig& robot, const World& world)
+    : wheel_radius_m_(robot.geometry.wheel_radius_m),
+      track_m_(robot.geometry.track_m),
+      body_radius_m_(robot.geometry.body_radius_m),
+      time_constant_s_(robot.motor.time_constant_s),
+      max_wheel_rad_s_(robot.limits.max_wheel_speed_rad_s),
+      world_(world) {}
+
+control::WheelSpeeds RobotPlant::clampSetpoint(const control::WheelSpeeds& sp) const {
+  auto clamp = [&](double v) { return std::isfinite(v) ? std::clamp(v, -max_wheel_rad_s_, max_wheel_rad_s_) : 0.0; };
+  return {clamp(sp.left_rad_s), clamp(sp.right_rad_s)};
+}
+
+PlantStep RobotPlant::step(const PlantState& s, const control::WheelSpeeds& setpoint, double dt_s) const {
+  const auto sp = clampSetpoint(setpoint);
+  const MotorStep l = motorStep(s.wheel.left_rad_s, sp.left_rad_s, time_constant_s_, dt_s);
+  const MotorStep r = motorStep(s.wheel.right_rad_s, sp.right_rad_s, time_constant_s_, dt_s);
+  const double d_left_m = l.angle_rad * wheel_radius_m_;
+  const double d_right_m = r.angle_rad * wheel_radius_m_;
+
+  PlantStep out;
+  out.state = s;
+  out.state.wheel = {l.speed_rad_s, r.speed_rad_s};
+  out.state.wheel_travel_left_m += d_left_m;
+  out.state.wheel_travel_right_m += d_right_m;
+
+  // Eqs 1-3 in the project convention, midpoint-integrated over the 1 ms step.
+  const control::Pose2 next = control::integrateOdometry(s.pose, d_left_m, d_right_m, track_m_);
+  const double c_next = clearance(world_, {next.x_m, next.y_m});
+  const double c_now = clearance(world_, {s.pose.x_m, s.pose.y_m});
+  // A step into a wall is refused; one that increases clearance is always
+  // allowed so that a robot touching a wall can back away.
+  if (c_next < body_radius_m_ && c_next < c_now) {
+    out.blocked = true;
+    out.state.pose.theta_rad = next.theta_rad;  // a circle can always turn in place
+    out.clearance_m = c_now;
+  } else {
+    out.state.pose = next;
+    out.clearance_m = c_next;
+  }
+  return out;
+}
+
+}  // namespace inspect::sim

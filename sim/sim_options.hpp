@@ -1,0 +1,34 @@
+#pragma once
+// Command line of mcu_sim.
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace inspect::sim {
+
+/// A bad command line; main() prints what() (it names the flag) and exits 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Parsed mcu_sim arguments.
+struct SimOptions {
+  std::string world_path;
+  std::string robot_path = "config/robot.yaml";
+  std::string pty_link;              // empty: no symlink
+  std::string truth_path;            // empty: no truth log
+  double rate = 1.0;                 // sim seconds per wall second, [0.1, 100]
+  std::optional<double> duration_s;  // sim seconds; empty: until SIGINT/SIGTERM
+  uint64_t seed = 1;
+  bool help = false;
+};
+
+/// Parses argv (without argv[0]); throws UsageError naming the flag.
+SimOptions parseSimOptions(const std::vector<std::string>& args);
+/// The --help text.
+std::string simUsage();
+
+}  // namespace inspect::sim

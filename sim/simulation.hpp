@@ -1,0 +1,64 @@
+#pragma once
+// The whole simulated robot and world in sim time: plant, sensors and MCU,
+// stepped at 1 kHz with a sensor frame every 10 ms. No I/O and no clocks:
+// bytes go in through receive(), frames come out of takeTx().
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "shared/config/robot_config.hpp"
+#include "sim/grayscale_model.hpp"
+#include "sim/mcu_emulator.hpp"
+#include "sim/robot_plant.hpp"
+#include "sim/sim_observer.hpp"
+#include "sim/ultrasonic_model.hpp"
+#include "sim/world.hpp"
+
+namespace inspect::sim {
+
+/// World + robot + MCU, advanced in fixed 1 ms steps.
+class Simulation {
+ public:
+  static constexpr uint64_t kStep_ms = 1;
+  static constexpr uint64_t kFramePeriod_ms = 10;
+  /// Contact ends (and a new collision may be logged) once clearance exceeds body radius + this.
+  static constexpr double kContactRelease_m = 0.005;
+
+  /// Throws config::ConfigError when the start pose overlaps an obstacle.
+  Simulation(const config::RobotConfig& robot, World world, uint64_t seed, SimObserver* observer = nullptr);
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  /// Bytes from the host, applied at the current sim time.
+  void receive(std::span<const uint8_t> bytes);
+  /// One 1 ms step: MCU timers, a sensor frame when due, physics.
+  void step();
+  /// Steps until timeMs() == t_ms (no-op when already there).
+  void advanceTo(uint64_t t_ms);
+  /// Moves the bytes of the frames produced so far into out (out is cleared first).
+  void takeTx(std::vector<uint8_t>& out);
+
+  uint64_t timeMs() const { return t_ms_; }
+  double timeS() const { return static_cast<double>(t_ms_) / 1000.0; }
+  const PlantState& state() const { return state_; }
+  const McuEmulator& mcu() const { return mcu_; }
+  const World& world() const { return world_; }
+  uint64_t collisions() const { return collisions_; }
+
+ private:
+  void emitFrame();
+
+  World world_;
+  RobotPlant plant_;
+  UltrasonicModel ultrasonic_;
+  McuEmulator mcu_;
+  SimObserver* observer_;
+  PlantState state_;
+  uint64_t t_ms_ = 0;
+  bool in_contact_ = false;
+  uint64_t collisions_ = 0;
+  double body_radius_m_;
+  std::vector<uint8_t> tx_;
+};
+
+}  // namespace inspect::sim

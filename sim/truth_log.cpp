@@ -1,0 +1,69 @@
+#include "sim/truth_log.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+#include "shared/util/clock.hpp"
+
+namespace inspect::sim {
+
+TruthLog::TruthLog(const std::string& path) : file_(std::fopen(path.c_str(), "w")) {
+  if (!file_) throw std::runtime_error("--truth " + path + ": cannot open for writing: " + std::strerror(errno));
+  comment("mcu_sim ground truth; format: docs/simulator.md");
+  comment("T,mono_ns,sim_t_s,x_m,y_m,theta_rad,wheel_l_rad_s,wheel_r_rad_s,setpoint_l_rad_s,setpoint_r_rad_s,fault_flags");
+  comment("C,mono_ns,sim_t_s,seq,left_mrad_s,right_mrad_s,flags");
+  comment("E,mono_ns,sim_t_s,event,detail");
+}
+
+TruthLog::~TruthLog() {
+  if (file_) std::fclose(file_);
+}
+
+void TruthLog::line(const char* text, int n) {
+  if (n <= 0) return;
+  // snprintf returns the untruncated length; the callers' buffers end with '\n' only when it fit.
+  n = std::min(n, static_cast<int>(std::strlen(text)));
+  std::fwrite(text, 1, static_cast<std::size_t>(n), file_);
+  std::fflush(file_);
+}
+
+void TruthLog::onSample(const TruthSample& s) {
+  char buf[256];
+  const int n = std::snprintf(buf, sizeof buf, "T,%lld,%.3f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%.5f,%u\n",
+                              static_cast<long long>(monoNowNs()), s.sim_t_s, s.pose.x_m, s.pose.y_m, s.pose.theta_rad,
+                              s.wheel.left_rad_s, s.wheel.right_rad_s, s.setpoint.left_rad_s, s.setpoint.right_rad_s,
+                              static_cast<unsigned>(s.faults));
+  line(buf, n);
+}
+
+void TruthLog::onCommand(double sim_t_s, uint8_t seq, const serial::WheelCommand& cmd) {
+  char buf[128];
+  const int n = std::snprintf(buf, sizeof buf, "C,%lld,%.3f,%u,%d,%d,%u\n", static_cast<long long>(monoNowNs()),
+                              sim_t_s, static_cast<unsigned>(seq), static_cast<int>(cmd.left_mrad_s),
+                              static_cast<int>(cmd.right_mrad_s), static_cast<unsigned>(cmd.flags));
+  line(buf, n);
+}
+
+void TruthLog::onEvent(double sim_t_s, std::string_view event, std::string_view detail) {
+  std::string s = "E," + std::to_string(monoNowNs()) + ",";
+  char t[32];
+  std::snprintf(t, sizeof t, "%.3f", sim_t_s);
+  s += t;
+  s += ',';
+  s += event;
+  s += ',';
+  for (char c : detail) s += (c == ',' || c == '\n') ? ';' : c;  // keep one CSV record per line
+  s += '\n';
+  line(s.data(), static_cast<int>(s.size()));
+}
+
+void TruthLog::comment(std::string_view text) {
+  std::string s = "# ";
+  s += text;
+  s += '\n';
+  line(s.data(), static_cast<int>(s.size()));
+}
+
+}  // namespace inspect::sim

@@ -1,0 +1,32 @@
+#pragma once
+// Ground-truth CSV log (--truth FILE): T (state per frame), C (accepted wheel
+// commands), E (events) lines, '#' comments; every line flushed at once
+// because tests read the file while the simulator runs. Format: docs/simulator.md.
+#include <cstdio>
+#include <string>
+#include <string_view>
+
+#include "sim/sim_observer.hpp"
+
+namespace inspect::sim {
+
+/// Writes the truth log; throws std::runtime_error when the file cannot be opened.
+class TruthLog : public SimObserver {
+ public:
+  explicit TruthLog(const std::string& path);
+  ~TruthLog() override;
+  TruthLog(const TruthLog&) = delete;
+  TruthLog& operator=(const TruthLog&) = delete;
+
+  void onSample(const TruthSample& s) override;
+  void onCommand(double sim_t_s, uint8_t seq, const serial::WheelCommand& cmd) override;
+  void onEvent(double sim_t_s, std::string_view event, std::string_view detail) override;
+  /// Writes "# <text>".
+  void comment(std::string_view text);
+
+ private:
+  void line(const char* text, int n);
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace inspect::sim

@@ -1,0 +1,55 @@
+#pragma once
+// The simulated world: walls, closed obstacles, floor lines and the robot's
+// start pose, loaded from a YAML world file (docs/world-format.md).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "shared/config/config_node.hpp"
+#include "shared/control/diff_drive.hpp"
+#include "sim/geometry.hpp"
+
+namespace inspect::sim {
+
+/// A painted line on the floor seen by the grayscale sensor.
+struct FloorLine {
+  Segment centre;
+  double width_m = 0.025;
+};
+
+/// A named closed obstacle (box, pillar, L-shaped shelf ...).
+struct Obstacle {
+  std::string name;
+  Polygon polygon;
+};
+
+/// Everything static in a world. Later issues add pedestrians and gas sources
+/// as further members filled by loadWorld().
+struct World {
+  std::string name;
+  std::string description;
+  std::string source_file;  // file the world was loaded from (for error messages)
+  control::Pose2 start;
+  std::vector<Segment> walls;  // thin walls (two-sided segments)
+  std::vector<Obstacle> obstacles;
+  std::vector<FloorLine> floor_lines;
+};
+
+/// Distance from p to the nearest wall or obstacle edge; 0 when p is inside
+/// an obstacle; infinity in a world with nothing solid.
+double clearance(const World& w, Vec2 p);
+/// Distance to the first wall or obstacle edge along the ray from origin at
+/// world angle yaw_rad, or nullopt when nothing is hit within max_range_m.
+std::optional<double> castRay(const World& w, Vec2 origin, double yaw_rad, double max_range_m);
+/// True when p lies on a floor line (within half its width of the centre line).
+bool onFloorLine(const World& w, Vec2 p);
+
+/// Reads a world from a parsed file; throws config::ConfigError naming file, key and reason.
+World loadWorld(const config::ConfigNode& root);
+/// Loads a world file and rejects unknown keys.
+World loadWorldFile(const std::string& path);
+/// Throws ConfigError (naming the world file and `start`) when a robot of
+/// body_radius_m at the start pose would overlap a wall or obstacle.
+void checkStartPose(const World& world, double body_radius_m);
+
+}  // namespace inspect::sim

@@ -1,0 +1,74 @@
+// mcu_sim command line parsing.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "sim/sim_options.hpp"
+
+using namespace inspect::sim;
+
+namespace {
+std::string errorOf(const std::vector<std::string>& args) {
+  try {
+    (void)parseSimOptions(args);
+  } catch (const UsageError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(SimOptions, Defaults) {
+  const auto o = parseSimOptions({"--world", "w.yaml"});
+  EXPECT_EQ(o.world_path, "w.yaml");
+  EXPECT_EQ(o.robot_path, "config/robot.yaml");
+  EXPECT_DOUBLE_EQ(o.rate, 1.0);
+  EXPECT_FALSE(o.duration_s);
+  EXPECT_EQ(o.seed, 1u);
+  EXPECT_TRUE(o.pty_link.empty());
+  EXPECT_TRUE(o.truth_path.empty());
+}
+
+TEST(SimOptions, AllFlags) {
+  const auto o = parseSimOptions({"--world", "w.yaml", "--robot", "r.yaml", "--pty-link", "/tmp/mcu", "--truth",
+                                  "t.csv", "--rate=5", "--duration", "3", "--seed", "77"});
+  EXPECT_EQ(o.robot_path, "r.yaml");
+  EXPECT_EQ(o.pty_link, "/tmp/mcu");
+  EXPECT_EQ(o.truth_path, "t.csv");
+  EXPECT_DOUBLE_EQ(o.rate, 5.0);
+  EXPECT_DOUBLE_EQ(*o.duration_s, 3.0);
+  EXPECT_EQ(o.seed, 77u);
+}
+
+TEST(SimOptions, HelpNeedsNoWorld) { EXPECT_TRUE(parseSimOptions({"--help"}).help); }
+
+TEST(SimOptions, ErrorsNameTheFlag) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string expect;
+  };
+  const std::vector<Case> cases = {
+      {{}, "--world: required"},
+      {{"--world", "w", "--bogus"}, "--bogus: unknown option"},
+      {{"--world", "w", "--rate", "0.05"}, "--rate: 0.05 is out of range [0.1, 100]"},
+      {{"--world", "w", "--rate", "101"}, "--rate: 101 is out of range"},
+      {{"--world", "w", "--rate", "fast"}, "--rate: 'fast' is not a number"},
+      {{"--world", "w", "--duration", "0"}, "--duration: 0 is out of range"},
+      {{"--world", "w", "--duration", "-1"}, "--duration: -1 is out of range"},
+      {{"--world", "w", "--seed", "-3"}, "--seed: '-3' is not a non-negative integer"},
+      {{"--world", "w", "--seed", "1.5"}, "--seed: '1.5'"},
+      {{"--world", "w", "--truth"}, "--truth: missing value"},
+      {{"--world"}, "--world: missing value"},
+  };
+  for (const auto& c : cases) {
+    const auto e = errorOf(c.args);
+    EXPECT_EQ(e.rfind(c.expect, 0), 0u) << "got: " << e << " want: " << c.expect;
+  }
+}
+
+TEST(SimOptions, UsageListsEveryFlag) {
+  const auto u = simUsage();
+  for (const char* f : {"--world", "--robot", "--pty-link", "--truth", "--rate", "--duration", "--seed", "--help"})
+    EXPECT_NE(u.find(f), std::string::npos) << f;
+}
