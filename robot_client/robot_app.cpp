@@ -25,6 +25,7 @@ RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::
   if (!cmd_log_path.empty()) {
     cmd_log_ = std::fopen(cmd_log_path.c_str(), "w");
     if (!cmd_log_) throw config::ConfigError("--cmd-log: cannot write " + cmd_log_path);
+    std::setvbuf(cmd_log_, nullptr, _IOLBF, 0);  // readers see every command at once
     std::fprintf(cmd_log_, "# seq,left_mrad_s,right_mrad_s,flags\n");
   }
 }

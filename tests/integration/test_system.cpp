@@ -31,21 +31,21 @@ Rel relative(const TruthRow& s, const TruthRow& r) {
   return {c * dx + sn * dy, -sn * dx + c * dy, wrap(r.theta - s.theta)};
 }
 
-// The last row of every period of >= 0.5 s in which the wheels stood still.
+// The last row of every period of >= 0.3 s in which the wheels stood still.
 std::vector<TruthRow> restPoses(const Truth& t) {
   std::vector<TruthRow> out;
   std::size_t start = 0;
   bool in_rest = false;
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     const auto& r = t.rows[i];
-    const bool still = std::abs(r.wheel_l) < 0.01 && std::abs(r.wheel_r) < 0.01 && r.set_l == 0 && r.set_r == 0;
+    const bool still = std::abs(r.wheel_l) < 0.02 && std::abs(r.wheel_r) < 0.02 && r.set_l == 0 && r.set_r == 0;
     if (still && !in_rest) {
       start = i;
       in_rest = true;
     }
     if ((!still || i + 1 == t.rows.size()) && in_rest) {
       const std::size_t end = still ? i : i - 1;
-      if (t.rows[end].t - t.rows[start].t >= 0.5) out.push_back(t.rows[end]);
+      if (t.rows[end].t - t.rows[start].t >= 0.3) out.push_back(t.rows[end]);
       in_rest = false;
     }
   }
@@ -117,7 +117,7 @@ TEST(System, EStopHoldsUntilResume) {
   script +=
       "drive 0.2 0\nexpect v ~ 0.2 0.03 within 3\n"
       "estop\nexpect mode == ESTOP within 1\nexpect v ~ 0 0.01 within 1\n"
-      "drive 0.2 0\nwait 1\nexpect v ~ 0 0.01\nexpect mode == ESTOP\n"
+      "try drive 0.2 0\nwait 1\nexpect v ~ 0 0.01\nexpect mode == ESTOP\n"
       "stop\nwait 0.5\nexpect mode == ESTOP\n"
       "resume\nexpect mode == IDLE within 1\n"
       "drive 0.2 0\nexpect v ~ 0.2 0.03 within 3\nstop\nexpect v ~ 0 0.01 within 2\n";
@@ -214,7 +214,7 @@ TEST(System, SecondRobotConnectsWhileFirstDrives) {
       "expect robots == 2 within 20\n"
       "expect w ~ 0.5 0.1\n"
       "select robot2\nexpect connected == 1\nexpect sensor_hz > 50 within 5\n"
-      "drive 0 -0.5\nexpect w ~ -0.5 0.1 within 3\n"
+      "drive 0 -0.5\nexpect w ~ -0.5 0.1 within 3\nwait 3\n"
       "select robot1\nexpect w ~ 0.5 0.1\nstop\n"
       "select robot2\nstop\nexpect w ~ 0 0.02 within 2\n";
   ASSERT_TRUE(s.startServer(script)) << s.logs();
@@ -225,7 +225,8 @@ TEST(System, SecondRobotConnectsWhileFirstDrives) {
   const auto rc = s.server().wait(60);
   ASSERT_TRUE(rc.has_value()) << s.logs();
   EXPECT_EQ(*rc, 0) << s.serverOutput();
-  // robot1 never stopped while robot2 connected and drove.
+  // robot1 never slowed while robot2 connected and drove (robot1 is stopped
+  // by the script only after robot2 has driven for 3 s).
   const auto truth = readTruth(r1.truth);
   std::size_t checked = 0;
   for (const auto& row : truth.rows) {

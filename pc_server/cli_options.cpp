@@ -1,0 +1,94 @@
+#include "pc_server/cli_options.hpp"
+
+#include <functional>
+#include <map>
+
+#include "pc_server/server_config.hpp"
+#include "pc_server/text_util.hpp"
+
+namespace inspect::server {
+
+namespace {
+
+struct FlagSpec {
+  bool takes_value;
+  std::function<void(CliOptions&, const std::string&)> apply;
+};
+
+const std::map<std::string, FlagSpec>& flags() {
+  static const std::map<std::string, FlagSpec> kFlags = {
+      {"--config", {true, [](CliOptions& o, const std::string& v) { o.config_path = v; }}},
+      {"--bind",
+       {true,
+        [](CliOptions& o, const std::string& v) {
+          if (!validBindAddress(v)) throw UsageError("--bind: '" + v + "' is not a numeric IP address");
+          o.bind_address = v;
+        }}},
+      {"--port",
+       {true,
+        [](CliOptions& o, const std::string& v) {
+          const auto n = parseInteger(v);
+          if (!n || *n < 0 || *n > 65535) throw UsageError("--port: '" + v + "' is not a port number (0-65535)");
+          o.port = static_cast<uint16_t>(*n);
+        }}},
+      {"--port-file", {true, [](CliOptions& o, const std::string& v) { o.port_file = v; }}},
+      {"--script", {true, [](CliOptions& o, const std::string& v) { o.script_path = v; }}},
+      {"--interactive", {false, [](CliOptions& o, const std::string&) { o.interactive = true; }}},
+      {"--no-console", {false, [](CliOptions& o, const std::string&) { o.no_console = true; }}},
+      {"--help", {false, [](CliOptions& o, const std::string&) { o.help = true; }}},
+      {"-h", {false, [](CliOptions& o, const std::string&) { o.help = true; }}},
+  };
+  return kFlags;
+}
+
+}  // namespace
+
+CliOptions parseCli(const std::vector<std::string>& args) {
+  CliOptions o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    std::string name = args[i];
+    std::optional<std::string> value;
+    if (const auto eq = name.find('='); name.rfind("--", 0) == 0 && eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    }
+    const auto it = flags().find(name);
+    if (it == flags().end()) {
+      if (name.empty() || name[0] != '-') throw UsageError("unexpected argument '" + args[i] + "'");
+      throw UsageError("unknown flag '" + name + "'");
+    }
+    if (it->second.takes_value) {
+      if (!value) {
+        if (i + 1 >= args.size()) throw UsageError(name + ": needs a value");
+        value = args[++i];
+      }
+      if (value->empty()) throw UsageError(name + ": needs a non-empty value");
+    } else if (value) {
+      throw UsageError(name + ": takes no value");
+    }
+    it->second.apply(o, value.value_or(""));
+  }
+  if (o.no_console && (o.script_path || o.interactive))
+    throw UsageError("--no-console cannot be combined with --script or --interactive");
+  return o;
+}
+
+std::string usageText() {
+  return "usage: pc_server [options]\n"
+         "Operator PC server: accepts robot_client links (TCP, protobuf) and runs the operator console.\n"
+         "\n"
+         "  --config FILE     server config (default: config/server.yaml if it exists, else built-in defaults)\n"
+         "  --bind ADDR       listen address, numeric IPv4/IPv6 (overrides 'bind'; default 0.0.0.0)\n"
+         "  --port N          TCP port, 0 = ephemeral (overrides 'port'; default 7600)\n"
+         "  --port-file FILE  write the listening port to FILE (atomically) once listening\n"
+         "  --script FILE     run the console commands in FILE, then exit (0 = all expects passed, 1 = not)\n"
+         "  --interactive     after --script, stay in the interactive console; alone, force the interactive console\n"
+         "  --no-console      serve until SIGINT/SIGTERM without reading stdin (service mode)\n"
+         "  --help            show this text and exit\n"
+         "\n"
+         "Without --script the console is interactive when stdin is a terminal; otherwise commands are read\n"
+         "from stdin like a script and the server exits at end of input. See docs/console.md.\n"
+         "Exit status: 0 ok, 1 script failure, 2 bad command line or config, 3 cannot listen / write port file.\n";
+}
+
+}  // namespace inspect::server

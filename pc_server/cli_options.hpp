@@ -1,0 +1,36 @@
+#pragma once
+// pc_server command line.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "shared/config/config_node.hpp"
+
+namespace inspect::server {
+
+/// A bad command line; main() prints what() and exits with status 2.
+class UsageError : public config::ConfigError {
+ public:
+  using config::ConfigError::ConfigError;
+};
+
+/// Parsed command line; unset optionals mean "use the config file / default".
+struct CliOptions {
+  std::optional<std::string> config_path;
+  std::optional<std::string> bind_address;
+  std::optional<uint16_t> port;
+  std::optional<std::string> port_file;
+  std::optional<std::string> script_path;
+  bool interactive = false;
+  bool no_console = false;
+  bool help = false;
+};
+
+/// Parses argv (without argv[0]). Throws UsageError naming the flag.
+CliOptions parseCli(const std::vector<std::string>& args);
+
+/// The --help text.
+std::string usageText();
+
+}  // namespace inspect::server

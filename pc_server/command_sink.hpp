@@ -1,0 +1,27 @@
+#pragma once
+// What the console needs from the link to command robots (LinkServer in the
+// program, a fake in tests). Thread-safe; never blocks on the network.
+#include <cstdint>
+#include <string>
+
+#include "inspect/v1/link.pb.h"
+
+namespace inspect::server {
+
+class CommandSink {
+ public:
+  virtual ~CommandSink() = default;
+  /// Sets the robot's teleop set-point: sends it at once and re-sends it at the
+  /// configured rate until cleared. Returns the id of the first Command, 0 if the robot is not connected.
+  virtual uint64_t setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s) = 0;
+  /// Stops re-sending the set-point (sends nothing).
+  virtual void clearTeleop(const std::string& robot_id) = 0;
+  /// Assigns a new id to `cmd` and sends it; Stop and EStop also clear the set-point.
+  /// Returns the id, 0 if the robot is not connected.
+  virtual uint64_t sendCommand(const std::string& robot_id, v1::Command cmd) = 0;
+  /// Called by the console thread whenever it is responsive (every few tens of ms);
+  /// re-sent set-points stop when these calls stop (a hung console must not keep a robot driving).
+  virtual void consoleAlive() = 0;
+};
+
+}  // namespace inspect::server

@@ -1,0 +1,419 @@
+#include "pc_server/console.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <variant>
+
+#include "pc_server/expect_check.hpp"
+#include "pc_server/hello_check.hpp"
+#include "pc_server/status_line.hpp"
+#include "pc_server/text_util.hpp"
+#include "shared/util/clock.hpp"
+
+namespace inspect::server {
+
+namespace {
+std::chrono::nanoseconds seconds(double s) { return std::chrono::nanoseconds(static_cast<int64_t>(s * 1e9)); }
+
+std::string padRight(std::string s, std::size_t w) {
+  if (s.size() < w) s.append(w - s.size(), ' ');
+  return s;
+}
+std::string padLeft(std::string s, std::size_t w) {
+  if (s.size() < w) s.insert(0, w - s.size(), ' ');
+  return s;
+}
+
+/// Removes a comment: '#' at the start or after a blank.
+std::string stripComment(const std::string& line) {
+  for (std::size_t i = 0; i < line.size(); ++i)
+    if (line[i] == '#' && (i == 0 || line[i - 1] == ' ' || line[i - 1] == '\t')) return line.substr(0, i);
+  return line;
+}
+}  // namespace
+
+Console::Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop)
+    : Console(registry, sink, out, stop, Options{}) {}
+
+Console::Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop, Options options)
+    : registry_(registry), sink_(sink), out_(out), stop_(stop), options_(options) {}
+
+const std::vector<Console::CommandDef>& Console::commands() {
+  static const std::vector<CommandDef> kCommands = {
+      {"help", "help [command]", "list the commands, or explain one",
+       "  help          lists every command\n"
+       "  help drive    explains one command\n",
+       &Console::cmdHelp},
+      {"robots", "robots", "table of robots: id, connected, address, telemetry Hz, mode, telemetry age",
+       "  Lists every robot that connected since the server started; '*' marks the selected one.\n",
+       &Console::cmdRobots},
+      {"select", "select <robot>", "choose the robot that drive/stop/estop/resume/status/expect act on",
+       "  The robot need not be connected yet. With no selection, the first robot to connect\n"
+       "  is selected automatically.\n"
+       "  example: select robot2\n",
+       &Console::cmdSelect},
+      {"status", "status [robot]", "one status line of the selected (or named) robot",
+       "  example: status\n"
+       "  robot1 | TELEOP | v +0.30 w +0.00 | x 1.20 y 0.00 th +0.00 | us 1.23 2.01 -- 0.88 | faults none |"
+       " tlm 50 Hz | serial ok\n",
+       &Console::cmdStatus},
+      {"drive", "drive <v_m_s> <w_rad_s>", "set the teleop set-point; re-sent at teleop_resend_hz until stop",
+       "  v in [-1, 1] m/s (forward positive), w in [-2, 2] rad/s (counter-clockwise positive).\n"
+       "  The server re-sends the set-point (default 20 Hz) so the robot's 300 ms deadman stays\n"
+       "  quiet while the console and link work. Waits up to 1 s for the robot's Ack of the first\n"
+       "  command; a rejection or no Ack clears the set-point and is an error.\n"
+       "  example: drive 0.3 0      (straight ahead at 0.3 m/s)\n"
+       "  example: drive 0 0.5      (turn on the spot, 0.5 rad/s to the left)\n",
+       &Console::cmdDrive},
+      {"teleop", "teleop [step|hold]", "keyboard teleop (interactive terminal only)",
+       "  step (default): w/s or Up/Down step v by 0.05 m/s, a/d or Left/Right step w by 0.1 rad/s\n"
+       "    (clamped to +-1.0 m/s, +-2.0 rad/s); the set-point stays until changed.\n"
+       "  hold: hold w/s/a/d (or arrows) to drive at 0.3 m/s or 1.0 rad/s; releasing the key\n"
+       "    zeroes the set-point (deadman: 600 ms before the first auto-repeat, 200 ms after).\n"
+       "  Both: space (or x, 0) zeroes at once; q or Esc leaves teleop and sends stop.\n",
+       &Console::cmdTeleop},
+      {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
+       "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
+       "  'robot1: no ack within 1 s' (the last two are errors).\n",
+       &Console::cmdStop},
+      {"estop", "estop", "emergency stop, latched until resume",
+       "  Clears the set-point and sends EStop; waits up to 1 s for the Ack.\n", &Console::cmdEstop},
+      {"resume", "resume", "clear a latched e-stop or failsafe",
+       "  Waits up to 1 s for the Ack; e.g. 'robot1: resume rejected: <reason>'.\n", &Console::cmdResume},
+      {"wait", "wait <seconds>", "pause the console (events still print)",
+       "  example: wait 2.5\n", &Console::cmdWait},
+      {"expect", "expect <field> <op> <value> [<tol>] [within <seconds>]", "check a value (scripts, tests)",
+       "  ops: == != < <= > >= ~   ('~' needs a tolerance: |field - value| <= tol; '+-' before it is optional)\n"
+       "  within: poll every 20 ms until true or the time runs out (default: check once).\n"
+       "  fields of the selected robot: x y theta v w cmd_v cmd_w wheel_l wheel_r mode faults mcu_faults\n"
+       "    connected telemetry_hz telemetry_age sensor_hz battery serial_bad_crc serial_frames_ok\n"
+       "  and: robots (number of connected robots).\n"
+       "  mode takes IDLE, TELEOP, ESTOP, FAILSAFE; integer fields take 0x.. too.\n"
+       "  examples: expect robots >= 1 within 5\n"
+       "            expect x ~ 2.0 0.05 within 10\n"
+       "            expect mode == ESTOP within 1\n",
+       &Console::cmdExpect},
+      {"echo", "echo <text>", "print text (to label script output)", "  example: echo --- leg 2 ---\n",
+       &Console::cmdEcho},
+      {"quit", "quit", "leave the console and shut the server down ('exit' too)", "", &Console::cmdQuit},
+      {"exit", "exit", "same as quit", "", &Console::cmdQuit},
+  };
+  return kCommands;
+}
+
+const Console::CommandDef* Console::findCommand(const std::string& name) {
+  for (const auto& c : commands())
+    if (name == c.name) return &c;
+  return nullptr;
+}
+
+std::string Console::helpText(const std::string& command) {
+  if (command.empty()) {
+    std::string s = "commands:\n";
+    for (const auto& c : commands()) {
+      if (std::string(c.name) == "exit") continue;
+      const std::string syntax = c.syntax;
+      s += syntax.size() <= 30 ? "  " + padRight(syntax, 30) + " " + c.summary + "\n"
+                               : "  " + syntax + "\n  " + std::string(31, ' ') + c.summary + "\n";
+    }
+    s += "'help <command>' explains one; '#' starts a comment; 'try <command>' runs a command\n"
+         "whose failure (e.g. an expected rejection) should not fail a script.\n";
+    return s;
+  }
+  const CommandDef* c = findCommand(command);
+  if (!c) return "";
+  return std::string(c->syntax) + "\n  " + c->summary + "\n" + c->details;
+}
+
+bool Console::fail(const std::string& cmd, const std::string& message) {
+  out_ << cmd << ": " << message << "\n";
+  ++tally_.errors;
+  return false;
+}
+
+bool Console::execute(const std::string& raw_line, int line_no) {
+  out_ << background();
+  const std::string line = trim(stripComment(raw_line));
+  if (line.empty()) return true;
+  const auto words = splitWords(line);
+  const std::string& name = words.front();
+  if (name == "try") {
+    // 'try <command>': run it, but a failure (an error, a rejection, a failed
+    // expect) does not count against the script; for checks that a command is refused.
+    if (words.size() < 2) return fail("try", "needs a command: try <command>");
+    const Tally before = tally_;
+    const bool ok = execute(trim(line.substr(3)), line_no);
+    if (!ok) {
+      tally_.errors = before.errors;
+      tally_.expects_failed = before.expects_failed;
+      out_ << "(try: failure allowed)\n";
+    }
+    return true;
+  }
+  ++tally_.commands;
+  const CommandDef* c = findCommand(name == "?" ? "help" : name);
+  if (!c) {
+    out_ << "unknown command '" << name << "' (try 'help')\n";
+    ++tally_.errors;
+    return false;
+  }
+  const std::size_t at = line.find_first_of(" \t", 0);
+  const std::string rest = at == std::string::npos ? "" : trim(line.substr(at));
+  const Args args(words.begin() + 1, words.end());
+  const bool ok = (this->*(c->run))(args, rest, line_no);
+  out_.flush();
+  return ok;
+}
+
+std::string Console::background() {
+  sink_.consoleAlive();
+  std::string s;
+  if (selected_.empty()) {
+    if (auto first = registry_.firstConnected(); !first.empty()) {
+      selected_ = first;
+      s += "selected " + first + " (the first robot to connect)\n";
+    }
+  }
+  for (const auto& e : registry_.takeEvents())
+    s += "[" + e.robot_id + "] " + v1::Event::Kind_Name(e.event.kind()) + ": " + e.event.text() + "\n";
+  return s;
+}
+
+void Console::pump() {
+  out_ << background();
+  out_.flush();
+  if (idle_hook_) idle_hook_();
+}
+
+bool Console::sleepPumping(double s) {
+  const auto deadline = std::chrono::steady_clock::now() + seconds(s);
+  for (;;) {
+    pump();
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline) return true;
+    const auto step = std::min<std::chrono::steady_clock::duration>(deadline - now, seconds(options_.poll_period_s));
+    if (!stop_.sleepFor(step)) return false;
+  }
+}
+
+std::optional<std::string> Console::connectedRobot(const std::string& cmd) {
+  if (selected_.empty()) {
+    fail(cmd, "no robot selected");
+    return std::nullopt;
+  }
+  const auto snap = registry_.snapshot(selected_, monoNowNs());
+  if (!snap || !snap->connected) {
+    fail(cmd, selected_ + " is not connected");
+    return std::nullopt;
+  }
+  return selected_;
+}
+
+std::optional<v1::Ack> Console::waitAck(const std::string& robot_id, uint64_t command_id) {
+  const auto deadline = std::chrono::steady_clock::now() + seconds(options_.ack_timeout_s);
+  for (;;) {
+    if (auto a = registry_.ack(robot_id, command_id)) return a;
+    if (std::chrono::steady_clock::now() >= deadline) return std::nullopt;
+    pump();
+    // Acks come back within a millisecond or two on a working link; polling
+    // finely keeps 'drive' + 'wait T' close to T of motion.
+    if (!stop_.sleepFor(seconds(options_.ack_poll_period_s))) return std::nullopt;
+  }
+}
+
+bool Console::cmdHelp(const Args& args, const std::string&, int) {
+  if (args.size() > 1) return fail("help", "takes at most one command name");
+  if (args.empty()) {
+    out_ << helpText();
+    return true;
+  }
+  const std::string text = helpText(args[0]);
+  if (text.empty()) return fail("help", "unknown command '" + args[0] + "'");
+  out_ << text;
+  return true;
+}
+
+bool Console::cmdRobots(const Args& args, const std::string&, int) {
+  if (!args.empty()) return fail("robots", "takes no arguments");
+  const auto all = registry_.snapshots(monoNowNs());
+  if (all.empty()) {
+    out_ << "no robot has connected yet\n";
+    return true;
+  }
+  out_ << "  " << padRight("id", 16) << " " << padRight("connected", 9) << " " << padRight("address", 21) << " "
+       << padLeft("tlm Hz", 6) << " " << padRight("mode", 9) << " " << padLeft("tlm age", 8) << "\n";
+  for (const auto& r : all) {
+    const std::string age = r.has_telemetry ? fmtFixed(r.telemetry_age_s, 2) + " s" : "-";
+    const std::string mode = r.has_telemetry ? modeName(r.telemetry.mode()) : "-";
+    out_ << (r.id == selected_ ? "* " : "  ") << padRight(r.id, 16) << " " << padRight(r.connected ? "yes" : "no", 9)
+         << " " << padRight(r.address, 21) << " " << padLeft(fmtFixed(r.telemetry_hz, 1), 6) << " "
+         << padRight(mode, 9) << " " << padLeft(age, 8) << "\n";
+  }
+  return true;
+}
+
+bool Console::cmdSelect(const Args& args, const std::string&, int) {
+  if (args.size() != 1) return fail("select", "needs one robot id: select <robot>");
+  if (!validRobotId(args[0])) return fail("select", "'" + args[0] + "' is not a valid robot id ([A-Za-z0-9_-]{1,64})");
+  selected_ = args[0];
+  const auto snap = registry_.snapshot(selected_, monoNowNs());
+  out_ << "selected " << selected_ << (snap && snap->connected ? "" : " (not connected yet)") << "\n";
+  return true;
+}
+
+bool Console::cmdStatus(const Args& args, const std::string&, int) {
+  if (args.size() > 1) return fail("status", "takes at most one robot id");
+  const std::string robot = args.empty() ? selected_ : args[0];
+  if (robot.empty()) return fail("status", "no robot selected");
+  out_ << statusLine(robot, registry_.snapshot(robot, monoNowNs())) << "\n";
+  return true;
+}
+
+bool Console::cmdDrive(const Args& args, const std::string&, int) {
+  if (args.size() != 2) return fail("drive", "needs two numbers: drive <v_m_s> <w_rad_s>");
+  const auto v = parseNumber(args[0]);
+  if (!v) return fail("drive", "'" + args[0] + "' is not a number");
+  const auto w = parseNumber(args[1]);
+  if (!w) return fail("drive", "'" + args[1] + "' is not a number");
+  if (std::fabs(*v) > options_.max_v_m_s)
+    return fail("drive", "v " + args[0] + " m/s is outside [-" + fmtShort(options_.max_v_m_s) + ", " +
+                             fmtShort(options_.max_v_m_s) + "]");
+  if (std::fabs(*w) > options_.max_w_rad_s)
+    return fail("drive", "w " + args[1] + " rad/s is outside [-" + fmtShort(options_.max_w_rad_s) + ", " +
+                             fmtShort(options_.max_w_rad_s) + "]");
+  const auto robot = connectedRobot("drive");
+  if (!robot) return false;
+  const uint64_t id = sink_.setTeleop(*robot, *v, *w);
+  if (id == 0) return fail("drive", *robot + " is not connected");
+  const std::string what = "drive " + fmtSigned(*v) + " m/s " + fmtSigned(*w) + " rad/s";
+  const auto ack = waitAck(*robot, id);
+  if (!ack) {
+    sink_.clearTeleop(*robot);
+    out_ << *robot << ": " << what << ": no ack within " << fmtShort(options_.ack_timeout_s) << " s (set-point cleared)\n";
+    ++tally_.errors;
+    return false;
+  }
+  if (ack->status() == v1::Ack::REJECTED) {
+    sink_.clearTeleop(*robot);
+    out_ << *robot << ": " << what << " rejected: " << ack->reason() << "\n";
+    ++tally_.errors;
+    return false;
+  }
+  out_ << *robot << ": " << what << " accepted (re-sent until stop)\n";
+  return true;
+}
+
+bool Console::cmdTeleop(const Args& args, const std::string&, int) {
+  if (args.size() > 1) return fail("teleop", "takes at most one mode: teleop [step|hold]");
+  KeyboardTeleop::Mode mode = KeyboardTeleop::Mode::kStep;
+  if (!args.empty() && !parseTeleopMode(args[0], mode))
+    return fail("teleop", "unknown mode '" + args[0] + "' (step or hold)");
+  if (!teleop_handler_) return fail("teleop", "keyboard teleop needs an interactive terminal (scripts use drive)");
+  const auto robot = connectedRobot("teleop");
+  if (!robot) return false;
+  if (!teleop_handler_(mode, *robot)) {
+    ++tally_.errors;
+    return false;
+  }
+  return true;
+}
+
+bool Console::simpleCommand(const std::string& name, const Args& args, v1::Command cmd) {
+  if (!args.empty()) return fail(name, "takes no arguments");
+  const auto robot = connectedRobot(name);
+  if (!robot) return false;
+  const uint64_t id = sink_.sendCommand(*robot, std::move(cmd));
+  if (id == 0) return fail(name, *robot + " is not connected");
+  const auto ack = waitAck(*robot, id);
+  if (!ack) {
+    out_ << *robot << ": " << name << ": no ack within " << fmtShort(options_.ack_timeout_s) << " s\n";
+    ++tally_.errors;
+    return false;
+  }
+  switch (ack->status()) {
+    case v1::Ack::ACCEPTED: out_ << *robot << ": " << name << " accepted\n"; return true;
+    case v1::Ack::COMPLETED: out_ << *robot << ": " << name << " completed\n"; return true;
+    case v1::Ack::REJECTED:
+      out_ << *robot << ": " << name << " rejected: " << ack->reason() << "\n";
+      ++tally_.errors;
+      return false;
+    default:
+      out_ << *robot << ": " << name << ": ack with an unknown status " << ack->status() << "\n";
+      ++tally_.errors;
+      return false;
+  }
+}
+
+bool Console::cmdStop(const Args& args, const std::string&, int) {
+  v1::Command c;
+  c.mutable_stop();
+  return simpleCommand("stop", args, c);
+}
+
+bool Console::cmdEstop(const Args& args, const std::string&, int) {
+  v1::Command c;
+  c.mutable_estop();
+  return simpleCommand("estop", args, c);
+}
+
+bool Console::cmdResume(const Args& args, const std::string&, int) {
+  v1::Command c;
+  c.mutable_resume();
+  return simpleCommand("resume", args, c);
+}
+
+bool Console::cmdWait(const Args& args, const std::string&, int) {
+  if (args.size() != 1) return fail("wait", "needs one number of seconds: wait <seconds>");
+  const auto s = parseNumber(args[0]);
+  if (!s) return fail("wait", "'" + args[0] + "' is not a number");
+  if (*s < 0 || *s > 3600) return fail("wait", args[0] + " s is outside [0, 3600]");
+  if (!sleepPumping(*s)) return fail("wait", "interrupted (server stopping)");
+  return true;
+}
+
+bool Console::cmdExpect(const Args& args, const std::string&, int line_no) {
+  const auto parsed = parseExpect(args);
+  if (const auto* err = std::get_if<std::string>(&parsed)) {
+    out_ << "EXPECT FAILED (line " << line_no << "): " << *err << "\n";
+    ++tally_.expects_failed;
+    return false;
+  }
+  const auto& spec = std::get<ExpectSpec>(parsed);
+  const auto deadline = std::chrono::steady_clock::now() + seconds(spec.within_s);
+  FieldReading r;
+  bool interrupted = false;
+  for (;;) {
+    r = readField(spec.field, registry_, selected_, monoNowNs());
+    if (r.ok && compare(spec.op, r.value, spec.value, spec.tol)) {
+      out_ << "expect ok (line " << line_no << "): " << spec.field << " = " << r.text << "\n";
+      ++tally_.expects_passed;
+      return true;
+    }
+    if (std::chrono::steady_clock::now() >= deadline) break;
+    pump();
+    if (!stop_.sleepFor(seconds(options_.poll_period_s))) {
+      interrupted = true;
+      break;
+    }
+  }
+  out_ << "EXPECT FAILED (line " << line_no << "): " << spec.field;
+  if (r.ok) out_ << " = " << r.text;
+  else out_ << ": " << r.error;
+  out_ << ", wanted " << describeWanted(spec) << (interrupted ? " (interrupted)" : "") << "\n";
+  ++tally_.expects_failed;
+  return false;
+}
+
+bool Console::cmdEcho(const Args&, const std::string& rest, int) {
+  out_ << rest << "\n";
+  return true;
+}
+
+bool Console::cmdQuit(const Args& args, const std::string&, int) {
+  if (!args.empty()) return fail("quit", "takes no arguments");
+  quit_ = true;
+  return true;
+}
+
+}  // namespace inspect::server

@@ -1,0 +1,116 @@
+#pragma once
+// The operator console's commands: parsing, dispatch and output. It holds no
+// terminal and no socket: lines in, text out (tested on strings); the robots
+// are reached through the registry (state) and a CommandSink (commands).
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "pc_server/command_sink.hpp"
+#include "pc_server/keyboard_teleop.hpp"
+#include "pc_server/robot_registry.hpp"
+#include "pc_server/stop_flag.hpp"
+
+namespace inspect::server {
+
+class Console {
+ public:
+  struct Options {
+    double ack_timeout_s = 1.0;    // stop/estop/resume/drive wait this long for the Ack
+    double poll_period_s = 0.02;   // expect ... within, wait
+    double ack_poll_period_s = 0.001;  // waiting for a command's Ack
+    double max_v_m_s = 1.0;        // drive limits (the keyboard gauge uses the same)
+    double max_w_rad_s = 2.0;
+  };
+  /// Runs keyboard teleop on the selected robot until the operator leaves; false on failure.
+  using TeleopHandler = std::function<bool(KeyboardTeleop::Mode mode, const std::string& robot_id)>;
+
+  /// Counts of a session, for the script summary and the exit status.
+  struct Tally {
+    int commands = 0;
+    int errors = 0;
+    int expects_passed = 0;
+    int expects_failed = 0;
+  };
+
+  Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop);
+  Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop, Options options);
+
+  /// Runs one line (blank lines and '#' comments are fine); false if it failed
+  /// (an error, or an expect that did not hold). `line_no` appears in expect results.
+  bool execute(const std::string& line, int line_no);
+
+  /// Background work between commands: selects the first robot to connect when
+  /// none is selected and returns the text of new robot events. Call it often.
+  std::string background();
+  /// background() printed to the output, then the idle hook; used while waiting.
+  void pump();
+  /// Called while the console waits (e.g. to refresh the status line).
+  void setIdleHook(std::function<void()> hook) { idle_hook_ = std::move(hook); }
+  /// Enables `teleop` (only an interactive terminal has one).
+  void setTeleopHandler(TeleopHandler handler) { teleop_handler_ = std::move(handler); }
+
+  bool quitRequested() const { return quit_; }
+  const std::string& selected() const { return selected_; }
+  const Tally& tally() const { return tally_; }
+  const Options& options() const { return options_; }
+  RobotRegistry& registry() { return registry_; }
+  CommandSink& sink() { return sink_; }
+
+  /// The text of `help` (all commands) or `help <command>`; empty for an unknown command.
+  static std::string helpText(const std::string& command = "");
+
+ private:
+  using Args = std::vector<std::string>;
+  using Handler = bool (Console::*)(const Args& args, const std::string& rest, int line_no);
+  struct CommandDef {
+    const char* name;
+    const char* syntax;
+    const char* summary;
+    const char* details;
+    Handler run;
+  };
+  static const std::vector<CommandDef>& commands();
+  static const CommandDef* findCommand(const std::string& name);
+
+  bool cmdHelp(const Args& args, const std::string& rest, int line_no);
+  bool cmdRobots(const Args& args, const std::string& rest, int line_no);
+  bool cmdSelect(const Args& args, const std::string& rest, int line_no);
+  bool cmdStatus(const Args& args, const std::string& rest, int line_no);
+  bool cmdDrive(const Args& args, const std::string& rest, int line_no);
+  bool cmdTeleop(const Args& args, const std::string& rest, int line_no);
+  bool cmdStop(const Args& args, const std::string& rest, int line_no);
+  bool cmdEstop(const Args& args, const std::string& rest, int line_no);
+  bool cmdResume(const Args& args, const std::string& rest, int line_no);
+  bool cmdWait(const Args& args, const std::string& rest, int line_no);
+  bool cmdExpect(const Args& args, const std::string& rest, int line_no);
+  bool cmdEcho(const Args& args, const std::string& rest, int line_no);
+  bool cmdQuit(const Args& args, const std::string& rest, int line_no);
+
+  /// Prints "<cmd>: <message>" and returns false.
+  bool fail(const std::string& cmd, const std::string& message);
+  /// The selected robot when it is connected; otherwise prints why (as `cmd`) and returns nullopt.
+  std::optional<std::string> connectedRobot(const std::string& cmd);
+  /// Sends a Stop/EStop/Resume and reports its Ack.
+  bool simpleCommand(const std::string& name, const Args& args, v1::Command cmd);
+  /// Waits up to ack_timeout_s for the Ack of `command_id`; nullopt when none came.
+  std::optional<v1::Ack> waitAck(const std::string& robot_id, uint64_t command_id);
+  /// Sleeps up to `seconds` while pumping; false if the server is stopping.
+  bool sleepPumping(double seconds);
+
+  RobotRegistry& registry_;
+  CommandSink& sink_;
+  std::ostream& out_;
+  StopFlag& stop_;
+  Options options_;
+  std::function<void()> idle_hook_;
+  TeleopHandler teleop_handler_;
+  std::string selected_;
+  bool quit_ = false;
+  Tally tally_;
+};
+
+}  // namespace inspect::server

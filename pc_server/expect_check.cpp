@@ -1,0 +1,206 @@
+#include "pc_server/expect_check.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <functional>
+#include <map>
+
+#include "pc_server/text_util.hpp"
+
+namespace inspect::server {
+
+namespace {
+
+struct FieldDef {
+  std::string name;
+  bool integer;        // printed without decimals
+  bool needs_robot;    // reads the selected robot
+  bool needs_telemetry;
+  std::function<double(const RobotSnapshot&)> get;
+};
+
+const std::vector<FieldDef>& fieldDefs() {
+  using S = RobotSnapshot;
+  static const std::vector<FieldDef> kDefs = {
+      {"x", false, true, true, [](const S& s) { return s.telemetry.pose().x_m(); }},
+      {"y", false, true, true, [](const S& s) { return s.telemetry.pose().y_m(); }},
+      {"theta", false, true, true, [](const S& s) { return s.telemetry.pose().theta_rad(); }},
+      {"v", false, true, true, [](const S& s) { return s.telemetry.v_m_s(); }},
+      {"w", false, true, true, [](const S& s) { return s.telemetry.w_rad_s(); }},
+      {"cmd_v", false, true, true, [](const S& s) { return s.telemetry.cmd_v_m_s(); }},
+      {"cmd_w", false, true, true, [](const S& s) { return s.telemetry.cmd_w_rad_s(); }},
+      {"wheel_l", false, true, true, [](const S& s) { return s.telemetry.wheel_left_rad_s(); }},
+      {"wheel_r", false, true, true, [](const S& s) { return s.telemetry.wheel_right_rad_s(); }},
+      {"mode", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.mode()); }},
+      {"faults", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.faults()); }},
+      {"mcu_faults", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.mcu_faults()); }},
+      {"connected", true, true, false, [](const S& s) { return s.connected ? 1.0 : 0.0; }},
+      {"telemetry_hz", false, true, false, [](const S& s) { return s.telemetry_hz; }},
+      {"telemetry_age", false, true, true, [](const S& s) { return s.telemetry_age_s; }},
+      {"sensor_hz", false, true, true, [](const S& s) { return s.telemetry.sensor_rate_hz(); }},
+      {"battery", false, true, true, [](const S& s) { return s.telemetry.battery_v(); }},
+      {"serial_bad_crc", true, true, true,
+       [](const S& s) { return static_cast<double>(s.telemetry.serial().bad_crc()); }},
+      {"serial_frames_ok", true, true, true,
+       [](const S& s) { return static_cast<double>(s.telemetry.serial().frames_ok()); }},
+      {"robots", true, false, false, nullptr},
+  };
+  return kDefs;
+}
+
+const FieldDef* findField(const std::string& name) {
+  for (const auto& f : fieldDefs())
+    if (f.name == name) return &f;
+  return nullptr;
+}
+
+const std::map<std::string, ExpectOp>& ops() {
+  static const std::map<std::string, ExpectOp> kOps = {{"==", ExpectOp::kEq}, {"!=", ExpectOp::kNe},
+                                                       {"<", ExpectOp::kLt},  {"<=", ExpectOp::kLe},
+                                                       {">", ExpectOp::kGt},  {">=", ExpectOp::kGe},
+                                                       {"~", ExpectOp::kNear}};
+  return kOps;
+}
+
+std::optional<int> modeFromName(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::toupper(c); });
+  v1::Mode m{};
+  if (!v1::Mode_Parse(text, &m)) return std::nullopt;
+  return static_cast<int>(m);
+}
+
+std::string fieldList() {
+  std::string s;
+  for (const auto& f : fieldDefs()) s += (s.empty() ? "" : ", ") + f.name;
+  return s;
+}
+
+}  // namespace
+
+const std::vector<std::string>& expectFields() {
+  static const std::vector<std::string> kNames = [] {
+    std::vector<std::string> v;
+    for (const auto& f : fieldDefs()) v.push_back(f.name);
+    return v;
+  }();
+  return kNames;
+}
+
+std::string modeName(int mode) {
+  if (v1::Mode_IsValid(mode) && mode != v1::MODE_UNSPECIFIED) return v1::Mode_Name(static_cast<v1::Mode>(mode));
+  return mode == 0 ? "UNSPECIFIED" : std::to_string(mode);
+}
+
+std::variant<ExpectSpec, std::string> parseExpect(const std::vector<std::string>& args) {
+  static const std::string kSyntax = "syntax: expect <field> <op> <value> [<tol>] [within <seconds>]";
+  if (args.size() < 3) return "expect: too few words; " + kSyntax;
+  ExpectSpec s;
+  s.field = args[0];
+  const FieldDef* def = findField(s.field);
+  if (!def) return "expect: unknown field '" + s.field + "' (fields: " + fieldList() + ")";
+  const auto op = ops().find(args[1]);
+  if (op == ops().end()) return "expect: unknown operator '" + args[1] + "' (use == != < <= > >= ~)";
+  s.op = op->second;
+  s.op_text = args[1];
+  s.value_text = args[2];
+  if (const auto v = parseNumber(args[2])) {
+    s.value = *v;
+  } else if (s.field == "mode" && modeFromName(args[2])) {
+    s.value = *modeFromName(args[2]);
+  } else if (const auto i = parseInteger(args[2]); i && def->integer) {
+    s.value = static_cast<double>(*i);  // e.g. faults == 0x4
+  } else {
+    return "expect: '" + args[2] + "' is not a number" +
+           (s.field == "mode" ? " or a mode (IDLE, TELEOP, ESTOP, FAILSAFE)" : "");
+  }
+  std::size_t i = 3;
+  if (s.op == ExpectOp::kNear) {
+    if (i < args.size() && args[i] == "+-") ++i;
+    if (i >= args.size() || args[i] == "within") return "expect: '~' needs a tolerance: expect x ~ 2.0 0.05";
+    const auto tol = parseNumber(args[i]);
+    if (!tol || *tol < 0) return "expect: tolerance '" + args[i] + "' is not a number >= 0";
+    s.tol = *tol;
+    s.tol_text = args[i];
+    ++i;
+  }
+  if (i < args.size()) {
+    if (args[i] != "within") {
+      if (s.op != ExpectOp::kNear && parseNumber(args[i]))
+        return "expect: a tolerance is only allowed with '~'; " + kSyntax;
+      return "expect: unexpected '" + args[i] + "'; " + kSyntax;
+    }
+    if (i + 1 >= args.size()) return "expect: 'within' needs a number of seconds";
+    const auto w = parseNumber(args[i + 1]);
+    if (!w || *w < 0 || *w > 3600) return "expect: within '" + args[i + 1] + "' is not a number of seconds in [0, 3600]";
+    s.within_s = *w;
+    s.has_within = true;
+    i += 2;
+  }
+  if (i < args.size()) return "expect: unexpected '" + args[i] + "' at the end; " + kSyntax;
+  return s;
+}
+
+FieldReading readField(const std::string& field, const RobotRegistry& registry, const std::string& selected,
+                       int64_t now_ns) {
+  FieldReading r;
+  const FieldDef* def = findField(field);
+  if (!def) {
+    r.error = "unknown field '" + field + "'";
+    return r;
+  }
+  double v = 0;
+  if (!def->needs_robot) {
+    v = registry.connectedCount();
+  } else {
+    if (selected.empty()) {
+      r.error = "no robot selected";
+      return r;
+    }
+    const auto snap = registry.snapshot(selected, now_ns);
+    if (!snap) {
+      if (field == "connected") {
+        v = 0;  // selected before it ever connected
+      } else if (field == "telemetry_hz") {
+        v = 0;
+      } else {
+        r.error = selected + " has never connected";
+        return r;
+      }
+    } else {
+      if (def->needs_telemetry && !snap->has_telemetry) {
+        r.error = "no telemetry from " + selected + " yet";
+        return r;
+      }
+      v = def->get(*snap);
+    }
+  }
+  r.ok = true;
+  r.value = v;
+  if (field == "mode") r.text = modeName(static_cast<int>(v));
+  else if (def->integer) r.text = std::to_string(static_cast<long long>(v));
+  else r.text = fmtShort(v, 3);
+  return r;
+}
+
+bool compare(ExpectOp op, double actual, double value, double tol) {
+  switch (op) {
+    case ExpectOp::kEq: return actual == value;
+    case ExpectOp::kNe: return actual != value;
+    case ExpectOp::kLt: return actual < value;
+    case ExpectOp::kLe: return actual <= value;
+    case ExpectOp::kGt: return actual > value;
+    case ExpectOp::kGe: return actual >= value;
+    case ExpectOp::kNear: return std::fabs(actual - value) <= tol;
+  }
+  return false;
+}
+
+std::string describeWanted(const ExpectSpec& spec) {
+  std::string s = spec.op_text + " " + spec.value_text;
+  if (spec.op == ExpectOp::kNear) s += " +- " + spec.tol_text;
+  if (spec.has_within) s += " within " + fmtShort(spec.within_s) + " s";
+  return s;
+}
+
+}  // namespace inspect::server

@@ -1,0 +1,32 @@
+#pragma once
+// Reads lines (or raw key bytes) from a descriptor with a timeout, waking at
+// once when the server is asked to stop - std::getline cannot be interrupted.
+#include <string>
+
+#include "pc_server/stop_flag.hpp"
+
+namespace inspect::server {
+
+class LineReader {
+ public:
+  enum class Result { kData, kEof, kStopped, kTimeout };
+
+  LineReader(int fd, const StopFlag& stop) : fd_(fd), stop_(stop) {}
+
+  /// Next line without its newline; waits up to `timeout_ms` (< 0: until data, EOF or stop).
+  /// A last line without a newline is returned before kEof.
+  Result nextLine(std::string& line, int timeout_ms);
+  /// Whatever bytes are available (raw terminal keys); same waiting rules.
+  Result readChunk(std::string& bytes, int timeout_ms);
+
+ private:
+  /// Waits for input; kData when readable.
+  Result waitReadable(int timeout_ms);
+
+  int fd_;
+  const StopFlag& stop_;
+  std::string buf_;
+  bool eof_ = false;
+};
+
+}  // namespace inspect::server

@@ -1,0 +1,99 @@
+#pragma once
+// What the server knows about each robot: connection, latest telemetry and its
+// rate, events, acks. Written by the network threads, read by the console;
+// every member function is thread-safe (one mutex, never held across I/O).
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "inspect/v1/link.pb.h"
+
+namespace inspect::server {
+
+/// A copy of one robot's state at one instant.
+struct RobotSnapshot {
+  std::string id;
+  bool connected = false;
+  std::string address;           // "ip:port" of the current or last connection
+  std::string software_version;  // from Hello
+  std::vector<std::string> capabilities;
+  bool has_telemetry = false;
+  v1::Telemetry telemetry;       // latest received (kept after a disconnect)
+  double telemetry_age_s = -1;   // since the latest telemetry was received; < 0 = none yet
+  double telemetry_hz = 0;       // telemetry messages received per second (last second)
+  uint64_t telemetry_count = 0;  // over the server's lifetime
+  double state_age_s = 0;        // since the robot connected / disconnected
+  std::string close_reason;      // why the last connection ended
+};
+
+/// One robot event waiting to be shown on the console.
+struct PendingEvent {
+  std::string robot_id;
+  v1::Event event;
+};
+
+/// Map robot id -> state. Updates carry the session serial so that a replaced
+/// (older) connection cannot overwrite the state of its replacement.
+class RobotRegistry {
+ public:
+  static constexpr std::size_t kMaxAcksPerRobot = 256;
+  static constexpr std::size_t kMaxEventsPerRobot = 100;
+  static constexpr std::size_t kMaxPendingEvents = 1000;
+  static constexpr int64_t kRateWindowNs = 1'000'000'000;
+
+  void onConnected(const std::string& id, const std::string& address, uint64_t serial, const v1::Hello& hello,
+                   int64_t now_ns);
+  void onDisconnected(const std::string& id, uint64_t serial, const std::string& reason, int64_t now_ns);
+  void onTelemetry(const std::string& id, uint64_t serial, const v1::Telemetry& t, int64_t now_ns);
+  void onEvent(const std::string& id, uint64_t serial, const v1::Event& e);
+  void onAck(const std::string& id, uint64_t serial, const v1::Ack& a);
+
+  /// State of one robot; nullopt if it never connected.
+  std::optional<RobotSnapshot> snapshot(const std::string& id, int64_t now_ns) const;
+  /// All robots ever connected, sorted by id.
+  std::vector<RobotSnapshot> snapshots(int64_t now_ns) const;
+  int connectedCount() const;
+  /// The connected robot that connected first ("" if none).
+  std::string firstConnected() const;
+  /// The latest Ack of a command (bounded history per robot).
+  std::optional<v1::Ack> ack(const std::string& id, uint64_t command_id) const;
+  /// Events received since the last call, oldest first.
+  std::vector<PendingEvent> takeEvents();
+  /// Number of events dropped because nobody took them.
+  uint64_t droppedEvents() const;
+  /// The robot's recent events, oldest first.
+  std::vector<v1::Event> events(const std::string& id) const;
+
+ private:
+  struct Entry {
+    uint64_t serial = 0;
+    bool connected = false;
+    uint64_t connect_order = 0;
+    std::string address;
+    std::string software_version;
+    std::vector<std::string> capabilities;
+    int64_t state_change_ns = 0;
+    std::string close_reason;
+    bool has_telemetry = false;
+    v1::Telemetry telemetry;
+    int64_t telemetry_rx_ns = 0;
+    uint64_t telemetry_count = 0;
+    std::deque<int64_t> rx_times_ns;
+    std::map<uint64_t, v1::Ack> acks;
+    std::deque<v1::Event> events;
+  };
+  Entry* current(const std::string& id, uint64_t serial);
+  RobotSnapshot makeSnapshot(const std::string& id, const Entry& e, int64_t now_ns) const;
+
+  mutable std::mutex mu_;
+  std::map<std::string, Entry> robots_;
+  uint64_t connect_counter_ = 0;
+  std::deque<PendingEvent> pending_;
+  uint64_t dropped_events_ = 0;
+};
+
+}  // namespace inspect::server

@@ -1,0 +1,151 @@
+#include "pc_server/server_app.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <thread>
+#include <vector>
+
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+
+#include "pc_server/console.hpp"
+#include "pc_server/console_runner.hpp"
+#include "pc_server/link_server.hpp"
+#include "pc_server/robot_registry.hpp"
+#include "pc_server/startup_error.hpp"
+#include "pc_server/stop_flag.hpp"
+#include "shared/util/log.hpp"
+
+namespace inspect::server {
+
+namespace asio = boost::asio;
+
+namespace {
+constexpr std::string_view kTag = "pc_server";
+constexpr const char* kDefaultConfig = "config/server.yaml";
+constexpr int kIoThreads = 2;
+// The console thread checks in every 20-50 ms; a stall this long means it hangs.
+constexpr std::chrono::milliseconds kConsoleWatchdog{500};
+
+enum class ConsoleMode { kNone, kScript, kInteractive, kStream };
+
+/// The io_context's threads; stopped and joined on every way out of runServer().
+struct IoThreads {
+  asio::io_context& ioc;
+  std::vector<std::thread> threads;
+  ~IoThreads() {
+    ioc.stop();
+    for (auto& t : threads)
+      if (t.joinable()) t.join();
+  }
+};
+}  // namespace
+
+ServerConfig resolveConfig(const CliOptions& options) {
+  ServerConfig c;
+  if (options.config_path) {
+    c = loadServerConfigFile(*options.config_path);
+  } else if (std::filesystem::exists(kDefaultConfig)) {
+    c = loadServerConfigFile(kDefaultConfig);
+  }
+  if (options.bind_address) c.bind_address = *options.bind_address;
+  if (options.port) c.port = *options.port;
+  return c;
+}
+
+void writePortFile(const std::string& path, uint16_t port) {
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) throw StartupError("--port-file: cannot write '" + tmp + "': " + std::strerror(errno));
+  const bool ok = std::fprintf(f, "%u\n", static_cast<unsigned>(port)) > 0;
+  if (std::fclose(f) != 0 || !ok) {
+    std::remove(tmp.c_str());
+    throw StartupError("--port-file: cannot write '" + tmp + "'");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    std::remove(tmp.c_str());
+    throw StartupError("--port-file: cannot rename to '" + path + "': " + why);
+  }
+}
+
+int runServer(const CliOptions& options) {
+  const ServerConfig config = resolveConfig(options);
+
+  ConsoleMode mode = ConsoleMode::kNone;
+  if (options.no_console) mode = ConsoleMode::kNone;
+  else if (options.script_path) mode = ConsoleMode::kScript;
+  else if (options.interactive || ::isatty(0)) mode = ConsoleMode::kInteractive;
+  else mode = ConsoleMode::kStream;
+  std::vector<std::string> script;
+  if (options.script_path) script = readScriptFile(*options.script_path);
+
+  // A console writing to a closed pipe must not kill the server.
+  std::signal(SIGPIPE, SIG_IGN);
+
+  asio::io_context ioc;
+  RobotRegistry registry;
+  LinkServer link(ioc, config, registry);
+  link.setLogEvents(mode == ConsoleMode::kNone);
+  if (mode != ConsoleMode::kNone) link.setConsoleWatchdog(kConsoleWatchdog);
+  const auto endpoint = link.listen();
+  log::warn(kTag, "robot link is plaintext TCP (TLS is not implemented yet): use it only on a trusted network");
+  std::cout << "pc_server: listening on " << endpoint.address().to_string() << ":" << endpoint.port() << std::endl;
+  if (options.port_file) writePortFile(*options.port_file, endpoint.port());
+
+  StopFlag stop;
+  asio::signal_set signals(ioc, SIGINT, SIGTERM);
+  signals.async_wait([&stop](const boost::system::error_code& ec, int sig) {
+    if (ec) return;
+    log::info(kTag, "signal ", sig == SIGINT ? "SIGINT" : "SIGTERM", ": shutting down");
+    stop.request();
+  });
+
+  auto work = asio::make_work_guard(ioc);
+  IoThreads io{ioc, {}};
+  for (int i = 0; i < kIoThreads; ++i) io.threads.emplace_back([&ioc] { ioc.run(); });
+
+  int status = 0;
+  {
+    Console::Options copt;
+    Console console(registry, link, std::cout, stop, copt);
+    ConsoleRunner runner(console, stop, config.status_refresh_hz);
+    switch (mode) {
+      case ConsoleMode::kNone:
+        stop.wait();
+        break;
+      case ConsoleMode::kScript:
+        status = runner.runScript(script, *options.script_path) ? 0 : 1;
+        if (options.interactive && !stop.requested() && !console.quitRequested()) runner.runInteractive();
+        break;
+      case ConsoleMode::kInteractive:
+        runner.runInteractive();
+        break;
+      case ConsoleMode::kStream:
+        status = runner.runStream(0) ? 0 : 1;
+        break;
+    }
+  }
+  std::cout.flush();
+
+  log::info(kTag, "stopping: closing robot sessions");
+  link.stop();
+  if (!link.waitAllClosed(std::chrono::seconds(1))) log::warn(kTag, "some sessions did not close within 1 s");
+  asio::post(ioc, [&signals] {
+    boost::system::error_code ignored;
+    signals.cancel(ignored);
+  });
+  work.reset();
+  return status;  // io stops and joins the threads
+
+}
+
+}  // namespace inspect::server

@@ -1,0 +1,40 @@
+#include "pc_server/server_config.hpp"
+
+#include <boost/asio/ip/address.hpp>
+
+namespace inspect::server {
+
+bool validBindAddress(const std::string& address) {
+  boost::system::error_code ec;
+  (void)boost::asio::ip::make_address(address, ec);
+  return !ec;
+}
+
+ServerConfig loadServerConfig(const config::ConfigNode& root) {
+  ServerConfig c;
+  c.bind_address = root.string("bind", c.bind_address);
+  if (!validBindAddress(c.bind_address))
+    root.fail("bind", "'" + c.bind_address + "' is not a numeric IP address (e.g. 0.0.0.0, 127.0.0.1, ::)");
+  c.port = static_cast<uint16_t>(root.integer("port", c.port, 0, 65535));
+  c.server_id = root.string("server_id", c.server_id);
+  if (c.server_id.empty() || c.server_id.size() > 64) root.fail("server_id", "must be 1 to 64 characters");
+  c.heartbeat_period_s = root.number("heartbeat_period_s", c.heartbeat_period_s, 0.01, 5);
+  // The robot sends heartbeats at 0.1 s by default; a timeout must cover a few of them.
+  c.session_timeout_s = root.number("session_timeout_s", c.session_timeout_s, 0.2, 60);
+  c.handshake_timeout_s = root.number("handshake_timeout_s", c.handshake_timeout_s, 0.1, 60);
+  // The robot zeroes a set-point older than 300 ms; below 10 Hz it would stutter.
+  c.teleop_resend_hz = root.number("teleop_resend_hz", c.teleop_resend_hz, 10, 100);
+  c.max_frame_bytes = static_cast<std::size_t>(root.integer("max_frame_bytes", static_cast<long>(c.max_frame_bytes),
+                                                            1024, 64L * 1024 * 1024));
+  c.status_refresh_hz = root.number("status_refresh_hz", c.status_refresh_hz, 0.5, 30);
+  return c;
+}
+
+ServerConfig loadServerConfigFile(const std::string& path) {
+  const auto root = config::ConfigNode::loadFile(path);
+  ServerConfig c = loadServerConfig(root);
+  root.checkKnown();
+  return c;
+}
+
+}  // namespace inspect::server

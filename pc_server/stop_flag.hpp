@@ -1,0 +1,36 @@
+#pragma once
+// A one-shot "shut down" request shared by the signal handler, the console and
+// waits: sleeping threads wake at once, and a pipe lets poll() loops wake too.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+
+namespace inspect::server {
+
+/// Set once (SIGINT/SIGTERM, quit); never reset.
+class StopFlag {
+ public:
+  StopFlag();
+  ~StopFlag();
+  StopFlag(const StopFlag&) = delete;
+  StopFlag& operator=(const StopFlag&) = delete;
+
+  /// Requests the stop; thread-safe, idempotent.
+  void request();
+  bool requested() const { return requested_.load(); }
+  /// Sleeps for `d` or until the stop request; false if stopped.
+  bool sleepFor(std::chrono::steady_clock::duration d);
+  /// Blocks until the stop request.
+  void wait();
+  /// A descriptor that becomes readable once the stop is requested (for poll()).
+  int wakeFd() const { return pipe_[0]; }
+
+ private:
+  std::atomic<bool> requested_{false};
+  std::mutex mu_;
+  std::condition_variable cv_;
+  int pipe_[2] = {-1, -1};
+};
+
+}  // namespace inspect::server

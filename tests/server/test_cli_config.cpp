@@ -1,0 +1,100 @@
+// Command line and config/server.yaml: defaults, overrides, errors that name the flag or key.
+#include <gtest/gtest.h>
+
+#include "pc_server/cli_options.hpp"
+#include "pc_server/server_config.hpp"
+
+using namespace inspect;
+using namespace inspect::server;
+
+namespace {
+std::string cliError(const std::vector<std::string>& args) {
+  try {
+    (void)parseCli(args);
+  } catch (const UsageError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string configError(const std::string& yaml) {
+  try {
+    const auto root = config::ConfigNode::loadString(yaml, "server.yaml");
+    (void)loadServerConfig(root);
+    root.checkKnown();
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Cli, FlagsAndValues) {
+  const auto o = parseCli({"--config", "a.yaml", "--bind=127.0.0.1", "--port", "0", "--port-file", "p", "--script",
+                           "s.txt", "--interactive"});
+  EXPECT_EQ(o.config_path, "a.yaml");
+  EXPECT_EQ(o.bind_address, "127.0.0.1");
+  EXPECT_EQ(o.port, 0);
+  EXPECT_EQ(o.port_file, "p");
+  EXPECT_EQ(o.script_path, "s.txt");
+  EXPECT_TRUE(o.interactive);
+  EXPECT_FALSE(o.no_console);
+  EXPECT_TRUE(parseCli({"--help"}).help);
+  EXPECT_FALSE(parseCli({}).port.has_value());
+}
+
+TEST(Cli, ErrorsNameTheFlag) {
+  EXPECT_EQ(cliError({"--prot", "1"}), "unknown flag '--prot'");
+  EXPECT_EQ(cliError({"--port", "70000"}), "--port: '70000' is not a port number (0-65535)");
+  EXPECT_EQ(cliError({"--port", "12ab"}), "--port: '12ab' is not a port number (0-65535)");
+  EXPECT_EQ(cliError({"--port"}), "--port: needs a value");
+  EXPECT_EQ(cliError({"--bind", "localhost"}), "--bind: 'localhost' is not a numeric IP address");
+  EXPECT_EQ(cliError({"--no-console=1"}), "--no-console: takes no value");
+  EXPECT_EQ(cliError({"stray"}), "unexpected argument 'stray'");
+  EXPECT_NE(cliError({"--no-console", "--script", "x"}).find("cannot be combined"), std::string::npos);
+}
+
+TEST(Cli, UsageMentionsEveryFlag) {
+  const auto u = usageText();
+  for (const char* f : {"--config", "--bind", "--port", "--port-file", "--script", "--interactive", "--no-console",
+                        "--help"})
+    EXPECT_NE(u.find(f), std::string::npos) << f;
+}
+
+TEST(ServerConfig, EmptyFileGivesDefaults) {
+  const auto c = loadServerConfig(config::ConfigNode::loadString("", "server.yaml"));
+  EXPECT_EQ(c.bind_address, "0.0.0.0");
+  EXPECT_EQ(c.port, 7600);
+  EXPECT_DOUBLE_EQ(c.heartbeat_period_s, 0.1);
+  EXPECT_DOUBLE_EQ(c.session_timeout_s, 1.0);
+  EXPECT_DOUBLE_EQ(c.handshake_timeout_s, 5.0);
+  EXPECT_DOUBLE_EQ(c.teleop_resend_hz, 20.0);
+  EXPECT_EQ(c.max_frame_bytes, 1u << 20);
+  EXPECT_DOUBLE_EQ(c.status_refresh_hz, 5.0);
+}
+
+TEST(ServerConfig, ShippedFileLoadsWithDefaults) {
+  const auto c = loadServerConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/server.yaml");
+  const ServerConfig d;
+  EXPECT_EQ(c.bind_address, d.bind_address);
+  EXPECT_EQ(c.port, d.port);
+  EXPECT_EQ(c.server_id, d.server_id);
+  EXPECT_DOUBLE_EQ(c.heartbeat_period_s, d.heartbeat_period_s);
+  EXPECT_DOUBLE_EQ(c.session_timeout_s, d.session_timeout_s);
+  EXPECT_DOUBLE_EQ(c.handshake_timeout_s, d.handshake_timeout_s);
+  EXPECT_DOUBLE_EQ(c.teleop_resend_hz, d.teleop_resend_hz);
+  EXPECT_EQ(c.max_frame_bytes, d.max_frame_bytes);
+  EXPECT_DOUBLE_EQ(c.status_refresh_hz, d.status_refresh_hz);
+}
+
+TEST(ServerConfig, BadValuesNameFileAndKey) {
+  EXPECT_EQ(configError("port: 70000\n"), "server.yaml: port: 70000 is out of range [0, 65535]");
+  EXPECT_EQ(configError("teleop_resend_hz: 5\n"), "server.yaml: teleop_resend_hz: 5 is out of range [10, 100]");
+  EXPECT_EQ(configError("bind: nowhere\n").rfind("server.yaml: bind: 'nowhere' is not a numeric IP address", 0), 0u);
+  EXPECT_EQ(configError("session_timeout_s: fast\n"), "server.yaml: session_timeout_s: 'fast' is not a number");
+  EXPECT_EQ(configError("max_frame_bytes: 2048.5\n"), "server.yaml: max_frame_bytes: 2048.5 is not a whole number");
+  EXPECT_EQ(configError("max_frame_bytes: 100\n").rfind("server.yaml: max_frame_bytes: 100 is out of range", 0), 0u);
+  EXPECT_EQ(configError("heartbeat_period: 0.1\n"),
+            "server.yaml: heartbeat_period: unknown key (misspelt, or not used by this program)");
+  EXPECT_EQ(configError("server_id: ''\n"), "server.yaml: server_id: must be 1 to 64 characters");
+}

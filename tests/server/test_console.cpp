@@ -1,0 +1,365 @@
+// Console parsing and dispatch on strings, with a fake command sink that
+// answers like a robot through the registry.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <sstream>
+#include <thread>
+
+#include "pc_server/console.hpp"
+#include "shared/util/clock.hpp"
+
+using namespace inspect;
+using namespace inspect::server;
+
+namespace {
+
+constexpr uint64_t kSerial = 1;
+
+/// Records commands; acks them through the registry as a robot would (or not).
+class FakeSink : public CommandSink {
+ public:
+  explicit FakeSink(RobotRegistry& r) : registry_(r) {}
+  uint64_t setTeleop(const std::string& robot, double v, double w) override {
+    if (!registry_.snapshot(robot, monoNowNs()) || !registry_.snapshot(robot, monoNowNs())->connected) return 0;
+    teleop_active = true;
+    last_v = v;
+    last_w = w;
+    v1::Command c;
+    c.mutable_teleop();
+    return answer(robot, c);
+  }
+  void clearTeleop(const std::string&) override { teleop_active = false; }
+  void consoleAlive() override { ++alive_calls; }
+  uint64_t sendCommand(const std::string& robot, v1::Command cmd) override {
+    if (!registry_.snapshot(robot, monoNowNs()) || !registry_.snapshot(robot, monoNowNs())->connected) return 0;
+    if (cmd.has_stop() || cmd.has_estop()) teleop_active = false;
+    sent.push_back(cmd);
+    return answer(robot, cmd);
+  }
+
+  std::optional<v1::Ack::Status> reply = v1::Ack::ACCEPTED;  // nullopt = never ack
+  std::string reason;
+  bool teleop_active = false;
+  int alive_calls = 0;
+  double last_v = 0, last_w = 0;
+  std::vector<v1::Command> sent;
+
+ private:
+  uint64_t answer(const std::string& robot, const v1::Command&) {
+    const uint64_t id = ++next_id_;
+    if (reply) {
+      v1::Ack a;
+      a.set_command_id(id);
+      a.set_status(*reply);
+      a.set_reason(reason);
+      registry_.onAck(robot, kSerial, a);
+    }
+    return id;
+  }
+  RobotRegistry& registry_;
+  uint64_t next_id_ = 0;
+};
+
+class ConsoleTest : public ::testing::Test {
+ protected:
+  ConsoleTest() : sink_(registry_), console_(registry_, sink_, out_, stop_, fastOptions()) {}
+
+  static Console::Options fastOptions() {
+    Console::Options o;
+    o.ack_timeout_s = 0.1;
+    o.poll_period_s = 0.005;
+    return o;
+  }
+
+  /// A robot as the link would register it; `settle` lets the console auto-select it now.
+  void connectRobot(const std::string& id = "robot1", bool settle = true) {
+    v1::Hello h;
+    h.set_robot_id(id);
+    registry_.onConnected(id, "127.0.0.1:1", kSerial, h, monoNowNs());
+    if (settle) (void)console_.background();
+  }
+  void telemetry(double x, v1::Mode mode = v1::IDLE, const std::string& id = "robot1") {
+    v1::Telemetry t;
+    t.mutable_pose()->set_x_m(x);
+    t.set_mode(mode);
+    t.set_faults(v1::FAULT_SENSOR_STALE);
+    registry_.onTelemetry(id, kSerial, t, monoNowNs());
+  }
+  /// Runs a line and returns (ok, output).
+  std::pair<bool, std::string> run(const std::string& line, int line_no = 7) {
+    out_.str("");
+    const bool ok = console_.execute(line, line_no);
+    return {ok, out_.str()};
+  }
+
+  RobotRegistry registry_;
+  FakeSink sink_;
+  std::ostringstream out_;
+  StopFlag stop_;
+  Console console_;
+};
+
+#define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
+
+}  // namespace
+
+TEST_F(ConsoleTest, BlankAndCommentLinesDoNothing) {
+  EXPECT_TRUE(run("").first);
+  EXPECT_TRUE(run("   # just a comment").first);
+  EXPECT_EQ(console_.tally().commands, 0);
+}
+
+TEST_F(ConsoleTest, UnknownCommandIsAClearError) {
+  const auto [ok, out] = run("drvie 0.1 0");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "unknown command 'drvie' (try 'help')\n");
+  EXPECT_EQ(console_.tally().errors, 1);
+}
+
+TEST_F(ConsoleTest, HelpListsEveryCommandAndExplainsOne) {
+  auto [ok, out] = run("help");
+  EXPECT_TRUE(ok);
+  for (const char* c : {"robots", "select", "status", "drive", "teleop", "stop", "estop", "resume", "wait", "expect",
+                        "echo", "quit"})
+    EXPECT_HAS(out, c);
+  std::tie(ok, out) = run("help drive");
+  EXPECT_TRUE(ok);
+  EXPECT_HAS(out, "drive <v_m_s> <w_rad_s>");
+  std::tie(ok, out) = run("help nope");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "unknown command 'nope'");
+}
+
+struct BadArgsCase {
+  const char* line;
+  const char* message;
+};
+
+class ConsoleBadArgs : public ConsoleTest, public ::testing::WithParamInterface<BadArgsCase> {};
+
+TEST_P(ConsoleBadArgs, PrintsAClearMessage) {
+  connectRobot();
+  const auto [ok, out] = run(GetParam().line);
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, GetParam().message);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Table, ConsoleBadArgs,
+    ::testing::Values(BadArgsCase{"drive abc 0", "drive: 'abc' is not a number"},
+                      BadArgsCase{"drive 0.1 nan", "drive: 'nan' is not a number"},
+                      BadArgsCase{"drive 0.1", "drive: needs two numbers"},
+                      BadArgsCase{"drive 0.1 0 3", "drive: needs two numbers"},
+                      BadArgsCase{"drive 5 0", "drive: v 5 m/s is outside [-1, 1]"},
+                      BadArgsCase{"drive 0 -2.5", "drive: w -2.5 rad/s is outside [-2, 2]"},
+                      BadArgsCase{"wait", "wait: needs one number"}, BadArgsCase{"wait soon", "'soon' is not a number"},
+                      BadArgsCase{"wait -1", "outside [0, 3600]"}, BadArgsCase{"select a b", "needs one robot id"},
+                      BadArgsCase{"select bad!id", "not a valid robot id"},
+                      BadArgsCase{"stop now", "stop: takes no arguments"},
+                      BadArgsCase{"teleop fast", "teleop: unknown mode 'fast'"},
+                      BadArgsCase{"teleop", "keyboard teleop needs an interactive terminal"},
+                      BadArgsCase{"status a b", "status: takes at most one"}));
+
+TEST_F(ConsoleTest, CommandsNeedASelectedConnectedRobot) {
+  auto [ok, out] = run("drive 0.1 0");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "drive: no robot selected\n");
+  std::tie(ok, out) = run("select robot2");
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(out, "selected robot2 (not connected yet)\n");
+  std::tie(ok, out) = run("estop");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "estop: robot2 is not connected\n");
+}
+
+TEST_F(ConsoleTest, FirstRobotToConnectIsSelected) {
+  connectRobot("robot9", false);
+  connectRobot("robot3", false);
+  const auto [ok, out] = run("status");
+  EXPECT_TRUE(ok);
+  EXPECT_HAS(out, "selected robot9 (the first robot to connect)");
+  EXPECT_EQ(console_.selected(), "robot9");
+}
+
+TEST_F(ConsoleTest, DriveSetsTheSetPointAndReportsTheAck) {
+  connectRobot();
+  auto [ok, out] = run("drive 0.3 -0.5");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_HAS(out, "robot1: drive +0.30 m/s -0.50 rad/s accepted");
+  EXPECT_TRUE(sink_.teleop_active);
+  EXPECT_DOUBLE_EQ(sink_.last_v, 0.3);
+  EXPECT_DOUBLE_EQ(sink_.last_w, -0.5);
+  std::tie(ok, out) = run("stop");
+  EXPECT_TRUE(ok);
+  EXPECT_HAS(out, "robot1: stop accepted");
+  EXPECT_FALSE(sink_.teleop_active);
+  ASSERT_EQ(sink_.sent.size(), 1u);
+  EXPECT_TRUE(sink_.sent[0].has_stop());
+}
+
+TEST_F(ConsoleTest, RejectedDriveClearsTheSetPoint) {
+  connectRobot();
+  sink_.reply = v1::Ack::REJECTED;
+  sink_.reason = "robot in ESTOP";
+  const auto [ok, out] = run("drive 0.3 0");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "rejected: robot in ESTOP");
+  EXPECT_FALSE(sink_.teleop_active);
+}
+
+TEST_F(ConsoleTest, EstopResumeAckMessages) {
+  connectRobot();
+  auto [ok, out] = run("estop");
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(out, "robot1: estop accepted\n");
+  EXPECT_TRUE(sink_.sent.back().has_estop());
+  sink_.reply = v1::Ack::REJECTED;
+  sink_.reason = "fault still active";
+  std::tie(ok, out) = run("resume");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "robot1: resume rejected: fault still active\n");
+  sink_.reply = std::nullopt;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::tie(ok, out) = run("stop");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "robot1: stop: no ack within 0.1 s\n");
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(100));
+}
+
+TEST_F(ConsoleTest, RobotsTableAndStatusLine) {
+  connectRobot();
+  telemetry(1.2, v1::TELEOP);
+  auto [ok, out] = run("robots");
+  EXPECT_TRUE(ok);
+  EXPECT_HAS(out, "* robot1");
+  EXPECT_HAS(out, "127.0.0.1:1");
+  EXPECT_HAS(out, "TELEOP");
+  std::tie(ok, out) = run("status");
+  EXPECT_TRUE(ok);
+  EXPECT_HAS(out, "robot1 | TELEOP | v +0.00 w +0.00 | x 1.20 y 0.00 th +0.00");
+  EXPECT_HAS(out, "faults SENSOR_STALE");
+  std::tie(ok, out) = run("status ghost");
+  EXPECT_EQ(out, "ghost | not connected yet\n");
+}
+
+TEST_F(ConsoleTest, EchoPrintsTheRestOfTheLine) {
+  const auto [ok, out] = run("echo  hello   world  # note");
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(out, "hello   world\n");
+}
+
+TEST_F(ConsoleTest, WaitSleepsAndQuitIsRecorded) {
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_TRUE(run("wait 0.05").first);
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(50));
+  EXPECT_FALSE(console_.quitRequested());
+  EXPECT_TRUE(run("exit").first);
+  EXPECT_TRUE(console_.quitRequested());
+}
+
+TEST_F(ConsoleTest, ConsoleReportsItIsAliveWhileWaiting) {
+  EXPECT_TRUE(run("wait 0.1").first);
+  EXPECT_GE(sink_.alive_calls, 5) << "the console watchdog needs a sign of life every poll";
+}
+
+TEST_F(ConsoleTest, WaitIsInterruptedByStop) {
+  stop_.request();
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto [ok, out] = run("wait 10");
+  EXPECT_FALSE(ok);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(1));
+}
+
+TEST_F(ConsoleTest, EventsArePrintedAsTheyCome) {
+  connectRobot();
+  v1::Event e;
+  e.set_kind(v1::Event::FAULT_RAISED);
+  e.set_text("link lost");
+  registry_.onEvent("robot1", kSerial, e);
+  const auto [ok, out] = run("echo x");
+  EXPECT_HAS(out, "[robot1] FAULT_RAISED: link lost\n");
+}
+
+// --- expect ---
+
+TEST_F(ConsoleTest, ExpectPassesAndFailsWithTheWantedText) {
+  connectRobot();
+  telemetry(1.93);
+  auto [ok, out] = run("expect x ~ 2.0 0.05 ", 12);
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "EXPECT FAILED (line 12): x = 1.93, wanted ~ 2.0 +- 0.05\n");
+  std::tie(ok, out) = run("expect x ~ 2.0 +- 0.1", 13);
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(out, "expect ok (line 13): x = 1.93\n");
+  std::tie(ok, out) = run("expect mode == IDLE");
+  EXPECT_TRUE(ok);
+  EXPECT_HAS(out, "mode = IDLE");
+  std::tie(ok, out) = run("expect faults == 0x2");
+  EXPECT_TRUE(ok) << out;
+  std::tie(ok, out) = run("expect connected == 1");
+  EXPECT_TRUE(ok);
+  std::tie(ok, out) = run("expect robots >= 2");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "robots = 1, wanted >= 2");
+  EXPECT_EQ(console_.tally().expects_passed, 4);
+  EXPECT_EQ(console_.tally().expects_failed, 2);
+}
+
+TEST_F(ConsoleTest, ExpectUnknownFieldCountsAsFailure) {
+  connectRobot();
+  const auto [ok, out] = run("expect speed > 1", 3);
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "EXPECT FAILED (line 3): expect: unknown field 'speed'");
+  EXPECT_EQ(console_.tally().expects_failed, 1);
+}
+
+TEST_F(ConsoleTest, ExpectWithoutTelemetrySaysSo) {
+  auto [ok, out] = run("expect x > 0");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "x: no robot selected");
+  connectRobot();
+  std::tie(ok, out) = run("expect x > 0");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "x: no telemetry from robot1 yet");
+  std::tie(ok, out) = run("expect telemetry_hz == 0");
+  EXPECT_TRUE(ok) << out;
+}
+
+TEST_F(ConsoleTest, ExpectWithinPollsUntilTrue) {
+  connectRobot();
+  telemetry(0.0);
+  std::thread mover([this] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    telemetry(2.01);
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto [ok, out] = run("expect x ~ 2 0.05 within 2");
+  const auto dt = std::chrono::steady_clock::now() - t0;
+  mover.join();
+  EXPECT_TRUE(ok) << out;
+  EXPECT_HAS(out, "x = 2.01");
+  EXPECT_GE(dt, std::chrono::milliseconds(90));
+  EXPECT_LT(dt, std::chrono::milliseconds(1000));
+}
+
+TEST_F(ConsoleTest, ExpectWithinTimesOut) {
+  connectRobot();
+  telemetry(0.5);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto [ok, out] = run("expect x >= 1 within 0.2", 4);
+  const auto dt = std::chrono::steady_clock::now() - t0;
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "EXPECT FAILED (line 4): x = 0.5, wanted >= 1 within 0.2 s\n");
+  EXPECT_GE(dt, std::chrono::milliseconds(200));
+  EXPECT_LT(dt, std::chrono::milliseconds(800));
+}
+
+TEST_F(ConsoleTest, ExpectRobotsWorksWithoutSelection) {
+  auto [ok, out] = run("expect robots == 0");
+  EXPECT_TRUE(ok) << out;
+  connectRobot("r1");
+  connectRobot("r2");
+  std::tie(ok, out) = run("expect robots == 2");
+  EXPECT_TRUE(ok) << out;
+}

@@ -1,0 +1,428 @@
+// The server side of the robot link against small test robots on 127.0.0.1.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "server_fixture.hpp"
+
+using namespace inspect;
+using namespace inspect::test;
+using Body = v1::Envelope::BodyCase;
+
+namespace {
+
+class LinkServerTest : public ServerFixture {};
+
+std::vector<TestRobot::Received> commandsOf(const TestRobot& r, Body kind_of_body = Body::kCommand) {
+  std::vector<TestRobot::Received> out;
+  for (const auto& m : r.received())
+    if (m.env.body_case() == kind_of_body) out.push_back(m);
+  return out;
+}
+
+int teleopsBetween(const TestRobot& r, Clock::time_point from, Clock::time_point to) {
+  int n = 0;
+  for (const auto& m : commandsOf(r))
+    if (m.env.command().has_teleop() && m.t >= from && m.t < to) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_F(LinkServerTest, HandshakeAcceptedAndHeartbeatsFlow) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  const auto reply = r.hello("robot1");
+  ASSERT_TRUE(reply);
+  EXPECT_TRUE(reply->accepted());
+  EXPECT_EQ(reply->protocol_version(), net::kProtocolVersion);
+  EXPECT_EQ(reply->server_id(), "test_server");
+  // Heartbeats follow at 10 Hz.
+  const auto start = Clock::now();
+  int heartbeats = 0;
+  while (heartbeats < 3 && Clock::now() - start < 1s)
+    if (auto m = r.receive(500ms); m && m->has_heartbeat()) ++heartbeats;
+  EXPECT_EQ(heartbeats, 3);
+  EXPECT_LT(Clock::now() - start, 600ms);
+  ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
+  EXPECT_EQ(snap("robot1")->capabilities, std::vector<std::string>{"teleop"});
+}
+
+TEST_F(LinkServerTest, VersionMismatchRejectedWithReason) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  const auto reply = r.hello("robot1", net::kProtocolVersion + 1);
+  ASSERT_TRUE(reply);
+  EXPECT_FALSE(reply->accepted());
+  EXPECT_NE(reply->reason().find("protocol version"), std::string::npos) << reply->reason();
+  EXPECT_EQ(reply->protocol_version(), net::kProtocolVersion);
+  EXPECT_TRUE(r.waitClosed(2000ms));
+  EXPECT_FALSE(snap("robot1"));
+}
+
+TEST_F(LinkServerTest, BadRobotIdRejected) {
+  startServer();
+  for (const std::string& bad : {std::string(""), std::string("bad id"), std::string(65, 'a'), std::string("r/1")}) {
+    TestRobot r;
+    ASSERT_TRUE(r.connect(port_));
+    const auto reply = r.hello(bad);
+    ASSERT_TRUE(reply) << bad;
+    EXPECT_FALSE(reply->accepted()) << bad;
+    EXPECT_NE(reply->reason().find("invalid robot id"), std::string::npos) << reply->reason();
+    EXPECT_TRUE(r.waitClosed(2000ms));
+  }
+  // Not UTF-8: the Envelope itself does not parse (proto3 strings), so no reply, just a close.
+  TestRobot binary;
+  ASSERT_TRUE(binary.connect(port_));
+  EXPECT_FALSE(binary.hello("r\xff"));
+  EXPECT_TRUE(binary.waitClosed(2000ms));
+  TestRobot ok;
+  ASSERT_TRUE(ok.connect(port_));
+  const auto reply = ok.hello(std::string(64, 'a') + "");
+  ASSERT_TRUE(reply);
+  EXPECT_TRUE(reply->accepted());
+}
+
+TEST_F(LinkServerTest, MessageBeforeHelloCloses) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  v1::Envelope e;
+  e.mutable_telemetry()->mutable_pose()->set_x_m(1);
+  ASSERT_TRUE(r.send(e));
+  const auto m = r.receive(2000ms);
+  EXPECT_FALSE(m) << "no reply expected, got " << (m ? m->DebugString() : "");
+  EXPECT_TRUE(r.peerClosed());
+  EXPECT_EQ(registry_.connectedCount(), 0);
+}
+
+TEST_F(LinkServerTest, RobotSendingServerMessagesIsClosed) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  v1::Envelope e;
+  e.mutable_command()->set_id(5);
+  ASSERT_TRUE(r.send(e));
+  EXPECT_TRUE(r.waitClosed(2000ms));
+  ASSERT_TRUE(eventually([&] { return !connected("robot1"); }));
+  EXPECT_NE(snap("robot1")->close_reason.find("Command"), std::string::npos) << snap("robot1")->close_reason;
+}
+
+TEST_F(LinkServerTest, GarbageThatDoesNotParseCloses) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  // A valid length prefix around bytes that are not an Envelope (field 0 is illegal).
+  ASSERT_TRUE(r.sendRaw(std::string("\x03\x00\x00\x00", 4)));
+  EXPECT_TRUE(r.waitClosed(2000ms));
+  ASSERT_TRUE(eventually([&] { return !connected("robot1"); }));
+  EXPECT_NE(snap("robot1")->close_reason.find("malformed"), std::string::npos) << snap("robot1")->close_reason;
+}
+
+TEST_F(LinkServerTest, OversizeFrameClosesOnlyThatSession) {
+  startServer();
+  TestRobot good;
+  ASSERT_TRUE(good.connect(port_));
+  ASSERT_TRUE(good.hello("good"));
+  good.startPump(50);
+  TestRobot bad;
+  ASSERT_TRUE(bad.connect(port_));
+  ASSERT_TRUE(bad.hello("bad"));
+  ASSERT_TRUE(eventually([&] { return snap("good") && snap("good")->telemetry_count > 5; }));
+
+  // Length prefix of 2 GiB: refused before any allocation.
+  ASSERT_TRUE(bad.sendRaw(std::string("\x80\x80\x80\x80\x08", 5)));
+  EXPECT_TRUE(bad.waitClosed(1000ms));
+  ASSERT_TRUE(eventually([&] { return !connected("bad"); }));
+  EXPECT_NE(snap("bad")->close_reason.find("exceeds the maximum"), std::string::npos) << snap("bad")->close_reason;
+
+  // The other robot keeps its heartbeats and its telemetry keeps updating.
+  const int hb0 = good.count(Body::kHeartbeat);
+  const uint64_t tlm0 = snap("good")->telemetry_count;
+  std::this_thread::sleep_for(500ms);
+  EXPECT_GE(good.count(Body::kHeartbeat) - hb0, 3);
+  EXPECT_GE(snap("good")->telemetry_count - tlm0, 15u);
+  EXPECT_TRUE(connected("good"));
+  EXPECT_FALSE(good.peerClosed());
+}
+
+TEST_F(LinkServerTest, TruncatedFrameThenClose) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
+  // Announce 100 bytes, send 10, hang up.
+  ASSERT_TRUE(r.sendRaw(std::string("\x64") + std::string(10, '\x08')));
+  r.shutdownWrite();
+  EXPECT_TRUE(r.waitClosed(2000ms));
+  ASSERT_TRUE(eventually([&] { return !connected("robot1"); }));
+  EXPECT_NE(snap("robot1")->close_reason.find("middle of a frame"), std::string::npos) << snap("robot1")->close_reason;
+  EXPECT_TRUE(eventually([&] { return link_->sessionCount() == 0; }));
+}
+
+TEST_F(LinkServerTest, DuplicateRobotIdReplacesOldSession) {
+  startServer();
+  TestRobot first;
+  ASSERT_TRUE(first.connect(port_));
+  ASSERT_TRUE(first.hello("robot1"));
+  ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
+  const std::string first_address = snap("robot1")->address;
+
+  TestRobot second;
+  ASSERT_TRUE(second.connect(port_));
+  const auto reply = second.hello("robot1");
+  ASSERT_TRUE(reply);
+  EXPECT_TRUE(reply->accepted());
+  EXPECT_TRUE(first.waitClosed(2000ms));
+  second.startPump(20);
+  // The old session's close must not mark the robot disconnected.
+  std::this_thread::sleep_for(300ms);
+  EXPECT_TRUE(connected("robot1"));
+  EXPECT_NE(snap("robot1")->address, first_address);
+  EXPECT_GE(second.count(Body::kHeartbeat), 2);
+  EXPECT_EQ(registry_.connectedCount(), 1);
+  EXPECT_EQ(link_->sessionCount(), 1u);
+}
+
+TEST_F(LinkServerTest, TelemetryEventsAndAcksReachTheRegistry) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  v1::Envelope e;
+  auto* t = e.mutable_telemetry();
+  t->mutable_pose()->set_x_m(1.25);
+  t->mutable_pose()->set_theta_rad(-0.5);
+  t->set_mode(v1::ESTOP);
+  t->set_faults(v1::FAULT_LINK_LOST | v1::FAULT_SERIAL_DOWN);
+  t->mutable_serial()->set_bad_crc(7);
+  ASSERT_TRUE(r.send(e));
+  v1::Envelope ev;
+  ev.mutable_event()->set_kind(v1::Event::FAULT_RAISED);
+  ev.mutable_event()->set_text("link lost");
+  ASSERT_TRUE(r.send(ev));
+  v1::Envelope ack;
+  ack.mutable_ack()->set_command_id(42);
+  ack.mutable_ack()->set_status(v1::Ack::REJECTED);
+  ack.mutable_ack()->set_reason("busy");
+  ASSERT_TRUE(r.send(ack));
+
+  ASSERT_TRUE(eventually([&] { return registry_.ack("robot1", 42).has_value(); }));
+  const auto s = snap("robot1");
+  ASSERT_TRUE(s && s->has_telemetry);
+  EXPECT_DOUBLE_EQ(s->telemetry.pose().x_m(), 1.25);
+  EXPECT_DOUBLE_EQ(s->telemetry.pose().theta_rad(), -0.5);
+  EXPECT_EQ(s->telemetry.mode(), v1::ESTOP);
+  EXPECT_EQ(s->telemetry.serial().bad_crc(), 7u);
+  EXPECT_GE(s->telemetry_age_s, 0.0);
+  EXPECT_LT(s->telemetry_age_s, 1.0);
+  EXPECT_EQ(registry_.ack("robot1", 42)->reason(), "busy");
+  const auto events = registry_.takeEvents();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].robot_id, "robot1");
+  EXPECT_EQ(events[0].event.text(), "link lost");
+}
+
+TEST_F(LinkServerTest, TelemetryRateIsMeasured) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(50);
+  std::this_thread::sleep_for(1200ms);
+  const auto s = snap("robot1");
+  ASSERT_TRUE(s);
+  EXPECT_NEAR(s->telemetry_hz, 50.0, 8.0);
+  r.stopPump();
+  r.close();
+  ASSERT_TRUE(eventually([&] { return !connected("robot1"); }));
+  ASSERT_TRUE(eventually([&] { return snap("robot1")->telemetry_hz == 0.0; }, 1500ms));
+}
+
+TEST_F(LinkServerTest, DriveResendsTeleopAt20Hz) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(0);
+  ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
+  const auto t0 = Clock::now();
+  const uint64_t first = link_->setTeleop("robot1", 0.3, -0.2);
+  EXPECT_GT(first, 0u);
+  std::this_thread::sleep_for(1050ms);
+  const auto t1 = Clock::now();
+  // 1 immediate + 20 per second.
+  const int n = teleopsBetween(r, t0, t1);
+  EXPECT_GE(n, 18);
+  EXPECT_LE(n, 24);
+  uint64_t last_id = 0;
+  for (const auto& m : commandsOf(r)) {
+    const auto& c = m.env.command();
+    ASSERT_TRUE(c.has_teleop());
+    EXPECT_DOUBLE_EQ(c.teleop().v_m_s(), 0.3);
+    EXPECT_DOUBLE_EQ(c.teleop().w_rad_s(), -0.2);
+    EXPECT_GT(c.id(), last_id) << "ids must increase";
+    last_id = c.id();
+  }
+  EXPECT_EQ(commandsOf(r).front().env.command().id(), first);
+  // Every command was acked and the registry keeps the acks.
+  EXPECT_TRUE(eventually([&] { return registry_.ack("robot1", last_id).has_value(); }));
+}
+
+TEST_F(LinkServerTest, StopEndsTheResend) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(0);
+  ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
+  link_->setTeleop("robot1", 0.2, 0);
+  std::this_thread::sleep_for(200ms);
+  v1::Command stop;
+  stop.mutable_stop();
+  const uint64_t stop_id = link_->sendCommand("robot1", stop);
+  ASSERT_GT(stop_id, 0u);
+  ASSERT_TRUE(eventually([&] { return registry_.ack("robot1", stop_id).has_value(); }));
+  Clock::time_point stop_seen{};
+  for (const auto& m : commandsOf(r))
+    if (m.env.command().has_stop()) stop_seen = m.t;
+  ASSERT_NE(stop_seen, Clock::time_point{});
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(teleopsBetween(r, stop_seen, Clock::now()), 0);
+  EXPECT_GE(teleopsBetween(r, Clock::time_point{}, stop_seen), 3);
+
+  // clearTeleop stops it too, without sending anything.
+  link_->setTeleop("robot1", 0.1, 0);
+  std::this_thread::sleep_for(100ms);
+  link_->clearTeleop("robot1");
+  std::this_thread::sleep_for(60ms);
+  const auto after_clear = Clock::now();
+  std::this_thread::sleep_for(250ms);
+  EXPECT_EQ(teleopsBetween(r, after_clear, Clock::now()), 0);
+}
+
+TEST_F(LinkServerTest, HungConsoleStopsTheResend) {
+  startServer();
+  link_->setConsoleWatchdog(200ms);
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(0);
+  ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
+  const auto t0 = Clock::now();
+  link_->consoleAlive();
+  link_->setTeleop("robot1", 0.2, 0);
+  // A live console keeps it going...
+  while (Clock::now() - t0 < 500ms) {
+    link_->consoleAlive();
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_GE(teleopsBetween(r, t0 + 300ms, Clock::now()), 3);
+  // ...a silent one stops it within the watchdog time plus one period.
+  const auto hung = Clock::now();
+  std::this_thread::sleep_for(600ms);
+  EXPECT_EQ(teleopsBetween(r, hung + 300ms, Clock::now()), 0);
+  EXPECT_TRUE(connected("robot1")) << "only the set-point stops, not the session";
+}
+
+TEST_F(LinkServerTest, ClosingTheSessionClearsTheSetPoint) {
+  startServer();
+  {
+    TestRobot r;
+    ASSERT_TRUE(r.connect(port_));
+    ASSERT_TRUE(r.hello("robot1"));
+    r.startPump(0);
+    ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
+    link_->setTeleop("robot1", 0.2, 0);
+    std::this_thread::sleep_for(150ms);
+  }
+  ASSERT_TRUE(eventually([&] { return !connected("robot1"); }));
+  EXPECT_EQ(link_->setTeleop("robot1", 0.2, 0), 0u) << "not connected: nothing to send to";
+  TestRobot again;
+  ASSERT_TRUE(again.connect(port_));
+  ASSERT_TRUE(again.hello("robot1"));
+  again.startPump(0);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(again.count(Body::kCommand), 0) << "a reconnected robot must not resume driving";
+}
+
+TEST_F(LinkServerTest, SessionTimeoutClosesSilentRobot) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  const auto t0 = Clock::now();
+  ASSERT_TRUE(r.hello("robot1"));
+  ASSERT_TRUE(r.waitClosed(3000ms));  // says nothing after Hello
+  const auto dt = Clock::now() - t0;
+  EXPECT_GE(dt, 900ms);
+  EXPECT_LE(dt, 1500ms);
+  ASSERT_TRUE(eventually([&] { return !connected("robot1"); }));
+  EXPECT_NE(snap("robot1")->close_reason.find("session timeout"), std::string::npos) << snap("robot1")->close_reason;
+}
+
+TEST_F(LinkServerTest, HeartbeatsKeepTheSessionAlive) {
+  startServer();
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(0);
+  std::this_thread::sleep_for(1500ms);
+  EXPECT_TRUE(connected("robot1"));
+  EXPECT_FALSE(r.peerClosed());
+}
+
+TEST_F(LinkServerTest, HandshakeTimeoutClosesSilentConnection) {
+  auto c = testConfig();
+  c.handshake_timeout_s = 0.3;
+  startServer(c);
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  const auto t0 = Clock::now();
+  ASSERT_TRUE(r.waitClosed(2000ms));
+  EXPECT_GE(Clock::now() - t0, 250ms);
+  EXPECT_TRUE(eventually([&] { return link_->sessionCount() == 0; }));
+}
+
+TEST_F(LinkServerTest, CommandIdsAreUniqueAcrossRobots) {
+  startServer();
+  TestRobot a, b;
+  ASSERT_TRUE(a.connect(port_));
+  ASSERT_TRUE(a.hello("a"));
+  ASSERT_TRUE(b.connect(port_));
+  ASSERT_TRUE(b.hello("b"));
+  ASSERT_TRUE(eventually([&] { return registry_.connectedCount() == 2; }));
+  std::vector<uint64_t> ids;
+  for (int i = 0; i < 5; ++i) {
+    v1::Command c;
+    c.mutable_stop();
+    ids.push_back(link_->sendCommand(i % 2 ? "a" : "b", c));
+  }
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    EXPECT_GT(ids[i], 0u);
+    if (i > 0) {
+      EXPECT_GT(ids[i], ids[i - 1]);
+    }
+  }
+  v1::Command c;
+  c.mutable_stop();
+  EXPECT_EQ(link_->sendCommand("nobody", c), 0u);
+}
+
+TEST_F(LinkServerTest, StopClosesAllSessions) {
+  startServer();
+  TestRobot a;
+  ASSERT_TRUE(a.connect(port_));
+  ASSERT_TRUE(a.hello("a"));
+  TestRobot pending;  // still in the handshake
+  ASSERT_TRUE(pending.connect(port_));
+  ASSERT_TRUE(eventually([&] { return link_->sessionCount() == 2; }));
+  link_->stop();
+  EXPECT_TRUE(link_->waitAllClosed(1s));
+  EXPECT_TRUE(a.waitClosed(1000ms));
+  EXPECT_TRUE(pending.waitClosed(1000ms));
+}

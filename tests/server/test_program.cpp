@@ -1,0 +1,233 @@
+// The real pc_server binary: script mode with a test robot, piped stdin,
+// exit statuses, config errors and shutdown by signal.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "test_robot.hpp"
+
+using namespace inspect;
+using namespace inspect::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kBinary = std::string(INSPECT_BIN_DIR) + "/pc_server";
+const std::string kConfig = std::string(INSPECT_SOURCE_DIR) + "/config/server.yaml";
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// pc_server as a child process; stdout/stderr go to files, stdin from a file or /dev/null.
+class Program {
+ public:
+  explicit Program(const std::string& name) : dir_(fs::temp_directory_path() / ("pc_server_test_" + name + "_" +
+                                                                               std::to_string(::getpid()))) {
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  ~Program() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+    fs::remove_all(dir_);
+  }
+
+  fs::path file(const std::string& name, const std::string& text) const {
+    const auto p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+  fs::path path(const std::string& name) const { return dir_ / name; }
+
+  void start(std::vector<std::string> args, const std::string& stdin_text = "") {
+    const auto in_path = file("stdin.txt", stdin_text);
+    const auto out_path = path("stdout.txt");
+    const auto err_path = path("stderr.txt");
+    args.insert(args.begin(), kBinary);
+    pid_ = ::fork();
+    ASSERT_GE(pid_, 0);
+    if (pid_ == 0) {
+      const int in = ::open(in_path.c_str(), O_RDONLY);
+      const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(in, 0);
+      ::dup2(out, 1);
+      ::dup2(err, 2);
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      ::execv(kBinary.c_str(), argv.data());
+      ::_exit(127);
+    }
+  }
+
+  /// The port from --port-file, waiting up to 5 s for the file.
+  uint16_t waitPort(const fs::path& port_file) {
+    const auto deadline = Clock::now() + 5s;
+    while (Clock::now() < deadline) {
+      if (fs::exists(port_file)) return static_cast<uint16_t>(std::stoi(slurp(port_file)));
+      std::this_thread::sleep_for(10ms);
+    }
+    return 0;
+  }
+
+  /// Exit status, or -1 if it did not exit within `timeout`.
+  int wait(std::chrono::milliseconds timeout = 10000ms) {
+    const auto deadline = Clock::now() + timeout;
+    while (Clock::now() < deadline) {
+      int st = 0;
+      if (::waitpid(pid_, &st, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    return -1;
+  }
+
+  void signal(int sig) { ::kill(pid_, sig); }
+  std::string out() const { return slurp(dir_ / "stdout.txt"); }
+  std::string err() const { return slurp(dir_ / "stderr.txt"); }
+
+ private:
+  fs::path dir_;
+  pid_t pid_ = -1;
+};
+
+#define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
+
+}  // namespace
+
+TEST(Program, ScriptWithARobotPasses) {
+  Program p("script_ok");
+  const auto script = p.file("s.txt",
+                             "# waits for the test robot\n"
+                             "expect robots >= 1 within 5\n"
+                             "expect connected == 1\n"
+                             "\n"
+                             "expect x > 3 within 2\n"
+                             "drive 0.2 0\n"
+                             "expect telemetry_hz > 10 within 2\n"
+                             "stop\n"
+                             "estop\n"
+                             "robots\n"
+                             "echo all done\n");
+  const auto port_file = p.path("port");
+  p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--port-file", port_file.string(), "--script",
+           script.string()});
+  const uint16_t port = p.waitPort(port_file);
+  ASSERT_GT(port, 0);
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(50);
+  const int rc = p.wait();
+  const auto out = p.out();
+  EXPECT_EQ(rc, 0) << out << p.err();
+  EXPECT_HAS(out, "pc_server: listening on 127.0.0.1:" + std::to_string(port));
+  EXPECT_HAS(out, "[2] expect robots >= 1 within 5");
+  EXPECT_HAS(out, "selected robot1 (the first robot to connect)");
+  EXPECT_HAS(out, "expect ok (line 3): connected = 1");
+  EXPECT_HAS(out, "robot1: drive +0.20 m/s +0.00 rad/s accepted");
+  EXPECT_HAS(out, "robot1: stop accepted");
+  EXPECT_HAS(out, "robot1: estop accepted");
+  EXPECT_HAS(out, "all done");
+  EXPECT_HAS(out, "0 failed, 0 errors");
+  r.stopPump();
+  int teleops = 0;
+  for (const auto& m : r.received()) teleops += m.env.has_command() && m.env.command().has_teleop();
+  EXPECT_GE(teleops, 1);
+}
+
+TEST(Program, FailedExpectExitsWithOne) {
+  Program p("script_fail");
+  const auto script = p.file("s.txt", "echo start\nexpect robots >= 1 within 0.2\necho still runs\n");
+  p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--script", script.string()});
+  EXPECT_EQ(p.wait(), 1);
+  const auto out = p.out();
+  EXPECT_HAS(out, "EXPECT FAILED (line 2): robots = 0, wanted >= 1 within 0.2 s");
+  EXPECT_HAS(out, "still runs");
+}
+
+TEST(Program, CommandErrorExitsWithOne) {
+  Program p("script_error");
+  const auto script = p.file("s.txt", "drvie 1 0\n");
+  p.start({"--config", kConfig, "--port", "0", "--bind", "127.0.0.1", "--script", script.string()});
+  EXPECT_EQ(p.wait(), 1);
+  EXPECT_HAS(p.out(), "unknown command 'drvie' (try 'help')");
+}
+
+TEST(Program, PipedStdinRunsLikeAScript) {
+  Program p("stdin");
+  p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0"}, "echo hi\nexpect robots == 0\n");
+  EXPECT_EQ(p.wait(), 0) << p.out() << p.err();
+  EXPECT_HAS(p.out(), "[1] echo hi");
+  EXPECT_HAS(p.out(), "expect ok (line 2): robots = 0");
+}
+
+TEST(Program, BadConfigIsOneLineAndExitTwo) {
+  Program p("bad_config");
+  const auto cfg = p.file("server.yaml", "port: 7600\nsession_timeout_s: -1\n");
+  p.start({"--config", cfg.string(), "--port", "0"});
+  EXPECT_EQ(p.wait(), 2);
+  const auto err = p.err();
+  EXPECT_HAS(err, cfg.string() + ": session_timeout_s: -1 is out of range");
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
+TEST(Program, BadFlagExitsTwoAndHelpExitsZero) {
+  Program bad("bad_flag");
+  bad.start({"--porrt", "1"});
+  EXPECT_EQ(bad.wait(), 2);
+  EXPECT_HAS(bad.err(), "unknown flag '--porrt'");
+  Program help("help");
+  help.start({"--help"});
+  EXPECT_EQ(help.wait(), 0);
+  EXPECT_HAS(help.out(), "--no-console");
+}
+
+TEST(Program, NoConsoleServesUntilSigterm) {
+  Program p("no_console");
+  const auto port_file = p.path("port");
+  p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--port-file", port_file.string(),
+           "--no-console"});
+  const uint16_t port = p.waitPort(port_file);
+  ASSERT_GT(port, 0);
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(20);
+  std::this_thread::sleep_for(200ms);
+  p.signal(SIGTERM);
+  EXPECT_EQ(p.wait(3000ms), 0);
+  r.stopPump();
+  EXPECT_TRUE(r.waitClosed(1000ms));
+}
+
+TEST(Program, SigintInterruptsAScript) {
+  Program p("sigint");
+  const auto script = p.file("s.txt", "wait 30\n");
+  const auto port_file = p.path("port");
+  p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--port-file", port_file.string(), "--script",
+           script.string()});
+  ASSERT_GT(p.waitPort(port_file), 0);
+  std::this_thread::sleep_for(100ms);
+  const auto t0 = Clock::now();
+  p.signal(SIGINT);
+  EXPECT_EQ(p.wait(3000ms), 1);
+  EXPECT_LT(Clock::now() - t0, 2s);
+  EXPECT_HAS(p.out(), "interrupted");
+}
