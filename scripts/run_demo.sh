@@ -58,7 +58,8 @@ ARGS=(--config config/server.yaml --bind 127.0.0.1 --port "$PORT" --port-file "$
 status=0
 if [ "$MODE" = interactive ]; then
   echo "demo: the script runs first; then the console is yours (try 'help', 'teleop', 'quit')"
-  "$BIN/pc_server" "${ARGS[@]}" --interactive 2>"$OUT/pc_server.err" | tee "$OUT/pc_server.out" || status=$?
+  # Straight to the terminal (no tee), so the console has its live status line.
+  "$BIN/pc_server" "${ARGS[@]}" --interactive 2>"$OUT/pc_server.err" || status=$?
 else
   "$BIN/pc_server" "${ARGS[@]}" 2>"$OUT/pc_server.err" | tee "$OUT/pc_server.out" || status=$?
 fi
@@ -75,7 +76,7 @@ awk -F, '$1=="T"{ if(!n){x0=$4;y0=$5;t0=$6;n=1} x=$4;y=$5;t=$6 }
   END{ if(!n) exit; dx=x-x0; dy=y-y0; c=cos(t0); s=sin(t0);
        d=t-t0; while(d>3.14159265)d-=6.2831853; while(d<-3.14159265)d+=6.2831853;
        printf "ground truth, relative to the start pose: x=%.3f m  y=%.3f m  theta=%.3f rad\n", c*dx+s*dy, -s*dx+c*dy, d }' "$OUT/truth.csv"
-LAST=$(grep -E 'x [-+]?[0-9]' "$OUT/pc_server.out" | tail -n 1 || true)
+LAST=$(grep -E 'x [-+]?[0-9]' "$OUT/pc_server.out" 2>/dev/null | tail -n 1 || true)
 [ -n "$LAST" ] && echo "last telemetry status line:               $LAST"
 if [ "$status" -eq 0 ]; then echo "demo: all console checks passed"; else echo "demo: console checks FAILED (exit $status)"; fi
 exit "$status"
