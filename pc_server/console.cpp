@@ -1,5 +1,7 @@
 #include "pc_server/console.hpp"
 
+#include "shared/net/robot_id.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -255,7 +257,7 @@ bool Console::cmdRobots(const Args& args, const std::string&, int) {
 
 bool Console::cmdSelect(const Args& args, const std::string&, int) {
   if (args.size() != 1) return fail("select", "needs one robot id: select <robot>");
-  if (!validRobotId(args[0])) return fail("select", "'" + args[0] + "' is not a valid robot id ([A-Za-z0-9_-]{1,64})");
+  if (!net::validRobotId(args[0])) return fail("select", "'" + args[0] + "' is not a valid robot id ([A-Za-z0-9_-]{1,64})");
   selected_ = args[0];
   const auto snap = registry_.snapshot(selected_, monoNowNs());
   out_ << "selected " << selected_ << (snap && snap->connected ? "" : " (not connected yet)") << "\n";

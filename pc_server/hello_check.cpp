@@ -3,20 +3,15 @@
 #include <algorithm>
 
 #include "shared/net/link_version.hpp"
+#include "shared/net/robot_id.hpp"
 
 namespace inspect::server {
-
-bool validRobotId(const std::string& id) {
-  return !id.empty() && id.size() <= 64 && std::all_of(id.begin(), id.end(), [](char c) {
-           return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
-         });
-}
 
 std::optional<std::string> helloRejection(const v1::Hello& hello) {
   if (hello.protocol_version() != net::kProtocolVersion)
     return "protocol version mismatch: robot speaks " + std::to_string(hello.protocol_version()) +
            ", server speaks " + std::to_string(net::kProtocolVersion);
-  if (!validRobotId(hello.robot_id())) {
+  if (!net::validRobotId(hello.robot_id())) {
     std::string shown = hello.robot_id().substr(0, 80);
     std::replace_if(shown.begin(), shown.end(), [](char c) { return c < 0x20 || c > 0x7e; }, '?');
     return "invalid robot id '" + shown + "' (must be 1-64 characters of A-Z a-z 0-9 _ -)";

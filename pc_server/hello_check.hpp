@@ -7,9 +7,6 @@
 
 namespace inspect::server {
 
-/// True for ids of 1 to 64 characters from [A-Za-z0-9_-].
-bool validRobotId(const std::string& id);
-
 /// Why `hello` is refused, or nullopt when it is accepted.
 std::optional<std::string> helloRejection(const v1::Hello& hello);
 

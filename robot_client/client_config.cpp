@@ -1,14 +1,13 @@
 #include "robot_client/client_config.hpp"
 
+#include "shared/net/robot_id.hpp"
+
 #include <algorithm>
 #include <cctype>
 
 namespace inspect::client {
 
-bool validRobotId(const std::string& id) {
-  return !id.empty() && id.size() <= 64 &&
-         std::all_of(id.begin(), id.end(), [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-'; });
-}
+bool validRobotId(const std::string& id) { return net::validRobotId(id); }
 
 ClientConfig loadClientConfig(const config::ConfigNode& root) {
   ClientConfig c;

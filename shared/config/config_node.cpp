@@ -10,6 +10,7 @@ namespace inspect::config {
 namespace {
 std::string fmtNum(double v) {
   std::ostringstream os;
+  os.precision(12);  // ranges like [1024, 67108864] print exactly
   os << v;
   return os.str();
 }
