@@ -10,6 +10,9 @@ PACKAGES=(
   libyaml-cpp-dev
   libeigen3-dev
   libgtest-dev libgmock-dev
+  nlohmann-json3-dev
+  fuzzylite libfuzzylite-dev
+  gnuplot-nox
 )
 
 missing=()
