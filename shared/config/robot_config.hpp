@@ -29,7 +29,7 @@ struct RobotLimits {
 
 /// Hub motor + driver as a first-order plant (used by the simulator and the tuner).
 struct MotorModel {
-  double time_constant_s = 0.10;
+  double time_constant_s = 0.20;
   double speed_noise_m_s = 0.002;    // encoder speed error (paper: +-0.002 m/s)
   double heading_noise_rad = 0.002;  // heading sensor error (paper: +-0.002 rad)
 };

@@ -81,9 +81,9 @@ TEST(System, ScriptedSquareDriveReachesExpectedPoses) {
   const double turn_s = kPi / 2 / 0.8;
   const double corners[4][3] = {{1, 0, 0}, {1, 1, kPi / 2}, {0, 1, kPi}, {0, 0, -kPi / 2}};
   for (int leg = 0; leg < 4; ++leg) {
-    script << "drive 0.4 0\nwait 2.5\nstop\nwait 1\n";
+    script << "drive 0.4 0\nwait 2.5\nstop\nwait 1.5\n";
     script << "expect x ~ " << corners[leg][0] << " 0.05\nexpect y ~ " << corners[leg][1] << " 0.05\n";
-    script << "drive 0 0.8\nwait " << turn_s << "\nstop\nwait 1\n";
+    script << "drive 0 0.8\nwait " << turn_s << "\nstop\nwait 1.5\n";
   }
   script << "expect x ~ 0 0.05\nexpect y ~ 0 0.05\nexpect theta ~ 0 0.05\nstatus\n";
   ASSERT_TRUE(s.startServer(script.str())) << s.logs();

@@ -136,6 +136,8 @@ struct BadArgsCase {
   const char* message;
 };
 
+inline void PrintTo(const BadArgsCase& c, std::ostream* os) { *os << '"' << c.line << '"'; }
+
 class ConsoleBadArgs : public ConsoleTest, public ::testing::WithParamInterface<BadArgsCase> {};
 
 TEST_P(ConsoleBadArgs, PrintsAClearMessage) {

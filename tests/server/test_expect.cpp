@@ -17,6 +17,8 @@ struct ParseOk {
   double within_s;
 };
 
+inline void PrintTo(const ParseOk& c, std::ostream* os) { *os << '"' << c.line << '"'; }
+
 class ExpectParseOk : public ::testing::TestWithParam<ParseOk> {};
 
 TEST_P(ExpectParseOk, Parses) {
@@ -48,6 +50,8 @@ struct ParseBad {
   const char* line;
   const char* message;
 };
+
+inline void PrintTo(const ParseBad& c, std::ostream* os) { *os << '"' << c.line << '"'; }
 
 class ExpectParseBad : public ::testing::TestWithParam<ParseBad> {};
 

@@ -49,7 +49,7 @@ TEST(RobotPlant, SetpointClampedToWheelLimit) {
   const auto robot = paperRobot();
   const World w;
   const RobotPlant p(robot, w);
-  const PlantState s = run(p, {}, {100.0, -100.0}, 2.0);
+  const PlantState s = run(p, {}, {100.0, -100.0}, 20 * robot.motor.time_constant_s);
   EXPECT_NEAR(s.wheel.left_rad_s, robot.limits.max_wheel_speed_rad_s, 1e-6);
   EXPECT_NEAR(s.wheel.right_rad_s, -robot.limits.max_wheel_speed_rad_s, 1e-6);
   const PlantState n = run(p, {}, {std::nan(""), 1.0}, 1.0);

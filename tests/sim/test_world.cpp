@@ -134,6 +134,8 @@ struct RayCase {
   std::optional<double> expect_m;
 };
 
+inline void PrintTo(const RayCase& c, std::ostream* os) { *os << c.name; }
+
 class RayCast : public ::testing::TestWithParam<RayCase> {};
 
 TEST_P(RayCast, FirstHitDistance) {

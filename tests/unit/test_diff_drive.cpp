@@ -14,6 +14,7 @@ constexpr double kR = 0.2, kL = 0.438;
 struct TwistCase {
   double v, w;
 };
+inline void PrintTo(const TwistCase& c, std::ostream* os) { *os << "v=" << c.v << " w=" << c.w; }
 class DiffDriveRoundTrip : public ::testing::TestWithParam<TwistCase> {};
 
 TEST_P(DiffDriveRoundTrip, TwistToWheelsAndBack) {
