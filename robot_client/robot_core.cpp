@@ -208,13 +208,7 @@ serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, doub
     const double dr = static_cast<int32_t>(static_cast<uint32_t>(f.wheel_disp_0p1mm[1]) -
                                            static_cast<uint32_t>(last_disp_[1])) * 1e-4;
     last_disp_ = f.wheel_disp_0p1mm;
-    // Position from wheel travel, heading from the MCU's heading sensor.
-    const double th = control::wrapAngle((f.heading_0p1mrad - heading0_) * 1e-4);
-    const double mid = pose_.theta_rad + control::wrapAngle(th - pose_.theta_rad) / 2.0;
-    const double ds = (dl + dr) / 2.0;
-    pose_.x_m += ds * std::cos(mid);
-    pose_.y_m += ds * std::sin(mid);
-    pose_.theta_rad = th;
+    pose_ = control::odometryWithHeading(pose_, dl, dr, (f.heading_0p1mrad - heading0_) * 1e-4);
   }
   have_frame_ = true;
   last_frame_s_ = now_s;

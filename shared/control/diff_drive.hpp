@@ -63,3 +63,17 @@ inline Pose2 integrateOdometry(const Pose2& p, double d_left_m, double d_right_m
 }
 
 }  // namespace inspect::control
+
+namespace inspect::control {
+
+/// Dead-reckoning step as the robot runs it: position from the wheels'
+/// travel along the mean of the old and new heading, heading from the
+/// heading sensor (paper: +-0.002 rad, better than wheel-derived yaw).
+inline Pose2 odometryWithHeading(const Pose2& p, double d_left_m, double d_right_m, double heading_rad) {
+  const double th = wrapAngle(heading_rad);
+  const double mid = p.theta_rad + wrapAngle(th - p.theta_rad) / 2.0;
+  const double ds = (d_left_m + d_right_m) / 2.0;
+  return {p.x_m + ds * std::cos(mid), p.y_m + ds * std::sin(mid), th};
+}
+
+}  // namespace inspect::control

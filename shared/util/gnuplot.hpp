@@ -1,0 +1,44 @@
+#pragma once
+// PNG plots through gnuplot (Debian gnuplot-nox): figures are described as
+// data, written as one gnuplot script with inline data blocks, and rendered
+// by the gnuplot program. Used by experiments, scenarios and reports.
+#include <string>
+#include <vector>
+
+namespace inspect::plot {
+
+/// One line or point set.
+struct Series {
+  std::string title;
+  std::vector<double> x;
+  std::vector<double> y;
+  std::string style = "lines";  // gnuplot style: lines, points, linespoints, ...
+  std::string color;            // e.g. "#1f77b4"; empty = gnuplot's default cycle
+  int width = 2;
+  bool dashed = false;
+};
+
+/// A horizontal band shaded between y0 and y1 (e.g. a proxemic zone).
+struct Band {
+  double y0 = 0, y1 = 0;
+  std::string color = "#eeeeee";
+  std::string label;
+};
+
+/// One panel of a figure.
+struct Panel {
+  std::string title;
+  std::string xlabel;
+  std::string ylabel;
+  std::vector<Series> series;
+  std::vector<Band> bands;
+  bool equal_axes = false;  // same scale on x and y (trajectories)
+  std::string key = "top right";
+};
+
+/// Writes `png_path` with the panels stacked vertically. Returns an empty
+/// string on success, else what went wrong (gnuplot missing, its error).
+std::string renderPng(const std::string& png_path, const std::vector<Panel>& panels, int width_px = 900,
+                      int panel_height_px = 450);
+
+}  // namespace inspect::plot
