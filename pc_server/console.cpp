@@ -75,6 +75,15 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "    zeroes the set-point (deadman: 600 ms before the first auto-repeat, 200 ms after).\n"
        "  Both: space (or x, 0) zeroes at once; q or Esc leaves teleop and sends stop.\n",
        &Console::cmdTeleop},
+      {"track", "track circle <radius_m> [speed_m_s] [laps] [controller] | track line <length_m> [speed_m_s] [controller]",
+       "track a reference path from the robot's current pose (Eqs 10-15)",
+       "  circle: radius > 0 turns left (counter-clockwise), < 0 right; speed default 0.5 m/s, laps 1.\n"
+       "  line: straight ahead. controller: fuzzy_pid, pid or direct (default: the robot's config).\n"
+       "  Waits for the Ack; the robot acks again (COMPLETED) when the path is done and goes IDLE.\n"
+       "  Telemetry then carries the reference pose and the errors (expect pos_err, max_pos_err, ...).\n"
+       "  example: track circle 3.5 0.5\n"
+       "  example: track line 4 0.3 pid\n",
+       &Console::cmdTrack},
       {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
        "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
        "  'robot1: no ack within 1 s' (the last two are errors).\n",
@@ -90,8 +99,9 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  within: poll every 20 ms until true or the time runs out (default: check once).\n"
        "  fields of the selected robot: x y theta v w cmd_v cmd_w wheel_l wheel_r mode faults mcu_faults\n"
        "    connected telemetry_hz telemetry_age sensor_hz battery serial_bad_crc serial_frames_ok\n"
+       "    tracking: pos_err ang_err max_pos_err max_ang_err progress ref_x ref_y kp ki kd\n"
        "  and: robots (number of connected robots).\n"
-       "  mode takes IDLE, TELEOP, ESTOP, FAILSAFE; integer fields take 0x.. too.\n"
+       "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE; integer fields take 0x.. too.\n"
        "  examples: expect robots >= 1 within 5\n"
        "            expect x ~ 2.0 0.05 within 10\n"
        "            expect mode == ESTOP within 1\n",
@@ -323,6 +333,49 @@ bool Console::cmdTeleop(const Args& args, const std::string&, int) {
 
 bool Console::simpleCommand(const std::string& name, const Args& args, v1::Command cmd) {
   if (!args.empty()) return fail(name, "takes no arguments");
+  return sendAndReport(name, std::move(cmd));
+}
+
+bool Console::cmdTrack(const Args& args, const std::string&, int) {
+  static const char* kSyntax =
+      "syntax: track circle <radius_m> [speed_m_s] [laps] [controller] | track line <length_m> [speed_m_s] [controller]";
+  if (args.size() < 2) return fail("track", kSyntax);
+  std::vector<double> nums;
+  std::string controller;
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    if (const auto v = parseNumber(args[i]); v && controller.empty()) {
+      nums.push_back(*v);
+    } else if (controller.empty() && (args[i] == "fuzzy_pid" || args[i] == "pid" || args[i] == "direct")) {
+      controller = args[i];
+    } else {
+      return fail("track", "'" + args[i] + "' is neither a number nor a controller (fuzzy_pid, pid, direct)");
+    }
+  }
+  v1::Command c;
+  auto* t = c.mutable_track();
+  t->set_controller(controller);
+  const double speed = nums.size() > 1 ? nums[1] : 0.5;
+  if (!(speed > 0) || speed > 1.0) return fail("track", "speed " + fmtShort(speed) + " m/s is outside (0, 1]");
+  if (args[0] == "circle") {
+    if (nums.empty() || nums.size() > 3) return fail("track", kSyntax);
+    if (std::abs(nums[0]) < 0.1 || std::abs(nums[0]) > 100) return fail("track", "radius must be 0.1 to 100 m (negative turns right)");
+    const double laps = nums.size() > 2 ? nums[2] : 1.0;
+    if (!(laps > 0) || laps > 100) return fail("track", "laps must be in (0, 100]");
+    t->mutable_circle()->set_radius_m(nums[0]);
+    t->mutable_circle()->set_speed_m_s(speed);
+    t->mutable_circle()->set_laps(laps);
+  } else if (args[0] == "line") {
+    if (nums.empty() || nums.size() > 2) return fail("track", kSyntax);
+    if (!(nums[0] > 0) || nums[0] > 1000) return fail("track", "length must be in (0, 1000] m");
+    t->mutable_line()->set_length_m(nums[0]);
+    t->mutable_line()->set_speed_m_s(speed);
+  } else {
+    return fail("track", "unknown path '" + args[0] + "' (circle or line)");
+  }
+  return sendAndReport("track", std::move(c));
+}
+
+bool Console::sendAndReport(const std::string& name, v1::Command cmd) {
   const auto robot = connectedRobot(name);
   if (!robot) return false;
   const uint64_t id = sink_.sendCommand(*robot, std::move(cmd));

@@ -82,6 +82,7 @@ class Console {
   bool cmdStatus(const Args& args, const std::string& rest, int line_no);
   bool cmdDrive(const Args& args, const std::string& rest, int line_no);
   bool cmdTeleop(const Args& args, const std::string& rest, int line_no);
+  bool cmdTrack(const Args& args, const std::string& rest, int line_no);
   bool cmdStop(const Args& args, const std::string& rest, int line_no);
   bool cmdEstop(const Args& args, const std::string& rest, int line_no);
   bool cmdResume(const Args& args, const std::string& rest, int line_no);
@@ -96,6 +97,8 @@ class Console {
   std::optional<std::string> connectedRobot(const std::string& cmd);
   /// Sends a Stop/EStop/Resume and reports its Ack.
   bool simpleCommand(const std::string& name, const Args& args, v1::Command cmd);
+  /// Sends `cmd` to the selected robot, waits for its Ack and prints the answer.
+  bool sendAndReport(const std::string& name, v1::Command cmd);
   /// Waits up to ack_timeout_s for the Ack of `command_id`; nullopt when none came.
   std::optional<v1::Ack> waitAck(const std::string& robot_id, uint64_t command_id);
   /// Sleeps up to `seconds` while pumping; false if the server is stopping.

@@ -44,6 +44,16 @@ const std::vector<FieldDef>& fieldDefs() {
        [](const S& s) { return static_cast<double>(s.telemetry.serial().bad_crc()); }},
       {"serial_frames_ok", true, true, true,
        [](const S& s) { return static_cast<double>(s.telemetry.serial().frames_ok()); }},
+      {"pos_err", false, true, true, [](const S& s) { return s.telemetry.position_error_m(); }},
+      {"ang_err", false, true, true, [](const S& s) { return s.telemetry.angle_error_rad(); }},
+      {"max_pos_err", false, true, true, [](const S& s) { return s.telemetry.track_max_position_error_m(); }},
+      {"max_ang_err", false, true, true, [](const S& s) { return s.telemetry.track_max_angle_error_rad(); }},
+      {"progress", false, true, true, [](const S& s) { return s.telemetry.track_progress(); }},
+      {"ref_x", false, true, true, [](const S& s) { return s.telemetry.reference().x_m(); }},
+      {"ref_y", false, true, true, [](const S& s) { return s.telemetry.reference().y_m(); }},
+      {"kp", false, true, true, [](const S& s) { return s.telemetry.kp(); }},
+      {"ki", false, true, true, [](const S& s) { return s.telemetry.ki(); }},
+      {"kd", false, true, true, [](const S& s) { return s.telemetry.kd(); }},
       {"robots", true, false, false, nullptr},
   };
   return kDefs;
@@ -112,7 +122,7 @@ std::variant<ExpectSpec, std::string> parseExpect(const std::vector<std::string>
     s.value = static_cast<double>(*i);  // e.g. faults == 0x4
   } else {
     return "expect: '" + args[2] + "' is not a number" +
-           (s.field == "mode" ? " or a mode (IDLE, TELEOP, ESTOP, FAILSAFE)" : "");
+           (s.field == "mode" ? " or a mode (IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE)" : "");
   }
   std::size_t i = 3;
   if (s.op == ExpectOp::kNear) {

@@ -28,6 +28,9 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
   s += " | " + modeName(t.mode());
   s += " | v " + fmtSigned(t.v_m_s()) + " w " + fmtSigned(t.w_rad_s());
   s += " | x " + fmtFixed(t.pose().x_m()) + " y " + fmtFixed(t.pose().y_m()) + " th " + fmtSigned(t.pose().theta_rad());
+  if (t.mode() == v1::TRACKING)
+    s += " | " + t.track_controller() + " " + fmtFixed(100.0 * t.track_progress(), 0) + "% err " +
+         fmtFixed(t.position_error_m(), 3) + " m " + fmtFixed(t.angle_error_rad(), 3) + " rad kp " + fmtFixed(t.kp(), 1);
   if (t.ultrasonic_m_size() > 0) {
     s += " | us";
     for (double r : t.ultrasonic_m()) s += r < 0 ? " --" : " " + fmtFixed(r);

@@ -12,6 +12,7 @@
 
 #include "robot_client/client_config.hpp"
 #include "robot_client/robot_app.hpp"
+#include "shared/config/control_config.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/util/log.hpp"
 
@@ -25,6 +26,7 @@ Runs on the robot's Raspberry Pi: talks to the MCU over serial, runs the
 options:
   --config FILE        client settings (default: config/client.yaml if present)
   --robot-config FILE  robot geometry and limits (default: config/robot.yaml if present)
+  --control-config FILE  tracking controllers (default: config/control.yaml if present)
   --serial PATH        serial device of the MCU (overrides serial.device),
                        e.g. /dev/serial0, or the pty printed by mcu_sim
   --server HOST:PORT   pc_server address (overrides server.host/port)
@@ -52,6 +54,7 @@ int main(int argc, char** argv) {
   using namespace inspect;
   std::string config_path = fileExists("config/client.yaml") ? "config/client.yaml" : "";
   std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
+  std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
   std::string serial_dev, server, id, cmd_log;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -69,6 +72,8 @@ int main(int argc, char** argv) {
       config_path = value();
     } else if (a == "--robot-config") {
       robot_path = value();
+    } else if (a == "--control-config") {
+      control_path = value();
     } else if (a == "--serial") {
       serial_dev = value();
     } else if (a == "--server") {
@@ -102,8 +107,13 @@ int main(int argc, char** argv) {
       cfg.server_port = static_cast<int>(port);
     }
 
+    config::ControlConfig control;
+    if (!control_path.empty()) control = config::loadControlConfigFile(control_path);
+    config::applyRobot(control, robot);
+    const auto scheduler = config::loadScheduler(control);
+
     boost::asio::io_context io(1);
-    client::RobotApp app(io, cfg, robot, cmd_log);
+    client::RobotApp app(io, cfg, robot, control, scheduler, cmd_log);
     boost::asio::signal_set signals(io, SIGINT, SIGTERM);
     signals.async_wait([&](const boost::system::error_code&, int sig) {
       log::info("main", "signal ", sig, ": stopping");

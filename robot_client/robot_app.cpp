@@ -18,8 +18,9 @@ steady_clock::duration secs(double s) {
 }  // namespace
 
 RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::RobotConfig& robot,
+                   const config::ControlConfig& control, std::shared_ptr<control::FuzzyGainScheduler> scheduler,
                    const std::string& cmd_log_path)
-    : io_(io), cfg_(cfg), core_(robot, cfg.safety),
+    : io_(io), cfg_(cfg), core_(robot, cfg.safety, control, std::move(scheduler)),
       serial_(io, cfg.serial_device, cfg.baud, cfg.serial_reopen_period_s), link_(io, cfg), tick_timer_(io),
       telemetry_timer_(io), mcu_hb_timer_(io), t0_ns_(monoNowNs()) {
   if (!cmd_log_path.empty()) {
@@ -98,6 +99,11 @@ void RobotApp::onServerMessage(const v1::Envelope& env) {
 }
 
 void RobotApp::flushEvents() {
+  for (auto& a : core_.takeAcks()) {
+    v1::Envelope env;
+    *env.mutable_ack() = a;
+    link_.send(env);
+  }
   for (auto& e : core_.takeEvents()) {
     log::info("core", v1::Event::Kind_Name(e.kind), ": ", e.text);
     v1::Envelope env;

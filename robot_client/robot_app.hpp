@@ -12,6 +12,7 @@
 #include "robot_client/robot_core.hpp"
 #include "robot_client/serial_link.hpp"
 #include "robot_client/server_link.hpp"
+#include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
 
 namespace inspect::client {
@@ -19,6 +20,7 @@ namespace inspect::client {
 class RobotApp {
  public:
   RobotApp(boost::asio::io_context& io, const ClientConfig& cfg, const config::RobotConfig& robot,
+           const config::ControlConfig& control, std::shared_ptr<control::FuzzyGainScheduler> scheduler,
            const std::string& cmd_log_path);
   ~RobotApp();
   void start();

@@ -31,9 +31,69 @@ double slew(double cur, double target, double step) {
 
 }  // namespace
 
-RobotCore::RobotCore(const config::RobotConfig& robot, const SafetyParams& safety)
-    : robot_(robot), safety_(safety) {
+RobotCore::RobotCore(const config::RobotConfig& robot, const SafetyParams& safety,
+                     const config::ControlConfig& control, std::shared_ptr<control::FuzzyGainScheduler> scheduler)
+    : robot_(robot), safety_(safety), control_(control), scheduler_(std::move(scheduler)) {
+  config::applyRobot(control_, robot_);
   events_.reserve(16);
+}
+
+v1::Ack RobotCore::startTrack(const v1::Command& cmd) {
+  v1::Ack ack;
+  ack.set_command_id(cmd.id());
+  auto reject = [&](const std::string& why) {
+    ack.set_status(v1::Ack::REJECTED);
+    ack.set_reason(why);
+    return ack;
+  };
+  const auto& t = cmd.track();
+  control::TrackerParams params = control_.tracker;
+  const std::string& c = t.controller();
+  if (c == "fuzzy_pid") params.wheel_control = control::WheelControl::kFuzzyPid;
+  else if (c == "pid") params.wheel_control = control::WheelControl::kPid;
+  else if (c == "direct") params.wheel_control = control::WheelControl::kDirect;
+  else if (!c.empty()) return reject("unknown controller '" + c + "' (fuzzy_pid, pid or direct)");
+  if (params.wheel_control == control::WheelControl::kFuzzyPid && !scheduler_)
+    return reject("no fuzzy-PID controller loaded on the robot");
+  std::unique_ptr<control::ReferencePath> path;
+  try {
+    switch (t.path_case()) {
+      case v1::Track::kCircle:
+        path = control::makeCircle(pose_, t.circle().radius_m(), t.circle().speed_m_s(),
+                                   t.circle().laps() > 0 ? t.circle().laps() : 1.0);
+        break;
+      case v1::Track::kLine: path = control::makeLine(pose_, t.line().length_m(), t.line().speed_m_s()); break;
+      case v1::Track::kWaypoints: {
+        std::vector<control::TimedWaypoint> w{{0.0, pose_.x_m, pose_.y_m}};
+        const double c0 = std::cos(pose_.theta_rad), s0 = std::sin(pose_.theta_rad);
+        for (const auto& p : t.waypoints().points())
+          w.push_back({p.t_s(), pose_.x_m + c0 * p.x_m() - s0 * p.y_m(), pose_.y_m + s0 * p.x_m() + c0 * p.y_m()});
+        path = control::makeTimedWaypoints(w);
+        break;
+      }
+      case v1::Track::PATH_NOT_SET: return reject("no path given");
+    }
+  } catch (const std::invalid_argument& e) {
+    return reject(e.what());
+  }
+  if (path->at(0).speed_m_s > robot_.limits.max_v_m_s)
+    return reject("speed above the robot's limit of " + std::to_string(robot_.limits.max_v_m_s) + " m/s");
+  const std::string what = path->describe();
+  tracker_ = std::make_unique<control::TrajectoryTracker>(std::move(path), params, scheduler_);
+  track_command_id_ = cmd.id();
+  track_controller_ = control::toString(params.wheel_control);
+  track_out_ = {};
+  track_max_pos_m_ = track_max_ang_rad_ = 0.0;
+  setpoint_ = {};
+  setpoint_time_s_ = -1.0;
+  setMode(v1::TRACKING, "tracking " + what + " with " + track_controller_);
+  ack.set_status(v1::Ack::ACCEPTED);
+  return ack;
+}
+
+void RobotCore::endTrack() {
+  tracker_.reset();
+  track_command_id_ = 0;
 }
 
 void RobotCore::setMode(v1::Mode m, const std::string& why) {
@@ -57,6 +117,7 @@ void RobotCore::clear(uint32_t fault, const std::string& why) {
 void RobotCore::latchFailsafe(const std::string& why) {
   setpoint_ = {};
   setpoint_time_s_ = -1.0;
+  endTrack();
   if (mode_ == v1::ESTOP || mode_ == v1::FAILSAFE) return;
   latch_reason_ = why;
   setMode(v1::FAILSAFE, why + "; needs resume");
@@ -120,20 +181,30 @@ v1::Ack RobotCore::onCommand(const v1::Command& cmd, double now_s) {
                    std::clamp(w, -robot_.limits.max_w_rad_s, robot_.limits.max_w_rad_s)};
       setpoint_time_s_ = now_s;
       clear(v1::FAULT_COMMAND_STALE, "");
+      endTrack();  // the operator takes over
       setMode(v1::TELEOP, "teleop set-point");
       ack.set_status(v1::Ack::ACCEPTED);
       if (setpoint_.v_m_s != v || setpoint_.w_rad_s != w) ack.set_reason("clamped to the robot's limits");
       return ack;
     }
+    case v1::Command::kTrack:
+      if (mode_ == v1::ESTOP) return reject("e-stop latched: resume first");
+      if (mode_ == v1::FAILSAFE) return reject("failsafe latched (" + latch_reason_ + "): resume first");
+      if (faults_ & v1::FAULT_SENSOR_STALE) return reject("sensor frames stale");
+      if (faults_ & v1::FAULT_SERIAL_DOWN) return reject("serial device down");
+      if (!have_frame_) return reject("no sensor frame yet: the pose is unknown");
+      return startTrack(cmd);
     case v1::Command::kStop:
       setpoint_ = {};
       setpoint_time_s_ = -1.0;
-      if (mode_ == v1::TELEOP) setMode(v1::IDLE, "stop");
+      endTrack();
+      if (mode_ == v1::TELEOP || mode_ == v1::TRACKING) setMode(v1::IDLE, "stop");
       ack.set_status(v1::Ack::ACCEPTED);
       return ack;
     case v1::Command::kEstop:
       setpoint_ = {};
       setpoint_time_s_ = -1.0;
+      endTrack();
       latch_reason_ = "e-stop";
       setMode(v1::ESTOP, "e-stop from operator; needs resume");
       ack.set_status(v1::Ack::ACCEPTED);
@@ -173,6 +244,30 @@ void RobotCore::checkTimeouts(double now_s) {
 
 serial::WheelCommand RobotCore::computeCommand(double dt_s) {
   const bool latched = mode_ == v1::ESTOP || mode_ == v1::FAILSAFE;
+  if (mode_ == v1::TRACKING && tracker_ && !latched && !(faults_ & v1::FAULT_SENSOR_STALE)) {
+    if (dt_s > 0.0) {
+      track_out_ = tracker_->step(pose_, measured_, 1.0, dt_s);
+      track_max_pos_m_ = std::max(track_max_pos_m_, track_out_.error.position_m());
+      track_max_ang_rad_ = std::max(track_max_ang_rad_, std::abs(track_out_.error.theta_rad));
+      track_gains_ = tracker_->lastGains(0);
+      cmd_wheels_ = track_out_.command;  // the tracker's own loop shapes the command
+      if (track_out_.done) {
+        v1::Ack done;
+        done.set_command_id(track_command_id_);
+        done.set_status(v1::Ack::COMPLETED);
+        acks_.push_back(done);
+        endTrack();
+        cmd_wheels_ = {};
+        setMode(v1::IDLE, "path completed");
+      }
+    }
+    cmd_twist_ = control::twistFromWheels(cmd_wheels_, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
+    serial::WheelCommand c;
+    c.left_mrad_s = toMrad(cmd_wheels_.left_rad_s);
+    c.right_mrad_s = toMrad(cmd_wheels_.right_rad_s);
+    c.flags = serial::WheelCommand::kEnable;
+    return c;
+  }
   control::Twist target = mode_ == v1::TELEOP ? setpoint_ : control::Twist{};
   target = control::limitTwist(target, robot_.geometry.wheel_radius_m, robot_.geometry.track_m,
                                robot_.limits.max_wheel_speed_rad_s);
@@ -277,6 +372,27 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
   s->set_frames_tx(frames_tx_);
   t.set_sensor_rate_hz(have_frame_ ? sensor_rate_hz_ : 0.0);
   t.set_last_command_id(last_command_id_);
+  auto* ref = t.mutable_reference();
+  ref->set_x_m(track_out_.ref.pose.x_m);
+  ref->set_y_m(track_out_.ref.pose.y_m);
+  ref->set_theta_rad(track_out_.ref.pose.theta_rad);
+  t.set_position_error_m(track_out_.error.position_m());
+  t.set_angle_error_rad(std::abs(track_out_.error.theta_rad));
+  t.set_track_progress(tracker_ && tracker_->path().length_m() > 0
+                           ? tracker_->progress().s_m / tracker_->path().length_m()
+                           : (track_out_.done ? 1.0 : 0.0));
+  t.set_track_max_position_error_m(track_max_pos_m_);
+  t.set_track_max_angle_error_rad(track_max_ang_rad_);
+  t.set_kp(track_gains_.kp);
+  t.set_ki(track_gains_.ki);
+  t.set_kd(track_gains_.kd);
+  t.set_track_controller(tracker_ ? track_controller_ : std::string());
+}
+
+std::vector<v1::Ack> RobotCore::takeAcks() {
+  std::vector<v1::Ack> out;
+  out.swap(acks_);
+  return out;
 }
 
 std::vector<CoreEvent> RobotCore::takeEvents() {

@@ -9,7 +9,9 @@
 
 #include "inspect/v1/link.pb.h"
 #include "robot_client/client_config.hpp"
+#include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
+#include "shared/control/trajectory_tracker.hpp"
 #include "shared/control/diff_drive.hpp"
 #include "shared/serial/frame_codec.hpp"
 
@@ -23,7 +25,10 @@ struct CoreEvent {
 
 class RobotCore {
  public:
-  RobotCore(const config::RobotConfig& robot, const SafetyParams& safety);
+  /// `scheduler` may be null: tracking with the fuzzy-PID is then refused.
+  RobotCore(const config::RobotConfig& robot, const SafetyParams& safety,
+            const config::ControlConfig& control = {},
+            std::shared_ptr<control::FuzzyGainScheduler> scheduler = nullptr);
 
   /// A valid sensor frame arrived (100 Hz): updates the estimate, runs the
   /// tick, returns the wheel command to send.
@@ -51,6 +56,8 @@ class RobotCore {
   void fillTelemetry(v1::Telemetry& t, double now_s) const;
   /// Moves out the events raised since the last call.
   std::vector<CoreEvent> takeEvents();
+  /// Moves out Acks the core produced on its own (COMPLETED of a track run).
+  std::vector<v1::Ack> takeAcks();
 
   v1::Mode mode() const { return mode_; }
   uint32_t faults() const { return faults_; }
@@ -58,7 +65,9 @@ class RobotCore {
   control::Twist commandedTwist() const { return cmd_twist_; }
 
  private:
-  bool moving() const { return mode_ == v1::TELEOP; }
+  bool moving() const { return mode_ == v1::TELEOP || mode_ == v1::TRACKING; }
+  v1::Ack startTrack(const v1::Command& cmd);
+  void endTrack();
   void setMode(v1::Mode m, const std::string& why);
   void raise(uint32_t fault, const std::string& why);
   void clear(uint32_t fault, const std::string& why);
@@ -103,6 +112,18 @@ class RobotCore {
   uint64_t frames_tx_ = 0;
 
   std::vector<CoreEvent> events_;
+  std::vector<v1::Ack> acks_;
+
+  // Trajectory tracking.
+  config::ControlConfig control_;
+  std::shared_ptr<control::FuzzyGainScheduler> scheduler_;
+  std::unique_ptr<control::TrajectoryTracker> tracker_;
+  uint64_t track_command_id_ = 0;
+  std::string track_controller_;
+  control::TrackerOutput track_out_;
+  double track_max_pos_m_ = 0.0;
+  double track_max_ang_rad_ = 0.0;
+  control::PidGains track_gains_;
 };
 
 }  // namespace inspect::client

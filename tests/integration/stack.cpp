@@ -70,15 +70,16 @@ bool Stack::startServer(const std::string& script, const std::vector<std::string
 }
 
 RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
-                              const std::vector<std::string>& relay_args) {
+                              const std::vector<std::string>& relay_args, const std::vector<std::string>& sim_args) {
   auto r = std::make_unique<RobotProcs>();
   r->id = id;
   r->truth = dir_ / (id + "-truth.csv");
   r->cmd_log = dir_ / (id + "-cmds.csv");
   const std::string sim_pty = dir_ / (id + "-mcu");
-  r->sim = Process::spawn({binPath("mcu_sim"), "--world", srcPath("config/worlds/" + world), "--robot",
-                           srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth},
-                          dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
+  std::vector<std::string> sim_argv = {binPath("mcu_sim"), "--world", srcPath("config/worlds/" + world), "--robot",
+                                       srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
+  sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
+  r->sim = Process::spawn(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
   waitUntil([&] { return exists(sim_pty); }, 10.0);
   r->pty = sim_pty;
   if (!relay_args.empty()) {
@@ -89,7 +90,7 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     waitUntil([&] { return exists(r->pty); }, 10.0);
   }
   r->client = Process::spawn({binPath("robot_client"), "--config", srcPath("config/client.yaml"), "--robot-config",
-                              srcPath("config/robot.yaml"), "--serial", r->pty, "--server",
+                              srcPath("config/robot.yaml"), "--control-config", srcPath("config/control.yaml"), "--serial", r->pty, "--server",
                               "127.0.0.1:" + std::to_string(port_), "--id", id, "--cmd-log", r->cmd_log},
                              dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
   robots_.push_back(std::move(r));

@@ -61,7 +61,8 @@ class Stack {
   /// Starts mcu_sim (world file under config/worlds) and a robot_client.
   /// `relay_args` non-empty puts tests' serial_relay between them.
   RobotProcs& startRobot(const std::string& id, const std::string& world = "square_room.yaml",
-                         const std::vector<std::string>& relay_args = {});
+                         const std::vector<std::string>& relay_args = {},
+                         const std::vector<std::string>& sim_args = {});
   Process& server() { return server_; }
   int port() const { return port_; }
   std::string serverOutput() const { return readFile(dir_ / "server.out"); }

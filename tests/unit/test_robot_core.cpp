@@ -184,3 +184,67 @@ TEST(RobotCore, TelemetryReportsState) {
   EXPECT_EQ(t.last_command_id(), 7u);
   EXPECT_NEAR(t.cmd_v_m_s(), 0.2, 0.01);
 }
+
+namespace {
+v1::Command trackLine(uint64_t id, double len, double v, const std::string& controller) {
+  v1::Command c;
+  c.set_id(id);
+  c.mutable_track()->mutable_line()->set_length_m(len);
+  c.mutable_track()->mutable_line()->set_speed_m_s(v);
+  c.mutable_track()->set_controller(controller);
+  return c;
+}
+}  // namespace
+
+TEST(RobotCore, TrackingRunsAPathAndAcksCompletion) {
+  Harness h;
+  h.run(0.05);
+  // "direct": this harness's ideal MCU has no lag, on which a PID with the paper's gains oscillates.
+  const auto ack = h.core.onCommand(trackLine(1, 0.5, 0.5, "direct"), h.t);
+  ASSERT_EQ(ack.status(), v1::Ack::ACCEPTED) << ack.reason();
+  EXPECT_EQ(h.core.mode(), v1::TRACKING);
+  std::vector<v1::Ack> acks;
+  for (int i = 0; i < 300 && acks.empty(); ++i) {
+    h.step();
+    acks = h.core.takeAcks();
+  }
+  ASSERT_EQ(acks.size(), 1u);
+  EXPECT_EQ(acks[0].command_id(), 1u);
+  EXPECT_EQ(acks[0].status(), v1::Ack::COMPLETED);
+  EXPECT_EQ(h.core.mode(), v1::IDLE);
+  EXPECT_NEAR(h.core.pose().x_m, 0.5, 0.05);
+  v1::Telemetry t;
+  h.core.fillTelemetry(t, h.t);
+  EXPECT_DOUBLE_EQ(t.track_progress(), 1.0);
+  EXPECT_GT(t.track_max_position_error_m(), 0.0);
+}
+
+TEST(RobotCore, TrackingIsRefusedOrEndedSafely) {
+  Harness h;
+  h.run(0.05);
+  EXPECT_EQ(h.core.onCommand(trackLine(1, 2, 0.5, "fuzzy_pid"), h.t).status(), v1::Ack::REJECTED)
+      << "no fuzzy-PID scheduler loaded in this core";
+  EXPECT_EQ(h.core.onCommand(trackLine(2, 2, 0.5, "bogus"), h.t).status(), v1::Ack::REJECTED);
+  EXPECT_EQ(h.core.onCommand(trackLine(3, -1, 0.5, "pid"), h.t).status(), v1::Ack::REJECTED);
+  EXPECT_EQ(h.core.onCommand(trackLine(4, 2, 5.0, "pid"), h.t).status(), v1::Ack::REJECTED) << "above max speed";
+  // Teleop takes over from tracking; stop ends tracking; e-stop refuses it.
+  ASSERT_EQ(h.core.onCommand(trackLine(5, 2, 0.5, "direct"), h.t).status(), v1::Ack::ACCEPTED);
+  h.run(0.2);
+  h.core.onCommand(teleop(6, 0.1, 0), h.t);
+  EXPECT_EQ(h.core.mode(), v1::TELEOP);
+  ASSERT_EQ(h.core.onCommand(trackLine(7, 2, 0.5, "direct"), h.t).status(), v1::Ack::ACCEPTED);
+  h.core.onCommand(simple(8, 's'), h.t);
+  EXPECT_EQ(h.core.mode(), v1::IDLE);
+  h.core.onCommand(simple(9, 'e'), h.t);
+  EXPECT_EQ(h.core.onCommand(trackLine(10, 2, 0.5, "direct"), h.t).status(), v1::Ack::REJECTED);
+}
+
+TEST(RobotCore, LinkLossDuringTrackingLatchesFailsafe) {
+  Harness h;
+  h.run(0.05);
+  ASSERT_EQ(h.core.onCommand(trackLine(1, 5, 0.5, "direct"), h.t).status(), v1::Ack::ACCEPTED);
+  h.run(0.5);
+  h.core.onLinkDown(h.t, "closed");
+  EXPECT_EQ(h.core.mode(), v1::FAILSAFE);
+  EXPECT_EQ(h.core.commandNow().left_mrad_s, 0);
+}
