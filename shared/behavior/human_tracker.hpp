@@ -1,0 +1,112 @@
+#pragma once
+// People from the 4 ultrasonic sensors alone (2 front, 1 left, 1 right).
+//
+// Each valid echo becomes a point in the odometry frame (beam centre at the
+// measured range). Points near known static structure are dropped: the map
+// (walls/obstacles given to the robot, optional) and a persistence grid
+// (cells hit again and again over seconds while the robot moves are static).
+// The remaining points are associated (nearest neighbour within a gate) with
+// tracks, each a constant-velocity Kalman filter on (x, y, vx, vy) whose
+// measurement covariance is elongated across the beam (a sonar knows range
+// well, bearing only within its cone). Tracks are confirmed after a few hits
+// and dropped after a coasting time; tracks that never move are reclassified
+// as static. Deterministic; time enters as dt; no allocation per step.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "shared/config/robot_config.hpp"
+#include "shared/control/diff_drive.hpp"
+
+namespace inspect::behavior {
+
+/// A static segment known to the robot (odometry frame), e.g. from the map.
+struct MapSegment {
+  double x0, y0, x1, y1;
+};
+
+struct HumanTrackerParams {
+  double gate_m = 0.8;                // association gate (Euclidean, predicted position to point)
+  double map_margin_m = 0.2;          // points this close to a map segment are static
+  int confirm_hits = 3;               // hits needed to confirm a track
+  double confirm_window_s = 1.0;      // ...within this time
+  double coast_s = 1.5;               // drop a track not seen for this long
+  double min_person_speed_m_s = 0.15; // slower confirmed tracks count as static objects after static_after_s
+  double static_after_s = 3.0;
+  double moving_for_s = 0.3;          // ...and faster ones count as people after moving this long
+  double process_accel_m_s2 = 1.0;    // white-acceleration process noise
+  double range_sigma_m = 0.03;        // sonar range noise (paper +-0.03 m)
+  double grid_cell_m = 0.2;           // persistence grid
+  int grid_size = 200;                // cells per side (40 m x 40 m around the start)
+  double grid_static_s = 1.5;         // a cell hit continuously for this long is static structure
+  double grid_forget_s = 1.0;         // a cell not hit for this long starts afresh
+  int max_tracks = 8;
+};
+
+/// One tracked object (odometry frame); a person once confirmed and moving.
+struct HumanTrack {
+  int id = 0;
+  Eigen::Vector4d x = Eigen::Vector4d::Zero();   // x, y, vx, vy
+  Eigen::Matrix4d p = Eigen::Matrix4d::Identity();
+  double first_seen_s = 0, last_seen_s = 0;
+  int hits = 0;
+  bool confirmed = false;
+  double slow_since_s = -1;    // time the track became slower than min_person_speed
+  double moving_since_s = -1;  // time it became faster
+  bool person = false;         // confirmed and moving for moving_for_s
+  bool isPerson() const { return person; }
+  double speed() const { return std::hypot(x[2], x[3]); }
+  double positionSigma() const { return std::sqrt(std::max(p(0, 0), p(1, 1))); }
+};
+
+/// Detection bookkeeping (for telemetry and the scenario suite).
+struct TrackerCounters {
+  uint64_t echoes = 0;            // valid ranges seen
+  uint64_t static_map = 0;        // dropped: near the map
+  uint64_t static_grid = 0;       // dropped: persistent structure
+  uint64_t associated = 0;        // joined an existing track
+  uint64_t tracks_created = 0;
+  uint64_t tracks_confirmed = 0;
+  uint64_t tracks_unconfirmed_dropped = 0;  // likely false detections
+  uint64_t tracks_static_dropped = 0;       // became static objects
+};
+
+class HumanTracker {
+ public:
+  HumanTracker(const config::UltrasonicConfig& sonar, const HumanTrackerParams& params,
+               std::vector<MapSegment> map = {});
+
+  /// One tick: robot pose (odometry frame), the 4 ranges (< 0 = no echo), time.
+  void step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s);
+
+  const std::vector<HumanTrack>& tracks() const { return tracks_; }
+  const TrackerCounters& counters() const { return counters_; }
+  /// The confirmed person nearest to `pose` (nullptr if none).
+  const HumanTrack* nearest(const control::Pose2& pose) const;
+
+ private:
+  void predict(double dt);
+  bool nearMap(double x, double y) const;
+  /// Persistence cell: first and last time it was hit (< 0: never).
+  struct Cell {
+    float first_s = -1.0f;
+    float last_s = -1.0f;
+  };
+  Cell* cell(double x, double y);
+  void update(HumanTrack& t, const Eigen::Vector2d& z, const Eigen::Matrix2d& r, double t_s);
+
+  config::UltrasonicConfig sonar_;
+  HumanTrackerParams p_;
+  std::vector<MapSegment> map_;
+  std::vector<HumanTrack> tracks_;
+  std::vector<Cell> grid_;
+  double grid_origin_x_ = 0, grid_origin_y_ = 0;
+  bool have_time_ = false;
+  double last_t_s_ = 0;
+  int next_id_ = 1;
+  TrackerCounters counters_;
+};
+
+}  // namespace inspect::behavior
