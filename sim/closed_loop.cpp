@@ -10,7 +10,7 @@
 namespace inspect::sim {
 
 double convergenceTime(const std::vector<double>& t, const std::vector<double>& value, double band) {
-  for (std::size_t i = value.size(); i-- > 0;)
+  for (std::size_t i = std::min(t.size(), value.size()); i-- > 0;)
     if (std::abs(value[i]) > band) return i + 1 < t.size() ? t[i + 1] : t[i];
   return 0.0;
 }
