@@ -100,6 +100,8 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  fields of the selected robot: x y theta v w cmd_v cmd_w wheel_l wheel_r mode faults mcu_faults\n"
        "    connected telemetry_hz telemetry_age sensor_hz battery serial_bad_crc serial_frames_ok\n"
        "    tracking: pos_err ang_err max_pos_err max_ang_err progress ref_x ref_y kp ki kd\n"
+       "    people: pattern (0 none, 1 crossing, 2 encountering, 3 leading, 4 confronting) person_m\n"
+       "      speed_factor people\n"
        "  and: robots (number of connected robots).\n"
        "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE; integer fields take 0x.. too.\n"
        "  examples: expect robots >= 1 within 5\n"

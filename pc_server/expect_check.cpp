@@ -54,6 +54,10 @@ const std::vector<FieldDef>& fieldDefs() {
       {"kp", false, true, true, [](const S& s) { return s.telemetry.kp(); }},
       {"ki", false, true, true, [](const S& s) { return s.telemetry.ki(); }},
       {"kd", false, true, true, [](const S& s) { return s.telemetry.kd(); }},
+      {"pattern", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.pattern()); }},
+      {"person_m", false, true, true, [](const S& s) { return s.telemetry.nearest_person_m(); }},
+      {"speed_factor", false, true, true, [](const S& s) { return s.telemetry.speed_factor(); }},
+      {"people", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.people_tracked()); }},
       {"robots", true, false, false, nullptr},
   };
   return kDefs;

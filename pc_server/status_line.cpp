@@ -1,5 +1,7 @@
 #include "pc_server/status_line.hpp"
 
+#include <cctype>
+
 #include "pc_server/expect_check.hpp"
 #include "pc_server/text_util.hpp"
 
@@ -31,6 +33,12 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
   if (t.mode() == v1::TRACKING)
     s += " | " + t.track_controller() + " " + fmtFixed(100.0 * t.track_progress(), 0) + "% err " +
          fmtFixed(t.position_error_m(), 3) + " m " + fmtFixed(t.angle_error_rad(), 3) + " rad kp " + fmtFixed(t.kp(), 1);
+  if (t.nearest_person_m() >= 0) {
+    std::string pat = v1::HumanPattern_Name(t.pattern());
+    for (auto& ch : pat) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    s += " | person " + fmtFixed(t.nearest_person_m(), 1) + " m " + (t.pattern() == v1::PATTERN_NONE ? "?" : pat) +
+         " speed x" + fmtFixed(t.speed_factor(), 2);
+  }
   if (t.ultrasonic_m_size() > 0) {
     s += " | us";
     for (double r : t.ultrasonic_m()) s += r < 0 ? " --" : " " + fmtFixed(r);

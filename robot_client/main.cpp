@@ -12,7 +12,9 @@
 
 #include "robot_client/client_config.hpp"
 #include "robot_client/robot_app.hpp"
+#include "shared/behavior/human_awareness.hpp"
 #include "shared/config/control_config.hpp"
+#include "shared/fuzzy/fis_error.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/util/log.hpp"
 
@@ -27,6 +29,8 @@ options:
   --config FILE        client settings (default: config/client.yaml if present)
   --robot-config FILE  robot geometry and limits (default: config/robot.yaml if present)
   --control-config FILE  tracking controllers (default: config/control.yaml if present)
+  --behavior-config FILE human awareness: people tracking, patterns, Eq 9 speed
+                       strategy (default: config/behavior.yaml if present; else off)
   --serial PATH        serial device of the MCU (overrides serial.device),
                        e.g. /dev/serial0, or the pty printed by mcu_sim
   --server HOST:PORT   pc_server address (overrides server.host/port)
@@ -55,6 +59,7 @@ int main(int argc, char** argv) {
   std::string config_path = fileExists("config/client.yaml") ? "config/client.yaml" : "";
   std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
   std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
+  std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
   std::string serial_dev, server, id, cmd_log;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -74,6 +79,8 @@ int main(int argc, char** argv) {
       robot_path = value();
     } else if (a == "--control-config") {
       control_path = value();
+    } else if (a == "--behavior-config") {
+      behavior_path = value();
     } else if (a == "--serial") {
       serial_dev = value();
     } else if (a == "--server") {
@@ -112,8 +119,22 @@ int main(int argc, char** argv) {
     config::applyRobot(control, robot);
     const auto scheduler = config::loadScheduler(control);
 
+    std::unique_ptr<behavior::HumanAwareness> awareness;
+    if (!behavior_path.empty()) {
+      const auto acfg = behavior::loadAwarenessConfigFile(behavior_path);
+      try {
+        awareness = std::make_unique<behavior::HumanAwareness>(robot.ultrasonic, acfg,
+                                                               behavior::loadSpeedStrategy(acfg.speed_fis, acfg.speed));
+      } catch (const fuzzy::FisError& e) {
+        throw config::ConfigError(behavior_path + ": awareness.speed_fis: " + e.what());
+      }
+    } else {
+      log::warn("main", "no behaviour config: people are not tracked and do not slow the robot");
+    }
+
     boost::asio::io_context io(1);
     client::RobotApp app(io, cfg, robot, control, scheduler, cmd_log);
+    app.setAwareness(std::move(awareness));
     boost::asio::signal_set signals(io, SIGINT, SIGTERM);
     signals.async_wait([&](const boost::system::error_code&, int sig) {
       log::info("main", "signal ", sig, ": stopping");

@@ -25,6 +25,7 @@ class RobotApp {
   ~RobotApp();
   void start();
   void stop();
+  void setAwareness(std::unique_ptr<behavior::HumanAwareness> a) { core_.setAwareness(std::move(a)); }
 
  private:
   double now() const;

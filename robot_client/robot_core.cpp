@@ -246,7 +246,9 @@ serial::WheelCommand RobotCore::computeCommand(double dt_s) {
   const bool latched = mode_ == v1::ESTOP || mode_ == v1::FAILSAFE;
   if (mode_ == v1::TRACKING && tracker_ && !latched && !(faults_ & v1::FAULT_SENSOR_STALE)) {
     if (dt_s > 0.0) {
-      track_out_ = tracker_->step(pose_, measured_, 1.0, dt_s);
+      // Eq 9: people slow the robot down on its path.
+      const double factor = awareness_ ? awareness_->last().speed_factor : 1.0;
+      track_out_ = tracker_->step(pose_, measured_, factor, dt_s);
       track_max_pos_m_ = std::max(track_max_pos_m_, track_out_.error.position_m());
       track_max_ang_rad_ = std::max(track_max_ang_rad_, std::abs(track_out_.error.theta_rad));
       track_gains_ = tracker_->lastGains(0);
@@ -307,6 +309,13 @@ serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, doub
   }
   have_frame_ = true;
   last_frame_s_ = now_s;
+  if (awareness_) {
+    mcu_clock_s_ += std::clamp(dt_s, 0.0, 0.1);
+    std::array<double, 4> ranges{};
+    for (std::size_t i = 0; i < 4; ++i)
+      ranges[i] = f.ultrasonic_mm[i] == serial::kNoEcho ? -1.0 : f.ultrasonic_mm[i] * 1e-3;
+    awareness_->step(pose_, ranges, mcu_clock_s_);
+  }
   last_mcu_ms_ = f.mcu_time_ms;
   last_frame_ = f;
   measured_ = {f.wheel_speed_mrad_s[0] * 1e-3, f.wheel_speed_mrad_s[1] * 1e-3};
@@ -387,6 +396,17 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
   t.set_ki(track_gains_.ki);
   t.set_kd(track_gains_.kd);
   t.set_track_controller(tracker_ ? track_controller_ : std::string());
+  if (awareness_) {
+    const auto& a = awareness_->last();
+    t.set_pattern(static_cast<v1::HumanPattern>(static_cast<int>(a.pattern)));
+    t.set_nearest_person_m(a.distance_m);
+    t.set_nearest_person_speed_m_s(a.person_speed_m_s);
+    t.set_speed_factor(a.speed_factor);
+    t.set_people_tracked(static_cast<uint32_t>(a.people));
+  } else {
+    t.set_nearest_person_m(-1.0);
+    t.set_speed_factor(1.0);
+  }
 }
 
 std::vector<v1::Ack> RobotCore::takeAcks() {

@@ -9,6 +9,7 @@
 
 #include "inspect/v1/link.pb.h"
 #include "robot_client/client_config.hpp"
+#include "shared/behavior/human_awareness.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/control/trajectory_tracker.hpp"
@@ -40,6 +41,9 @@ class RobotCore {
   /// The command for the current state, to send at once after a command or
   /// link change (no slew step is taken).
   serial::WheelCommand commandNow();
+
+  /// Turns on human awareness (people tracking and the Eq 9 speed factor).
+  void setAwareness(std::unique_ptr<behavior::HumanAwareness> a) { awareness_ = std::move(a); }
 
   /// The TCP link came up (handshake accepted) / went down.
   void onLinkUp(double now_s);
@@ -124,6 +128,10 @@ class RobotCore {
   double track_max_pos_m_ = 0.0;
   double track_max_ang_rad_ = 0.0;
   control::PidGains track_gains_;
+
+  // Human awareness.
+  std::unique_ptr<behavior::HumanAwareness> awareness_;
+  double mcu_clock_s_ = 0.0;  // MCU time since the first frame
 };
 
 }  // namespace inspect::client

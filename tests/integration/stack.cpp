@@ -90,7 +90,7 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     waitUntil([&] { return exists(r->pty); }, 10.0);
   }
   r->client = Process::spawn({binPath("robot_client"), "--config", srcPath("config/client.yaml"), "--robot-config",
-                              srcPath("config/robot.yaml"), "--control-config", srcPath("config/control.yaml"), "--serial", r->pty, "--server",
+                              srcPath("config/robot.yaml"), "--control-config", srcPath("config/control.yaml"), "--behavior-config", srcPath("config/behavior.yaml"), "--serial", r->pty, "--server",
                               "127.0.0.1:" + std::to_string(port_), "--id", id, "--cmd-log", r->cmd_log},
                              dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
   robots_.push_back(std::move(r));
