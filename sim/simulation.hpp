@@ -1,7 +1,7 @@
 #pragma once
-// The whole simulated robot and world in sim time: plant, sensors and MCU,
-// stepped at 1 kHz with a sensor frame every 10 ms. No I/O and no clocks:
-// bytes go in through receive(), frames come out of takeTx().
+// The whole simulated robot and world in sim time: plant, sensors, MCU and
+// pedestrians, stepped at 1 kHz with a sensor frame every 10 ms. No I/O and no
+// clocks: bytes go in through receive(), frames come out of takeTx().
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -9,6 +9,7 @@
 #include "shared/config/robot_config.hpp"
 #include "sim/grayscale_model.hpp"
 #include "sim/mcu_emulator.hpp"
+#include "sim/pedestrian_crowd.hpp"
 #include "sim/robot_plant.hpp"
 #include "sim/sim_observer.hpp"
 #include "sim/ultrasonic_model.hpp"
@@ -21,6 +22,8 @@ class Simulation {
  public:
   static constexpr uint64_t kStep_ms = 1;
   static constexpr uint64_t kFramePeriod_ms = 10;
+  /// Pedestrian ground truth (P rows) every 100 ms of sim time.
+  static constexpr uint64_t kPedestrianPeriod_ms = 100;
   /// Contact ends (and a new collision may be logged) once clearance exceeds body radius + this.
   static constexpr double kContactRelease_m = 0.005;
 
@@ -31,7 +34,7 @@ class Simulation {
 
   /// Bytes from the host, applied at the current sim time.
   void receive(std::span<const uint8_t> bytes);
-  /// One 1 ms step: MCU timers, a sensor frame when due, physics.
+  /// One 1 ms step: MCU timers, a sensor frame when due, physics (robot and pedestrians).
   void step();
   /// Steps until timeMs() == t_ms (no-op when already there).
   void advanceTo(uint64_t t_ms);
@@ -44,20 +47,32 @@ class Simulation {
   const McuEmulator& mcu() const { return mcu_; }
   const World& world() const { return world_; }
   uint64_t collisions() const { return collisions_; }
+  const PedestrianCrowd& pedestrians() const { return crowd_; }
+  /// Robot-person contacts so far (one per contact, like collisions()).
+  uint64_t personCollisions() const { return person_collisions_; }
+  /// The robot's body as the pedestrians see it (true pose and velocity).
+  behavior::Agent robotBody() const;
 
  private:
   void emitFrame();
+  void emitPedestrians();
+  void checkPersonContacts();
 
   World world_;
   RobotPlant plant_;
   UltrasonicModel ultrasonic_;
   McuEmulator mcu_;
   SimObserver* observer_;
+  PedestrianCrowd crowd_;
   PlantState state_;
   uint64_t t_ms_ = 0;
   bool in_contact_ = false;
   uint64_t collisions_ = 0;
   double body_radius_m_;
+  double wheel_radius_m_;
+  double track_m_;
+  std::vector<bool> person_contact_;  // per pedestrian: overlapping the robot now
+  uint64_t person_collisions_ = 0;
   std::vector<uint8_t> tx_;
 };
 

@@ -15,6 +15,7 @@ TruthLog::TruthLog(const std::string& path) : file_(std::fopen(path.c_str(), "w"
   comment("T,mono_ns,sim_t_s,x_m,y_m,theta_rad,wheel_l_rad_s,wheel_r_rad_s,setpoint_l_rad_s,setpoint_r_rad_s,fault_flags");
   comment("C,mono_ns,sim_t_s,seq,left_mrad_s,right_mrad_s,flags");
   comment("E,mono_ns,sim_t_s,event,detail");
+  comment("P,mono_ns,sim_t_s,id,x_m,y_m,vx_m_s,vy_m_s,robot_dist_m");
 }
 
 TruthLog::~TruthLog() {
@@ -57,6 +58,16 @@ void TruthLog::onEvent(double sim_t_s, std::string_view event, std::string_view 
   for (char c : detail) s += (c == ',' || c == '\n') ? ';' : c;  // keep one CSV record per line
   s += '\n';
   line(s.data(), static_cast<int>(s.size()));
+}
+
+void TruthLog::onPedestrian(const PedestrianSample& s) {
+  // ids are checked at load to hold no comma; the length cap only guards the buffer.
+  char buf[256];
+  const int id_len = static_cast<int>(std::min<std::size_t>(s.id.size(), 64));
+  const int n = std::snprintf(buf, sizeof buf, "P,%lld,%.3f,%.*s,%.4f,%.4f,%.4f,%.4f,%.4f\n",
+                              static_cast<long long>(monoNowNs()), s.sim_t_s, id_len, s.id.data(), s.x_m, s.y_m,
+                              s.vx_m_s, s.vy_m_s, s.robot_distance_m);
+  line(buf, n);
 }
 
 void TruthLog::comment(std::string_view text) {

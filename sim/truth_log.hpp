@@ -1,6 +1,6 @@
 #pragma once
 // Ground-truth CSV log (--truth FILE): T (state per frame), C (accepted wheel
-// commands), E (events) lines, '#' comments; every line flushed at once
+// commands), E (events), P (pedestrians, 10 Hz) lines, '#' comments; every line flushed at once
 // because tests read the file while the simulator runs. Format: docs/simulator.md.
 #include <cstdio>
 #include <string>
@@ -21,6 +21,7 @@ class TruthLog : public SimObserver {
   void onSample(const TruthSample& s) override;
   void onCommand(double sim_t_s, uint8_t seq, const serial::WheelCommand& cmd) override;
   void onEvent(double sim_t_s, std::string_view event, std::string_view detail) override;
+  void onPedestrian(const PedestrianSample& s) override;
   /// Writes "# <text>".
   void comment(std::string_view text);
 

@@ -1,13 +1,16 @@
 #pragma once
 // The four ultrasonic range sensors: a fan of rays across each beam cone
-// against the world's walls and obstacles, range limits and uniform noise.
+// against the world's walls and obstacles and the people in it, range limits
+// and uniform noise.
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <random>
+#include <span>
 
 #include "shared/config/robot_config.hpp"
 #include "shared/control/diff_drive.hpp"
+#include "sim/circle.hpp"
 #include "sim/world.hpp"
 
 namespace inspect::sim {
@@ -21,12 +24,14 @@ class UltrasonicModel {
   UltrasonicModel(const config::UltrasonicConfig& cfg, uint64_t seed);
 
   /// Noise-free range of sensor `index` in metres (min_range_m when closer), or
-  /// nullopt when nothing lies within max_range_m.
-  std::optional<double> trueRange(const World& world, const control::Pose2& pose, int index) const;
+  /// nullopt when nothing lies within max_range_m. `people` are solid circles.
+  std::optional<double> trueRange(const World& world, const control::Pose2& pose, int index,
+                                  std::span<const Circle> people = {}) const;
   /// One noisy measurement in millimetres as sent on the wire (serial::kNoEcho = no echo).
-  uint16_t measureMm(const World& world, const control::Pose2& pose, int index);
+  uint16_t measureMm(const World& world, const control::Pose2& pose, int index, std::span<const Circle> people = {});
   /// All four sensors, in the wire order (front-left, front-right, left, right).
-  std::array<uint16_t, 4> measureAllMm(const World& world, const control::Pose2& pose);
+  std::array<uint16_t, 4> measureAllMm(const World& world, const control::Pose2& pose,
+                                       std::span<const Circle> people = {});
 
  private:
   config::UltrasonicConfig cfg_;

@@ -109,6 +109,26 @@ std::optional<double> castRay(const World& w, Vec2 origin, double yaw_rad, doubl
   return best;
 }
 
+std::vector<behavior::WallSegment> solidEdges(const World& w) {
+  std::vector<behavior::WallSegment> out;
+  forEachSolidEdge(w, [&](const Segment& s) {
+    behavior::WallSegment e;
+    e.a_m = {s.a.x_m, s.a.y_m};
+    e.b_m = {s.b.x_m, s.b.y_m};
+    out.push_back(e);
+  });
+  // Corners of polylines and polygons (or separate walls meeting end to end).
+  const auto same = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q) { return (p - q).norm() < 1e-9; };
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    for (std::size_t j = 0; j < out.size(); ++j) {
+      if (i == j) continue;
+      out[i].a_joined = out[i].a_joined || same(out[i].a_m, out[j].a_m) || same(out[i].a_m, out[j].b_m);
+      out[i].b_joined = out[i].b_joined || same(out[i].b_m, out[j].a_m) || same(out[i].b_m, out[j].b_m);
+    }
+  }
+  return out;
+}
+
 bool onFloorLine(const World& w, Vec2 p) {
   for (const auto& l : w.floor_lines)
     if (geom::pointSegmentDistance(p, l.centre) <= l.width_m / 2.0) return true;
@@ -140,6 +160,9 @@ World loadWorld(const ConfigNode& root) {
     const double width_m = n.number("width_m", 0.025, 0.001, 1.0);
     for (const auto& seg : readSegments(n)) w.floor_lines.push_back({seg, width_m});
   }
+  // After walls and obstacles: routes are checked against them.
+  w.pedestrians = readPedestrianScripts(root, w);
+  w.social_force = behavior::readSocialForceParams(root.optChild("social_force"));
   return w;
 }
 

@@ -1,13 +1,16 @@
 #pragma once
-// The simulated world: walls, closed obstacles, floor lines and the robot's
-// start pose, loaded from a YAML world file (docs/world-format.md).
+// The simulated world: walls, closed obstacles, floor lines, the robot's start
+// pose and scripted pedestrians, loaded from a YAML world file
+// (docs/world-format.md).
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "shared/behavior/social_force.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/control/diff_drive.hpp"
 #include "sim/geometry.hpp"
+#include "sim/pedestrian_script.hpp"
 
 namespace inspect::sim {
 
@@ -23,8 +26,8 @@ struct Obstacle {
   Polygon polygon;
 };
 
-/// Everything static in a world. Later issues add pedestrians and gas sources
-/// as further members filled by loadWorld().
+/// Everything in a world file. Later issues add gas sources as further
+/// members filled by loadWorld().
 struct World {
   std::string name;
   std::string description;
@@ -33,6 +36,8 @@ struct World {
   std::vector<Segment> walls;  // thin walls (two-sided segments)
   std::vector<Obstacle> obstacles;
   std::vector<FloorLine> floor_lines;
+  std::vector<PedestrianScript> pedestrians;  // moved by the social force model
+  behavior::SocialForceParams social_force;   // the `social_force` section (defaults when absent)
 };
 
 /// Distance from p to the nearest wall or obstacle edge; 0 when p is inside
@@ -41,6 +46,9 @@ double clearance(const World& w, Vec2 p);
 /// Distance to the first wall or obstacle edge along the ray from origin at
 /// world angle yaw_rad, or nullopt when nothing is hit within max_range_m.
 std::optional<double> castRay(const World& w, Vec2 origin, double yaw_rad, double max_range_m);
+/// Every wall and obstacle edge, as the social force model sees them (corners
+/// where edges meet marked as joined).
+std::vector<behavior::WallSegment> solidEdges(const World& w);
 /// True when p lies on a floor line (within half its width of the centre line).
 bool onFloorLine(const World& w, Vec2 p);
 
