@@ -166,11 +166,18 @@ World loadWorld(const ConfigNode& root) {
   return w;
 }
 
-World loadWorldFile(const std::string& path) {
-  const auto root = ConfigNode::loadFile(path);
+namespace {
+World loadChecked(const ConfigNode& root) {
   World w = loadWorld(root);
   root.checkKnown();
   return w;
+}
+}  // namespace
+
+World loadWorldFile(const std::string& path) { return loadChecked(ConfigNode::loadFile(path)); }
+
+World loadWorldText(const std::string& yaml, const std::string& name) {
+  return loadChecked(ConfigNode::loadString(yaml, name));
 }
 
 void checkStartPose(const World& world, double body_radius_m) {

@@ -56,6 +56,9 @@ bool onFloorLine(const World& w, Vec2 p);
 World loadWorld(const config::ConfigNode& root);
 /// Loads a world file and rejects unknown keys.
 World loadWorldFile(const std::string& path);
+/// Reads a world from YAML text (tests, tools); `name` stands in for the file
+/// name in error messages. Unknown keys are errors, as for files.
+World loadWorldText(const std::string& yaml, const std::string& name);
 /// Throws ConfigError (naming the world file and `start`) when a robot of
 /// body_radius_m at the start pose would overlap a wall or obstacle.
 void checkStartPose(const World& world, double body_radius_m);

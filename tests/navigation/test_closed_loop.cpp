@@ -34,10 +34,7 @@ constexpr double kDt = 0.01;          // 100 Hz, the robot's control rate
 constexpr double kNoCollisionGap = 0.1;  // body edge to the nearest wall, m: "never closer than body + margin"
 
 sim::World worldOf(const std::string& yaml) {
-  const auto root = config::ConfigNode::loadString(yaml, "nav_test_world.yaml");
-  sim::World w = sim::loadWorld(root);
-  root.checkKnown();
-  return w;
+  return sim::loadWorldText(yaml, "nav_test_world.yaml");
 }
 
 bool following(Mode m) { return m == Mode::kFollowCw || m == Mode::kFollowCcw; }

@@ -27,10 +27,7 @@ namespace {
 const std::string kSrc = INSPECT_SOURCE_DIR;
 
 World worldOf(const std::string& yaml) {
-  const auto root = config::ConfigNode::loadString(yaml, "peds.yaml");
-  World w = loadWorld(root);
-  root.checkKnown();
-  return w;
+  return loadWorldText(yaml, "peds.yaml");
 }
 
 struct Recorder : SimObserver {

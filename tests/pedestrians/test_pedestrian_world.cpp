@@ -16,10 +16,7 @@ namespace {
 const std::string kSrc = INSPECT_SOURCE_DIR;
 
 World worldOf(const std::string& yaml) {
-  const auto root = ConfigNode::loadString(yaml, "peds.yaml");
-  World w = loadWorld(root);
-  root.checkKnown();
-  return w;
+  return loadWorldText(yaml, "peds.yaml");
 }
 
 std::string errorOf(const std::string& yaml) {

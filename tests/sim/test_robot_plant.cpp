@@ -19,10 +19,7 @@ constexpr double kDt_s = 0.001;
 config::RobotConfig paperRobot() { return config::RobotConfig{}; }
 
 World worldOf(const std::string& yaml) {
-  const auto root = config::ConfigNode::loadString(yaml, "w.yaml");
-  World w = loadWorld(root);
-  root.checkKnown();
-  return w;
+  return loadWorldText(yaml, "w.yaml");
 }
 
 PlantState run(const RobotPlant& p, PlantState s, control::WheelSpeeds sp, double t_s) {

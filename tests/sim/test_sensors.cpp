@@ -15,10 +15,7 @@ using namespace inspect::sim;
 namespace {
 
 World worldOf(const std::string& yaml) {
-  const auto root = config::ConfigNode::loadString(yaml, "w.yaml");
-  World w = loadWorld(root);
-  root.checkKnown();
-  return w;
+  return loadWorldText(yaml, "w.yaml");
 }
 
 }  // namespace

@@ -19,10 +19,7 @@ namespace {
 const std::string kSrc = INSPECT_SOURCE_DIR;
 
 World worldOf(const std::string& yaml) {
-  const auto root = ConfigNode::loadString(yaml, "test_world.yaml");
-  World w = loadWorld(root);
-  root.checkKnown();
-  return w;
+  return loadWorldText(yaml, "test_world.yaml");
 }
 
 std::string errorOf(const std::string& yaml) {
