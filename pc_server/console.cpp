@@ -9,8 +9,10 @@
 
 #include "pc_server/expect_check.hpp"
 #include "pc_server/hello_check.hpp"
+#include "pc_server/route_file.hpp"
 #include "pc_server/status_line.hpp"
 #include "pc_server/text_util.hpp"
+#include "shared/config/config_node.hpp"
 #include "shared/util/clock.hpp"
 
 namespace inspect::server {
@@ -84,6 +86,25 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  example: track circle 3.5 0.5\n"
        "  example: track line 4 0.3 pid\n",
        &Console::cmdTrack},
+      {"goto", "goto <x_m> <y_m> [speed_m_s]", "navigate to a point, going round obstacles",
+       "  The robot's navigation automaton (go-to-goal, avoid, boundary following) drives to (x, y)\n"
+       "  in its odometry frame (origin and x axis = its pose when robot_client started) at up to\n"
+       "  speed_m_s (default: the robot's, 0.5 m/s; at most 1). People slow it down (Eq 9).\n"
+       "  Waits for the Ack; the robot acks again (COMPLETED) within 0.1 m of the goal and goes IDLE,\n"
+       "  and the console prints 'robot1: goto completed'. stop, estop or teleop end it.\n"
+       "  Telemetry: expect nav_mode, goal_dist, goal_index, goal_count, nav_switches.\n"
+       "  example: goto 2 0\n"
+       "  example: goto 3.5 -1 0.3\n",
+       &Console::cmdGoto},
+      {"route", "route <file>", "navigate through the waypoints of a route file, in order",
+       "  The file is YAML (example: config/routes/warehouse_tour.yaml):\n"
+       "    name: tour                          # optional, default: the file name\n"
+       "    speed_m_s: 0.4                      # optional, default: the robot's (0.5 m/s)\n"
+       "    waypoints_m: [x0, y0, x1, y1, ...]  # odometry frame, 1 to 100 points\n"
+       "  A bad file is an error naming the file and the key. Acked like goto; COMPLETED after the\n"
+       "  last point ('robot1: route completed'); goal_index counts the points reached.\n"
+       "  example: route config/routes/warehouse_tour.yaml\n",
+       &Console::cmdRoute},
       {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
        "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
        "  'robot1: no ack within 1 s' (the last two are errors).\n",
@@ -102,11 +123,14 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "    tracking: pos_err ang_err max_pos_err max_ang_err progress ref_x ref_y kp ki kd\n"
        "    people: pattern (0 none, 1 crossing, 2 encountering, 3 leading, 4 confronting) person_m\n"
        "      speed_factor people\n"
+       "    navigation: nav_mode goal_dist goal_index goal_count nav_switches\n"
        "  and: robots (number of connected robots).\n"
-       "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE; integer fields take 0x.. too.\n"
+       "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING; nav_mode takes NONE,\n"
+       "  GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL; integer fields take 0x.. too.\n"
        "  examples: expect robots >= 1 within 5\n"
        "            expect x ~ 2.0 0.05 within 10\n"
-       "            expect mode == ESTOP within 1\n",
+       "            expect mode == ESTOP within 1\n"
+       "            expect nav_mode == FOLLOW_CW within 20\n",
        &Console::cmdExpect},
       {"echo", "echo <text>", "print text (to label script output)", "  example: echo --- leg 2 ---\n",
        &Console::cmdEcho},
@@ -191,6 +215,15 @@ std::string Console::background() {
   }
   for (const auto& e : registry_.takeEvents())
     s += "[" + e.robot_id + "] " + v1::Event::Kind_Name(e.event.kind()) + ": " + e.event.text() + "\n";
+  for (auto it = runs_.begin(); it != runs_.end();) {
+    const auto a = registry_.ack(it->robot_id, it->command_id);
+    if (a && a->status() == v1::Ack::COMPLETED) {
+      s += it->robot_id + ": " + it->name + " completed\n";
+      it = runs_.erase(it);
+    } else {
+      ++it;
+    }
+  }
   return s;
 }
 
@@ -374,10 +407,45 @@ bool Console::cmdTrack(const Args& args, const std::string&, int) {
   } else {
     return fail("track", "unknown path '" + args[0] + "' (circle or line)");
   }
-  return sendAndReport("track", std::move(c));
+  return sendAndReport("track", std::move(c), true);
 }
 
-bool Console::sendAndReport(const std::string& name, v1::Command cmd) {
+bool Console::cmdGoto(const Args& args, const std::string&, int) {
+  if (args.size() < 2 || args.size() > 3) return fail("goto", "needs two or three numbers: goto <x_m> <y_m> [speed_m_s]");
+  std::vector<double> nums;
+  for (const auto& a : args) {
+    const auto v = parseNumber(a);
+    if (!v) return fail("goto", "'" + a + "' is not a number");
+    nums.push_back(*v);
+  }
+  if (std::fabs(nums[0]) > 1000 || std::fabs(nums[1]) > 1000) return fail("goto", "x and y must be in [-1000, 1000] m");
+  if (nums.size() > 2 && (!(nums[2] > 0) || nums[2] > kMaxRouteSpeed_m_s))
+    return fail("goto", "speed " + args[2] + " m/s is outside (0, " + fmtShort(kMaxRouteSpeed_m_s) + "]");
+  v1::Command c;
+  auto* g = c.mutable_go_to();
+  auto* p = g->add_points();
+  p->set_x_m(nums[0]);
+  p->set_y_m(nums[1]);
+  if (nums.size() > 2) g->set_speed_m_s(nums[2]);
+  return sendAndReport("goto", std::move(c), true);
+}
+
+bool Console::cmdRoute(const Args& args, const std::string&, int) {
+  if (args.size() != 1) return fail("route", "needs one file: route <file>");
+  Route r;
+  try {
+    r = loadRouteFile(args[0]);
+  } catch (const config::ConfigError& e) {
+    return fail("route", e.what());
+  }
+  v1::Command c;
+  *c.mutable_go_to() = goToOf(r);
+  out_ << "route '" << r.name << "': " << r.waypoints_m.size() / 2 << " points"
+       << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string()) << "\n";
+  return sendAndReport("route", std::move(c), true);
+}
+
+bool Console::sendAndReport(const std::string& name, v1::Command cmd, bool runs) {
   const auto robot = connectedRobot(name);
   if (!robot) return false;
   const uint64_t id = sink_.sendCommand(*robot, std::move(cmd));
@@ -389,7 +457,14 @@ bool Console::sendAndReport(const std::string& name, v1::Command cmd) {
     return false;
   }
   switch (ack->status()) {
-    case v1::Ack::ACCEPTED: out_ << *robot << ": " << name << " accepted\n"; return true;
+    case v1::Ack::ACCEPTED:
+      out_ << *robot << ": " << name << " accepted\n";
+      if (runs) {
+        // One run per robot: a new one ends the previous (the robot does the same).
+        std::erase_if(runs_, [&](const Run& r) { return r.robot_id == *robot; });
+        runs_.push_back({*robot, id, name});
+      }
+      return true;
     case v1::Ack::COMPLETED: out_ << *robot << ": " << name << " completed\n"; return true;
     case v1::Ack::REJECTED:
       out_ << *robot << ": " << name << " rejected: " << ack->reason() << "\n";

@@ -44,7 +44,8 @@ class Console {
   bool execute(const std::string& line, int line_no);
 
   /// Background work between commands: selects the first robot to connect when
-  /// none is selected and returns the text of new robot events. Call it often.
+  /// none is selected and returns the text of new robot events and of completed
+  /// runs ("robot1: goto completed"). Call it often.
   std::string background();
   /// background() printed to the output, then the idle hook; used while waiting.
   void pump();
@@ -83,6 +84,8 @@ class Console {
   bool cmdDrive(const Args& args, const std::string& rest, int line_no);
   bool cmdTeleop(const Args& args, const std::string& rest, int line_no);
   bool cmdTrack(const Args& args, const std::string& rest, int line_no);
+  bool cmdGoto(const Args& args, const std::string& rest, int line_no);
+  bool cmdRoute(const Args& args, const std::string& rest, int line_no);
   bool cmdStop(const Args& args, const std::string& rest, int line_no);
   bool cmdEstop(const Args& args, const std::string& rest, int line_no);
   bool cmdResume(const Args& args, const std::string& rest, int line_no);
@@ -97,8 +100,9 @@ class Console {
   std::optional<std::string> connectedRobot(const std::string& cmd);
   /// Sends a Stop/EStop/Resume and reports its Ack.
   bool simpleCommand(const std::string& name, const Args& args, v1::Command cmd);
-  /// Sends `cmd` to the selected robot, waits for its Ack and prints the answer.
-  bool sendAndReport(const std::string& name, v1::Command cmd);
+  /// Sends `cmd` to the selected robot, waits for its Ack and prints the answer. With `runs`
+  /// (track, goto, route) the command's COMPLETED Ack is printed when it comes (background()).
+  bool sendAndReport(const std::string& name, v1::Command cmd, bool runs = false);
   /// Waits up to ack_timeout_s for the Ack of `command_id`; nullopt when none came.
   std::optional<v1::Ack> waitAck(const std::string& robot_id, uint64_t command_id);
   /// Sleeps up to `seconds` while pumping; false if the server is stopping.
@@ -114,6 +118,13 @@ class Console {
   std::string selected_;
   bool quit_ = false;
   Tally tally_;
+  /// An accepted long-running command waiting for its COMPLETED Ack (at most one per robot).
+  struct Run {
+    std::string robot_id;
+    uint64_t command_id = 0;
+    std::string name;
+  };
+  std::vector<Run> runs_;
 };
 
 }  // namespace inspect::server

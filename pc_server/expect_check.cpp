@@ -1,6 +1,7 @@
 #include "pc_server/expect_check.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <functional>
@@ -19,6 +20,23 @@ struct FieldDef {
   bool needs_telemetry;
   std::function<double(const RobotSnapshot&)> get;
 };
+
+// Telemetry.nav_mode is a string; expect compares its index here ("" = NONE).
+constexpr std::array<const char*, 6> kNavModes = {"NONE", "GO_TO_GOAL", "AVOID", "FOLLOW_CW", "FOLLOW_CCW", "AT_GOAL"};
+
+double navModeNumber(const std::string& name) {
+  if (name.empty()) return 0.0;
+  for (std::size_t i = 1; i < kNavModes.size(); ++i)
+    if (name == kNavModes[i]) return static_cast<double>(i);
+  return -1.0;  // a mode this console does not know
+}
+
+std::optional<int> navModeFromName(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::toupper(c); });
+  for (std::size_t i = 0; i < kNavModes.size(); ++i)
+    if (text == kNavModes[i]) return static_cast<int>(i);
+  return std::nullopt;
+}
 
 const std::vector<FieldDef>& fieldDefs() {
   using S = RobotSnapshot;
@@ -58,6 +76,11 @@ const std::vector<FieldDef>& fieldDefs() {
       {"person_m", false, true, true, [](const S& s) { return s.telemetry.nearest_person_m(); }},
       {"speed_factor", false, true, true, [](const S& s) { return s.telemetry.speed_factor(); }},
       {"people", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.people_tracked()); }},
+      {"nav_mode", true, true, true, [](const S& s) { return navModeNumber(s.telemetry.nav_mode()); }},
+      {"goal_dist", false, true, true, [](const S& s) { return s.telemetry.goal_distance_m(); }},
+      {"goal_index", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.goal_index()); }},
+      {"goal_count", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.goal_count()); }},
+      {"nav_switches", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.nav_switches()); }},
       {"robots", true, false, false, nullptr},
   };
   return kDefs;
@@ -122,11 +145,15 @@ std::variant<ExpectSpec, std::string> parseExpect(const std::vector<std::string>
     s.value = *v;
   } else if (s.field == "mode" && modeFromName(args[2])) {
     s.value = *modeFromName(args[2]);
+  } else if (s.field == "nav_mode" && navModeFromName(args[2])) {
+    s.value = *navModeFromName(args[2]);
   } else if (const auto i = parseInteger(args[2]); i && def->integer) {
     s.value = static_cast<double>(*i);  // e.g. faults == 0x4
   } else {
     return "expect: '" + args[2] + "' is not a number" +
-           (s.field == "mode" ? " or a mode (IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE)" : "");
+           (s.field == "mode" ? " or a mode (IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING)"
+            : s.field == "nav_mode" ? " or a navigation mode (NONE, GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL)"
+                                    : "");
   }
   std::size_t i = 3;
   if (s.op == ExpectOp::kNear) {
@@ -192,6 +219,7 @@ FieldReading readField(const std::string& field, const RobotRegistry& registry, 
   r.ok = true;
   r.value = v;
   if (field == "mode") r.text = modeName(static_cast<int>(v));
+  else if (field == "nav_mode") r.text = v >= 0 && v < static_cast<double>(kNavModes.size()) ? kNavModes[static_cast<std::size_t>(v)] : "?";
   else if (def->integer) r.text = std::to_string(static_cast<long long>(v));
   else r.text = fmtShort(v, 3);
   return r;

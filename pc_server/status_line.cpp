@@ -1,6 +1,7 @@
 #include "pc_server/status_line.hpp"
 
 #include <cctype>
+#include <cstdio>
 
 #include "pc_server/expect_check.hpp"
 #include "pc_server/text_util.hpp"
@@ -33,6 +34,12 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
   if (t.mode() == v1::TRACKING)
     s += " | " + t.track_controller() + " " + fmtFixed(100.0 * t.track_progress(), 0) + "% err " +
          fmtFixed(t.position_error_m(), 3) + " m " + fmtFixed(t.angle_error_rad(), 3) + " rad kp " + fmtFixed(t.kp(), 1);
+  if (t.mode() == v1::NAVIGATING) {
+    char nav[96];
+    std::snprintf(nav, sizeof nav, " goal %u/%u %s m sw %u", t.goal_index() + 1, t.goal_count(),
+                  fmtFixed(t.goal_distance_m()).c_str(), t.nav_switches());
+    s += " | nav " + t.nav_mode() + nav;
+  }
   if (t.nearest_person_m() >= 0) {
     std::string pat = v1::HumanPattern_Name(t.pattern());
     for (auto& ch : pat) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));

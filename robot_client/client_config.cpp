@@ -2,6 +2,8 @@
 
 #include "shared/net/robot_id.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cctype>
 
@@ -34,6 +36,11 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   c.safety.link_timeout_s = sa.number("link_timeout_s", c.safety.link_timeout_s, 0.05, 10);
   c.safety.command_timeout_s = sa.number("command_timeout_s", c.safety.command_timeout_s, 0.05, 10);
   c.safety.sensor_timeout_s = sa.number("sensor_timeout_s", c.safety.sensor_timeout_s, 0.02, 5);
+  c.safety.obstacle_stop_m = sa.number("obstacle_stop_m", c.safety.obstacle_stop_m, 0, 5);
+  c.safety.obstacle_slow_m = sa.number("obstacle_slow_m", c.safety.obstacle_slow_m, 0, 10);
+  if (c.safety.obstacle_slow_m <= c.safety.obstacle_stop_m && c.safety.obstacle_slow_m > 0)
+    sa.fail("obstacle_slow_m", "must be above obstacle_stop_m (or 0 to turn the obstacle stop off)");
+  c.map_file = root.string("map", c.map_file);
   return c;
 }
 
@@ -41,6 +48,14 @@ ClientConfig loadClientConfigFile(const std::string& path) {
   const auto root = config::ConfigNode::loadFile(path);
   ClientConfig c = loadClientConfig(root);
   root.checkKnown();
+  // A relative map path is taken from the working directory, or else from the
+  // directory above the config file's (config/client.yaml names config/worlds/...).
+  struct stat st {};
+  if (!c.map_file.empty() && c.map_file.front() != '/' && ::stat(c.map_file.c_str(), &st) != 0) {
+    const auto slash = path.rfind('/');
+    const std::string alt = (slash == std::string::npos ? std::string(".") : path.substr(0, slash)) + "/../" + c.map_file;
+    if (::stat(alt.c_str(), &st) == 0) c.map_file = alt;
+  }
   return c;
 }
 

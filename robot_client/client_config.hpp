@@ -11,6 +11,11 @@ struct SafetyParams {
   double link_timeout_s = 0.3;
   double command_timeout_s = 0.3;
   double sensor_timeout_s = 0.1;
+  // Tracking only: the nearest front-sonar range scales the speed down from
+  // obstacle_slow_m to a stop at obstacle_stop_m (like the MCU's own
+  // anti-collision stop), whatever the obstacle; people get Eq 9 as well.
+  double obstacle_stop_m = 0.35;
+  double obstacle_slow_m = 0.9;
 };
 
 struct ClientConfig {
@@ -27,6 +32,7 @@ struct ClientConfig {
   double serial_reopen_period_s = 1.0;
   double mcu_heartbeat_period_s = 0.1;
   SafetyParams safety;
+  std::string map_file;  // world file whose walls people tracking ignores ("" = no map); --map overrides
 };
 
 /// True for ids made of [A-Za-z0-9_-], 1 to 64 characters.

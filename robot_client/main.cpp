@@ -12,11 +12,13 @@
 
 #include "robot_client/client_config.hpp"
 #include "robot_client/robot_app.hpp"
+#include "robot_client/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/util/log.hpp"
+#include "sim/world.hpp"
 
 namespace {
 
@@ -35,6 +37,10 @@ options:
                        e.g. /dev/serial0, or the pty printed by mcu_sim
   --server HOST:PORT   pc_server address (overrides server.host/port)
   --id ROBOT_ID        robot id (overrides robot_id)
+  --map FILE           world file (config/worlds/*.yaml) whose walls and obstacles,
+                       moved into the odometry frame (origin = the world's start
+                       pose), people tracking treats as static (overrides
+                       map: in the client config)
   --cmd-log FILE       write every wheel command sent to the MCU (CSV; for tests)
   --version            print the version and exit
   --help               print this help and exit
@@ -60,7 +66,7 @@ int main(int argc, char** argv) {
   std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
   std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
   std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
-  std::string serial_dev, server, id, cmd_log;
+  std::string serial_dev, server, id, cmd_log, map_path;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -89,6 +95,8 @@ int main(int argc, char** argv) {
       id = value();
     } else if (a == "--cmd-log") {
       cmd_log = value();
+    } else if (a == "--map") {
+      map_path = value();
     } else {
       usageError("unknown option '" + a + "'");
     }
@@ -100,6 +108,7 @@ int main(int argc, char** argv) {
     config::RobotConfig robot;
     if (!robot_path.empty()) robot = config::loadRobotConfigFile(robot_path);
     if (!serial_dev.empty()) cfg.serial_device = serial_dev;
+    if (!map_path.empty()) cfg.map_file = map_path;
     if (!id.empty()) {
       if (!client::validRobotId(id)) usageError("--id '" + id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
       cfg.robot_id = id;
@@ -119,17 +128,23 @@ int main(int argc, char** argv) {
     config::applyRobot(control, robot);
     const auto scheduler = config::loadScheduler(control);
 
+    std::vector<behavior::MapSegment> map;
+    if (!cfg.map_file.empty()) {
+      map = client::mapFromWorld(sim::loadWorldFile(cfg.map_file));
+      log::info("main", "map ", cfg.map_file, ": ", map.size(), " wall segments");
+    }
     std::unique_ptr<behavior::HumanAwareness> awareness;
     if (!behavior_path.empty()) {
       const auto acfg = behavior::loadAwarenessConfigFile(behavior_path);
       try {
-        awareness = std::make_unique<behavior::HumanAwareness>(robot.ultrasonic, acfg,
-                                                               behavior::loadSpeedStrategy(acfg.speed_fis, acfg.speed));
+        awareness = std::make_unique<behavior::HumanAwareness>(
+            robot.ultrasonic, acfg, behavior::loadSpeedStrategy(acfg.speed_fis, acfg.speed), std::move(map));
       } catch (const fuzzy::FisError& e) {
         throw config::ConfigError(behavior_path + ": awareness.speed_fis: " + e.what());
       }
     } else {
-      log::warn("main", "no behaviour config: people are not tracked and do not slow the robot");
+      log::warn("main", "no behaviour config: people are not tracked and do not slow the robot",
+                map.empty() ? "" : " (the map is not used)");
     }
 
     boost::asio::io_context io(1);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <cstdio>
 
 namespace inspect::client {
 namespace {
@@ -22,6 +24,29 @@ int16_t toMrad(double rad_s) {
   return static_cast<int16_t>(v);
 }
 
+// "1.25" for messages.
+std::string fmt2(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f", v);
+  return buf;
+}
+
+// "(1.25, -0.50)" for messages.
+std::string fmtPoint(double x, double y) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "(%.2f, %.2f)", x, y);
+  return buf;
+}
+
+// The Ack of command `id` with `status` and, for a rejection, why.
+v1::Ack ackOf(uint64_t id, v1::Ack::Status status, const std::string& reason = "") {
+  v1::Ack a;
+  a.set_command_id(id);
+  a.set_status(status);
+  if (!reason.empty()) a.set_reason(reason);
+  return a;
+}
+
 // Moves `cur` toward `target` by at most `step`.
 double slew(double cur, double target, double step) {
   if (target > cur + step) return cur + step;
@@ -39,13 +64,7 @@ RobotCore::RobotCore(const config::RobotConfig& robot, const SafetyParams& safet
 }
 
 v1::Ack RobotCore::startTrack(const v1::Command& cmd) {
-  v1::Ack ack;
-  ack.set_command_id(cmd.id());
-  auto reject = [&](const std::string& why) {
-    ack.set_status(v1::Ack::REJECTED);
-    ack.set_reason(why);
-    return ack;
-  };
+  const auto reject = [&](const std::string& why) { return ackOf(cmd.id(), v1::Ack::REJECTED, why); };
   const auto& t = cmd.track();
   control::TrackerParams params = control_.tracker;
   const std::string& c = t.controller();
@@ -87,13 +106,98 @@ v1::Ack RobotCore::startTrack(const v1::Command& cmd) {
   setpoint_ = {};
   setpoint_time_s_ = -1.0;
   setMode(v1::TRACKING, "tracking " + what + " with " + track_controller_);
-  ack.set_status(v1::Ack::ACCEPTED);
-  return ack;
+  return ackOf(cmd.id(), v1::Ack::ACCEPTED);
 }
 
-void RobotCore::endTrack() {
+std::string RobotCore::autonomyRefusal() const {
+  if (mode_ == v1::ESTOP) return "e-stop latched: resume first";
+  if (mode_ == v1::FAILSAFE) return "failsafe latched (" + latch_reason_ + "): resume first";
+  if (faults_ & v1::FAULT_SENSOR_STALE) return "sensor frames stale";
+  if (faults_ & v1::FAULT_SERIAL_DOWN) return "serial device down";
+  if (!have_frame_) return "no sensor frame yet: the pose is unknown";
+  return "";
+}
+
+v1::Ack RobotCore::startGoTo(const v1::Command& cmd) {
+  const auto reject = [&](const std::string& why) { return ackOf(cmd.id(), v1::Ack::REJECTED, why); };
+  const auto& g = cmd.go_to();
+  if (g.points_size() == 0) return reject("no goal given");
+  if (g.points_size() > kMaxGoals)
+    return reject(std::to_string(g.points_size()) + " goals: at most " + std::to_string(kMaxGoals) + " per command");
+  for (int i = 0; i < g.points_size(); ++i)
+    if (!std::isfinite(g.points(i).x_m()) || !std::isfinite(g.points(i).y_m()))
+      return reject("goal " + std::to_string(i + 1) + " has a non-finite coordinate");
+  const double speed = g.speed_m_s();
+  if (!std::isfinite(speed) || speed < 0.0) return reject("speed must be a number >= 0 m/s (0 = default)");
+  if (speed > robot_.limits.max_v_m_s)
+    return reject("speed " + fmt2(speed) + " m/s is above the robot's limit of " + fmt2(robot_.limits.max_v_m_s) +
+                  " m/s");
+  navigation::NavigationParams params;
+  params.v_max_m_s = std::min(speed > 0.0 ? speed : kDefaultNavSpeed_m_s, robot_.limits.max_v_m_s);
+  params.w_max_rad_s = std::min(params.w_max_rad_s, robot_.limits.max_w_rad_s);
+  std::unique_ptr<navigation::Navigator> nav;
+  try {
+    nav = std::make_unique<navigation::Navigator>(params, robot_.ultrasonic);
+  } catch (const std::invalid_argument& e) {
+    return reject(e.what());
+  }
+  const bool was_navigating = mode_ == v1::NAVIGATING;
+  endAutonomy();
+  navigator_ = std::move(nav);
+  goals_.clear();
+  for (const auto& p : g.points()) goals_.push_back({p.x_m(), p.y_m()});
+  goal_index_ = 0;
+  nav_command_id_ = cmd.id();
+  nav_switches_done_ = 0;
+  nav_twist_ = {};
+  navigator_->setGoal(goals_.front());
+  goal_distance_m_ = std::hypot(goals_.front().x - pose_.x_m, goals_.front().y - pose_.y_m);
+  setpoint_ = {};
+  setpoint_time_s_ = -1.0;
+  const std::string what =
+      (g.name().empty() ? "" : "route '" + g.name() + "': ") +
+      (goals_.size() == 1 ? "to " + fmtPoint(goals_[0].x, goals_[0].y)
+                          : std::to_string(goals_.size()) + " goals") +
+      " at " + fmt2(params.v_max_m_s) + " m/s";
+  if (was_navigating) events_.push_back({v1::Event::INFO, "navigating " + what});
+  setMode(v1::NAVIGATING, "navigating " + what);
+  return ackOf(cmd.id(), v1::Ack::ACCEPTED);
+}
+
+void RobotCore::endAutonomy() {
   tracker_.reset();
   track_command_id_ = 0;
+  if (navigator_) nav_switches_done_ += navigator_->output().switch_count;
+  navigator_.reset();
+  nav_command_id_ = 0;
+  nav_twist_ = {};
+}
+
+control::Twist RobotCore::navigationTwist(double dt_s) {
+  if (dt_s <= 0.0) return nav_twist_;  // a command-time refresh: no tick
+  const navigation::NavigationOutput& out =
+      navigator_->step(pose_, navigation::rangesFromMm(last_frame_.ultrasonic_mm), dt_s);
+  goal_distance_m_ = out.distance_to_goal_m;
+  if (out.mode == navigation::Mode::kAtGoal) {
+    const navigation::Vec2 g = goals_[goal_index_];
+    events_.push_back({v1::Event::INFO, "goal " + std::to_string(goal_index_ + 1) + "/" +
+                                            std::to_string(goals_.size()) + " " + fmtPoint(g.x, g.y) +
+                                            " reached at " + fmtPoint(pose_.x_m, pose_.y_m)});
+    if (++goal_index_ < goals_.size()) {
+      nav_switches_done_ += out.switch_count;
+      navigator_->setGoal(goals_[goal_index_]);  // the obstacle memory is kept
+    } else {
+      acks_.push_back(ackOf(nav_command_id_, v1::Ack::COMPLETED));
+      endAutonomy();
+      setMode(v1::IDLE, "route completed");
+      return {};
+    }
+  }
+  // Eq 9: people slow the robot on its way. v and w are scaled together, so
+  // the path keeps its shape and a factor of 0 stops the robot.
+  const double factor = awareness_ ? awareness_->last().speed_factor : 1.0;
+  nav_twist_ = {out.twist.v_m_s * factor, out.twist.w_rad_s * factor};
+  return nav_twist_;
 }
 
 void RobotCore::setMode(v1::Mode m, const std::string& why) {
@@ -117,7 +221,7 @@ void RobotCore::clear(uint32_t fault, const std::string& why) {
 void RobotCore::latchFailsafe(const std::string& why) {
   setpoint_ = {};
   setpoint_time_s_ = -1.0;
-  endTrack();
+  endAutonomy();
   if (mode_ == v1::ESTOP || mode_ == v1::FAILSAFE) return;
   latch_reason_ = why;
   setMode(v1::FAILSAFE, why + "; needs resume");
@@ -181,30 +285,29 @@ v1::Ack RobotCore::onCommand(const v1::Command& cmd, double now_s) {
                    std::clamp(w, -robot_.limits.max_w_rad_s, robot_.limits.max_w_rad_s)};
       setpoint_time_s_ = now_s;
       clear(v1::FAULT_COMMAND_STALE, "");
-      endTrack();  // the operator takes over
+      endAutonomy();  // the operator takes over
       setMode(v1::TELEOP, "teleop set-point");
       ack.set_status(v1::Ack::ACCEPTED);
       if (setpoint_.v_m_s != v || setpoint_.w_rad_s != w) ack.set_reason("clamped to the robot's limits");
       return ack;
     }
     case v1::Command::kTrack:
-      if (mode_ == v1::ESTOP) return reject("e-stop latched: resume first");
-      if (mode_ == v1::FAILSAFE) return reject("failsafe latched (" + latch_reason_ + "): resume first");
-      if (faults_ & v1::FAULT_SENSOR_STALE) return reject("sensor frames stale");
-      if (faults_ & v1::FAULT_SERIAL_DOWN) return reject("serial device down");
-      if (!have_frame_) return reject("no sensor frame yet: the pose is unknown");
+      if (const std::string why = autonomyRefusal(); !why.empty()) return reject(why);
       return startTrack(cmd);
+    case v1::Command::kGoTo:
+      if (const std::string why = autonomyRefusal(); !why.empty()) return reject(why);
+      return startGoTo(cmd);
     case v1::Command::kStop:
       setpoint_ = {};
       setpoint_time_s_ = -1.0;
-      endTrack();
-      if (mode_ == v1::TELEOP || mode_ == v1::TRACKING) setMode(v1::IDLE, "stop");
+      endAutonomy();
+      if (moving()) setMode(v1::IDLE, "stop");
       ack.set_status(v1::Ack::ACCEPTED);
       return ack;
     case v1::Command::kEstop:
       setpoint_ = {};
       setpoint_time_s_ = -1.0;
-      endTrack();
+      endAutonomy();
       latch_reason_ = "e-stop";
       setMode(v1::ESTOP, "e-stop from operator; needs resume");
       ack.set_status(v1::Ack::ACCEPTED);
@@ -242,23 +345,37 @@ void RobotCore::checkTimeouts(double now_s) {
   }
 }
 
+double RobotCore::obstacleFactor() {
+  const double stop = safety_.obstacle_stop_m, slow = safety_.obstacle_slow_m;
+  if (!(slow > stop) || !have_frame_) return 1.0;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < robot_.ultrasonic.mounts.size() && i < serial::kUltrasonicCount; ++i) {
+    const uint16_t mm = last_frame_.ultrasonic_mm[i];
+    if (std::abs(robot_.ultrasonic.mounts[i].yaw_rad) < 0.3 && mm != serial::kNoEcho)
+      nearest = std::min(nearest, mm * 1e-3);
+  }
+  const double f = std::clamp((nearest - stop) / (slow - stop), 0.0, 1.0);
+  if (f == 0.0 && !obstacle_stopped_)
+    events_.push_back({v1::Event::INFO, "obstacle " + std::to_string(static_cast<int>(nearest * 100)) +
+                                            " cm ahead: stopped on the path until it clears"});
+  obstacle_stopped_ = f == 0.0;
+  return f;
+}
+
 serial::WheelCommand RobotCore::computeCommand(double dt_s) {
   const bool latched = mode_ == v1::ESTOP || mode_ == v1::FAILSAFE;
   if (mode_ == v1::TRACKING && tracker_ && !latched && !(faults_ & v1::FAULT_SENSOR_STALE)) {
     if (dt_s > 0.0) {
-      // Eq 9: people slow the robot down on its path.
-      const double factor = awareness_ ? awareness_->last().speed_factor : 1.0;
+      // Eq 9: people slow the robot down on its path; anything close ahead stops it.
+      const double factor = std::min(awareness_ ? awareness_->last().speed_factor : 1.0, obstacleFactor());
       track_out_ = tracker_->step(pose_, measured_, factor, dt_s);
       track_max_pos_m_ = std::max(track_max_pos_m_, track_out_.error.position_m());
       track_max_ang_rad_ = std::max(track_max_ang_rad_, std::abs(track_out_.error.theta_rad));
       track_gains_ = tracker_->lastGains(0);
       cmd_wheels_ = track_out_.command;  // the tracker's own loop shapes the command
       if (track_out_.done) {
-        v1::Ack done;
-        done.set_command_id(track_command_id_);
-        done.set_status(v1::Ack::COMPLETED);
-        acks_.push_back(done);
-        endTrack();
+        acks_.push_back(ackOf(track_command_id_, v1::Ack::COMPLETED));
+        endAutonomy();
         cmd_wheels_ = {};
         setMode(v1::IDLE, "path completed");
       }
@@ -270,7 +387,10 @@ serial::WheelCommand RobotCore::computeCommand(double dt_s) {
     c.flags = serial::WheelCommand::kEnable;
     return c;
   }
-  control::Twist target = mode_ == v1::TELEOP ? setpoint_ : control::Twist{};
+  control::Twist target;
+  if (mode_ == v1::TELEOP) target = setpoint_;
+  else if (mode_ == v1::NAVIGATING && navigator_ && !latched && !(faults_ & v1::FAULT_SENSOR_STALE))
+    target = navigationTwist(dt_s);
   target = control::limitTwist(target, robot_.geometry.wheel_radius_m, robot_.geometry.track_m,
                                robot_.limits.max_wheel_speed_rad_s);
   const auto want = control::wheelsFromTwist(target, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
@@ -278,7 +398,7 @@ serial::WheelCommand RobotCore::computeCommand(double dt_s) {
     cmd_wheels_ = {};  // safety stops are immediate, not slew-limited
   } else {
     // Normal starts and stops ramp symmetrically, so a timed teleop segment
-    // covers exactly v * T.
+    // covers exactly v * T; navigation is slewed the same way.
     const double step = robot_.limits.max_wheel_accel_rad_s2 * std::clamp(dt_s, 0.0, 0.05);
     cmd_wheels_.left_rad_s = slew(cmd_wheels_.left_rad_s, want.left_rad_s, step);
     cmd_wheels_.right_rad_s = slew(cmd_wheels_.right_rad_s, want.right_rad_s, step);
@@ -396,6 +516,11 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
   t.set_ki(track_gains_.ki);
   t.set_kd(track_gains_.kd);
   t.set_track_controller(tracker_ ? track_controller_ : std::string());
+  t.set_nav_mode(mode_ == v1::NAVIGATING && navigator_ ? navigation::toString(navigator_->output().mode) : "");
+  t.set_goal_distance_m(goal_distance_m_);
+  t.set_goal_index(static_cast<uint32_t>(goal_index_));
+  t.set_goal_count(static_cast<uint32_t>(goals_.size()));
+  t.set_nav_switches(nav_switches_done_ + (navigator_ ? navigator_->output().switch_count : 0u));
   if (awareness_) {
     const auto& a = awareness_->last();
     t.set_pattern(static_cast<v1::HumanPattern>(static_cast<int>(a.pattern)));

@@ -1,8 +1,10 @@
 #pragma once
-// The robot's decision core: modes, safety latches, teleop set-point, odometry
-// and wheel commands. Pure: every input carries its time (`now_s`, monotonic
-// seconds); no I/O, no clock reads, no allocation in the per-tick path.
+// The robot's decision core: modes, safety latches, teleop set-point, path
+// tracking, navigation to goals, odometry and wheel commands. Pure: every
+// input carries its time (`now_s`, monotonic seconds); no I/O, no clock
+// reads, no allocation in the per-tick path.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +16,7 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/control/trajectory_tracker.hpp"
 #include "shared/control/diff_drive.hpp"
+#include "shared/navigation/navigator.hpp"
 #include "shared/serial/frame_codec.hpp"
 
 namespace inspect::client {
@@ -60,24 +63,39 @@ class RobotCore {
   void fillTelemetry(v1::Telemetry& t, double now_s) const;
   /// Moves out the events raised since the last call.
   std::vector<CoreEvent> takeEvents();
-  /// Moves out Acks the core produced on its own (COMPLETED of a track run).
+  /// Moves out Acks the core produced on its own (COMPLETED of a track run or a route).
   std::vector<v1::Ack> takeAcks();
 
   v1::Mode mode() const { return mode_; }
   uint32_t faults() const { return faults_; }
   const control::Pose2& pose() const { return pose_; }
   control::Twist commandedTwist() const { return cmd_twist_; }
+  /// The navigator of the current (or last) go_to command; null before the first one.
+  const navigation::Navigator* navigator() const { return navigator_.get(); }
+
+  /// Most goals one go_to command may carry.
+  static constexpr int kMaxGoals = 100;
+  /// Cruise speed of a go_to command that gives none (clamped to the robot's limit).
+  static constexpr double kDefaultNavSpeed_m_s = 0.5;
 
  private:
-  bool moving() const { return mode_ == v1::TELEOP || mode_ == v1::TRACKING; }
+  bool moving() const { return mode_ == v1::TELEOP || mode_ == v1::TRACKING || mode_ == v1::NAVIGATING; }
   v1::Ack startTrack(const v1::Command& cmd);
-  void endTrack();
+  v1::Ack startGoTo(const v1::Command& cmd);
+  /// Why a track or go_to command cannot start now ("" when it can).
+  std::string autonomyRefusal() const;
+  /// Ends tracking and navigation (the operator or a safety stop takes over).
+  void endAutonomy();
+  /// One navigation tick: the navigator's twist scaled by Eq 9; advances the route.
+  control::Twist navigationTwist(double dt_s);
   void setMode(v1::Mode m, const std::string& why);
   void raise(uint32_t fault, const std::string& why);
   void clear(uint32_t fault, const std::string& why);
   void latchFailsafe(const std::string& why);
   void checkTimeouts(double now_s);
   serial::WheelCommand computeCommand(double dt_s);
+  /// Tracking: 1 when nothing is close ahead, down to 0 at safety.obstacle_stop_m (front sonars).
+  double obstacleFactor();
 
   config::RobotConfig robot_;
   SafetyParams safety_;
@@ -129,8 +147,18 @@ class RobotCore {
   double track_max_ang_rad_ = 0.0;
   control::PidGains track_gains_;
 
+  // Navigation (Command.go_to).
+  std::unique_ptr<navigation::Navigator> navigator_;
+  std::vector<navigation::Vec2> goals_;
+  std::size_t goal_index_ = 0;
+  uint64_t nav_command_id_ = 0;
+  uint32_t nav_switches_done_ = 0;  // automaton switches of the goals already reached
+  double goal_distance_m_ = 0.0;
+  control::Twist nav_twist_;          // the last tick's navigation twist (after Eq 9)
+
   // Human awareness.
   std::unique_ptr<behavior::HumanAwareness> awareness_;
+  bool obstacle_stopped_ = false;
   double mcu_clock_s_ = 0.0;  // MCU time since the first frame
 };
 

@@ -16,7 +16,8 @@ FollowSide chooseSide(Vec2 avoid, Vec2 to_goal, Vec2 heading);
 
 /// Eq 5.27: clear shot at the goal - the avoid and go-to-goal directions make an acute
 /// angle, dot(u_AO, u_GTG) > 0, and no remembered point lies in the corridor toward the
-/// goal within the guard distance. True when no obstacle is within the caution distance.
+/// goal within the guard distance. True when no obstacle is within the caution distance,
+/// and when the goal itself lies within the guard distance with its corridor free.
 bool clearShot(const ObstacleSummary& obs, Vec2 to_goal);
 
 /// Eq 5.25: progress since the boundary was entered, |x - x_g| < d_tau - margin.

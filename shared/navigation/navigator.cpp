@@ -42,6 +42,7 @@ void Navigator::setGoal(Vec2 goal) {
   side_ = FollowSide::kNone;
   d_tau_m_ = std::numeric_limits<double>::infinity();
   heading_pid_ = {};
+  has_boundary_point_ = false;
   resetCounters();
 }
 
@@ -58,8 +59,28 @@ void Navigator::reset() {
   side_ = FollowSide::kNone;
   d_tau_m_ = std::numeric_limits<double>::infinity();
   heading_pid_ = {};
+  has_boundary_point_ = false;
   resetCounters();
   out_ = {};
+}
+
+ObstacleSummary Navigator::boundaryView(const control::Pose2& pose) {
+  ObstacleSummary o = obs_;
+  SideView& v = side_ == FollowSide::kClockwise ? o.right : o.left;
+  const Vec2 x{pose.x_m, pose.y_m};
+  if (norm(v.avoid) > 0.0) {
+    boundary_point_ = x - v.distance_m * v.avoid;  // x_o of Eq 5.20
+    has_boundary_point_ = true;
+  } else if (has_boundary_point_ && norm(x - boundary_point_) < v.nearest_m) {
+    // Rounding the end of a thin wall, the end falls into the blind sector
+    // behind the side sonar and leaves the memory after memory_s, long before
+    // the half turn round it is done; without it the robot curved off toward
+    // whatever else it remembered. The last x_o stays the boundary until the
+    // sonars see one again.
+    v.avoid = normalized(x - boundary_point_);
+    v.distance_m = norm(x - boundary_point_);
+  }
+  return o;
 }
 
 void Navigator::switchTo(Mode m) {
@@ -72,6 +93,7 @@ void Navigator::switchTo(Mode m) {
   mode_since_s_ = time_s_;
   out_.switched = true;
   heading_pid_ = {};  // a new behaviour starts without the old one's integral or derivative
+  has_boundary_point_ = false;
 }
 
 void Navigator::enterBoundary(const control::Pose2& pose, double distance_to_goal_m, Vec2 to_goal) {
@@ -123,7 +145,7 @@ control::Twist Navigator::command(const control::Pose2& pose, double dt_s) {
       break;
     case Mode::kAvoid: s = avoidSteer(pose, obs_, params_); break;
     case Mode::kFollowCw:
-    case Mode::kFollowCcw: s = followSteer(pose, obs_, side_, params_); break;
+    case Mode::kFollowCcw: s = followSteer(pose, boundaryView(pose), side_, params_); break;
   }
   // Eq 5.13 on the heading error (Eq 5.14). The PID is fed setpoint 0 and
   // measurement -e so that its derivative acts on the wrapped error, never

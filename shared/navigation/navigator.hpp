@@ -73,6 +73,9 @@ class Navigator {
   void switchTo(Mode m);
   void resetCounters();
   control::Twist command(const control::Pose2& pose, double dt_s);
+  /// The summary the followed side is steered by: the last boundary point x_o stands in
+  /// for a boundary that left the memory (the end of a thin wall being rounded).
+  ObstacleSummary boundaryView(const control::Pose2& pose);
 
   NavigationParams params_;
   config::UltrasonicConfig sonar_;
@@ -87,6 +90,8 @@ class Navigator {
   Mode mode_ = Mode::kAtGoal;
   FollowSide side_ = FollowSide::kNone;
   double d_tau_m_ = std::numeric_limits<double>::infinity();
+  Vec2 boundary_point_;              // last x_o of the followed boundary (odometry frame)
+  bool has_boundary_point_ = false;  // ... since the current follow mode was entered
   double time_s_ = 0.0;
   double mode_since_s_ = 0.0;
   double last_switch_s_ = -std::numeric_limits<double>::infinity();

@@ -152,6 +152,11 @@ ObstacleSummary summarise(const ObstacleMemory& memory, const control::Pose2& po
   ObstacleSummary s;
   const Vec2 x{pose.x_m, pose.y_m};
   const Vec2 to_goal = normalized(goal - x);
+  const double goal_m = norm(goal - x);
+  // The corridor ends at the goal: the robot stops there, so what lies beyond
+  // (the wall behind a goal placed near it) is not in its way.
+  const double corridor_m = std::min(params.guard_distance_m, goal_m);
+  s.goal_near = goal_m <= params.guard_distance_m;
   const double dc = params.caution_distance_m;
   const double fc = params.follow_caution_m;
   Vec2 sum;
@@ -196,10 +201,11 @@ ObstacleSummary summarise(const ObstacleMemory& memory, const control::Pose2& po
       if (v.on_left) left.add(recency * closeness, closeness, unit_away, p - x);
     }
     // Corridor toward the goal: a point ahead along the goal direction,
-    // within the guard distance and closer to that line than the half width.
+    // within the guard distance, short of the goal and closer to that line
+    // than the half width.
     const Vec2 rel = p - x;
     const double along = dot(rel, to_goal);
-    if (along > 0.0 && along < params.guard_distance_m &&
+    if (along > 0.0 && along < corridor_m &&
         std::abs(cross(to_goal, rel)) < params.clear_shot_half_width_m)
       s.goal_blocked = true;
   }

@@ -61,7 +61,9 @@ struct ObstacleSummary {
   Vec2 avoid;                  // Eq 5.20 over the points within caution distance: closeness-weighted
                                // mean of unit (x - x_o); |avoid| <= 1, zero when none
   int points_in_caution = 0;   // points that made `avoid`
-  bool goal_blocked = false;   // a point lies in the corridor toward the goal within the guard distance
+  bool goal_blocked = false;   // a point lies in the corridor toward the goal, within the guard distance
+                               // and short of the goal (a point beyond the goal is not in the way)
+  bool goal_near = false;      // the goal lies within the guard distance: that corridor covers the whole way
   SideView right;              // bearings <= +follow_front_sector_rad (obstacle followed clockwise)
   SideView left;               // bearings >= -follow_front_sector_rad (obstacle followed counter-clockwise)
 };

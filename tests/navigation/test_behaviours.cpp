@@ -214,6 +214,7 @@ struct ClearCase {
   bool blocked;
   Vec2 to_goal;
   bool clear;
+  bool goal_near = false;  // the goal lies within the guard distance
 };
 
 std::ostream& operator<<(std::ostream& os, const ClearCase& c) { return os << c.name; }
@@ -226,6 +227,7 @@ TEST_P(ClearShotTable, AvoidAndGoalMakeAnAcuteAngle) {
   s.any = norm(c.avoid) > 0.0;
   s.avoid = c.avoid;
   s.goal_blocked = c.blocked;
+  s.goal_near = c.goal_near;
   EXPECT_EQ(clearShot(s, c.to_goal), c.clear);
 }
 
@@ -236,7 +238,11 @@ INSTANTIATE_TEST_SUITE_P(Eq5_27, ClearShotTable,
                                            ClearCase{"acute", {1, -1}, false, {1, 0}, true},
                                            ClearCase{"obtuse", {-1, -1}, false, {1, 0}, false},
                                            ClearCase{"perpendicular_is_not_clear", {0, -1}, false, {1, 0}, false},
-                                           ClearCase{"corridor_blocked", {1, 0}, true, {1, 0}, false}),
+                                           ClearCase{"corridor_blocked", {1, 0}, true, {1, 0}, false},
+                                           // A near goal with a free corridor: nothing is in the way,
+                                           // even with the obstacles pushing across the goal direction.
+                                           ClearCase{"near_goal_free", {-1, -1}, false, {1, 0}, true, true},
+                                           ClearCase{"near_goal_blocked", {1, 0}, true, {1, 0}, false, true}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 struct ProgressCase {

@@ -120,6 +120,10 @@ TEST(Summary, PointAheadPushesBackAndBlocksTheGoal) {
   EXPECT_TRUE(s.goal_blocked);
   // The same point seen with the goal to the side is out of the corridor.
   EXPECT_FALSE(summarise(m, {0, 0, 0}, {0, 5}, 0.0, p).goal_blocked);
+  // A point beyond the goal is not in the way: the robot stops at the goal.
+  EXPECT_FALSE(summarise(m, {0, 0, 0}, {0.5, 0}, 0.0, p).goal_blocked);
+  EXPECT_TRUE(summarise(m, {0, 0, 0}, {0.5, 0}, 0.0, p).goal_near);
+  EXPECT_FALSE(s.goal_near);
   // Beyond the caution distance it is remembered but does not push.
   ObstacleMemory far;
   far.add({1.6, 0.0}, 0.0);

@@ -2,11 +2,17 @@
 // answers like a robot through the registry.
 #include <gtest/gtest.h>
 
+#include <stdlib.h>
+
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <fstream>
 #include <sstream>
 #include <thread>
 
 #include "pc_server/console.hpp"
+#include "pc_server/route_file.hpp"
 #include "shared/util/clock.hpp"
 
 using namespace inspect;
@@ -364,4 +370,175 @@ TEST_F(ConsoleTest, ExpectRobotsWorksWithoutSelection) {
   connectRobot("r2");
   std::tie(ok, out) = run("expect robots == 2");
   EXPECT_TRUE(ok) << out;
+}
+
+// --- navigation: goto, route, nav telemetry ---
+
+namespace {
+
+// A file in a fresh temporary directory, removed with the object.
+struct TempFile {
+  std::string path;
+  explicit TempFile(const std::string& name, const std::string& text) {
+    char dir[] = "/tmp/console_route_XXXXXX";
+    path = std::string(::mkdtemp(dir)) + "/" + name;
+    std::ofstream(path) << text;
+  }
+  ~TempFile() {
+    std::remove(path.c_str());
+    std::remove(path.substr(0, path.rfind('/')).c_str());
+  }
+};
+
+void navTelemetry(RobotRegistry& registry, const std::string& nav_mode) {
+  v1::Telemetry t;
+  t.set_mode(nav_mode.empty() ? v1::IDLE : v1::NAVIGATING);
+  t.set_nav_mode(nav_mode);
+  t.set_goal_distance_m(1.25);
+  t.set_goal_index(1);
+  t.set_goal_count(3);
+  t.set_nav_switches(4);
+  registry.onTelemetry("robot1", kSerial, t, monoNowNs());
+}
+
+}  // namespace
+
+TEST_F(ConsoleTest, GotoSendsOneGoalAndReportsCompletion) {
+  connectRobot();
+  auto [ok, out] = run("goto 2 -1.5 0.3");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_EQ(out, "robot1: goto accepted\n");
+  ASSERT_EQ(sink_.sent.size(), 1u);
+  const auto& g = sink_.sent[0].go_to();
+  ASSERT_EQ(g.points_size(), 1);
+  EXPECT_DOUBLE_EQ(g.points(0).x_m(), 2.0);
+  EXPECT_DOUBLE_EQ(g.points(0).y_m(), -1.5);
+  EXPECT_DOUBLE_EQ(g.speed_m_s(), 0.3);
+  EXPECT_EQ(g.name(), "");
+  // The robot's second Ack, COMPLETED with the same id, is printed once when it comes.
+  v1::Ack done;
+  done.set_command_id(1);
+  done.set_status(v1::Ack::COMPLETED);
+  registry_.onAck("robot1", kSerial, done);
+  std::tie(ok, out) = run("echo x");
+  EXPECT_EQ(out, "robot1: goto completed\nx\n");
+  std::tie(ok, out) = run("echo y");
+  EXPECT_EQ(out, "y\n");
+  // Without a speed the robot's default is asked for (0).
+  std::tie(ok, out) = run("goto 1 1");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_DOUBLE_EQ(sink_.sent.back().go_to().speed_m_s(), 0.0);
+}
+
+TEST_F(ConsoleTest, GotoSyntaxErrorsNameTheProblem) {
+  connectRobot();
+  struct Case {
+    const char* line;
+    const char* message;
+  };
+  for (const Case& c : {Case{"goto 1", "goto: needs two or three numbers: goto <x_m> <y_m> [speed_m_s]\n"},
+                        Case{"goto 1 2 3 4", "goto: needs two or three numbers: goto <x_m> <y_m> [speed_m_s]\n"},
+                        Case{"goto a 1", "goto: 'a' is not a number\n"},
+                        Case{"goto 1 nan", "goto: 'nan' is not a number\n"},
+                        Case{"goto 1 1 2", "goto: speed 2 m/s is outside (0, 1]\n"},
+                        Case{"goto 1 1 0", "goto: speed 0 m/s is outside (0, 1]\n"},
+                        Case{"goto 5000 0", "goto: x and y must be in [-1000, 1000] m\n"}}) {
+    const auto [ok, out] = run(c.line);
+    EXPECT_FALSE(ok) << c.line;
+    EXPECT_EQ(out, c.message) << c.line;
+  }
+  EXPECT_TRUE(sink_.sent.empty());
+  sink_.reply = v1::Ack::REJECTED;
+  sink_.reason = "e-stop latched: resume first";
+  const auto [ok, out] = run("goto 1 1");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "robot1: goto rejected: e-stop latched: resume first\n");
+}
+
+TEST_F(ConsoleTest, RouteFileIsSentAsOneGoTo) {
+  connectRobot();
+  const TempFile f("tour.yaml", "name: tour\nspeed_m_s: 0.4\nwaypoints_m: [1, 0,  1, 1.5,  0, 1.5]\n");
+  auto [ok, out] = run("route " + f.path);
+  EXPECT_TRUE(ok) << out;
+  EXPECT_EQ(out, "route 'tour': 3 points at 0.4 m/s\nrobot1: route accepted\n");
+  ASSERT_EQ(sink_.sent.size(), 1u);
+  const auto& g = sink_.sent[0].go_to();
+  EXPECT_EQ(g.name(), "tour");
+  EXPECT_DOUBLE_EQ(g.speed_m_s(), 0.4);
+  ASSERT_EQ(g.points_size(), 3);
+  EXPECT_DOUBLE_EQ(g.points(1).x_m(), 1.0);
+  EXPECT_DOUBLE_EQ(g.points(1).y_m(), 1.5);
+  // Name and speed are optional: the file name, the robot's speed.
+  const TempFile bare("loop.yaml", "waypoints_m: [2, 0]\n");
+  std::tie(ok, out) = run("route " + bare.path);
+  EXPECT_TRUE(ok) << out;
+  EXPECT_EQ(sink_.sent.back().go_to().name(), "loop");
+  EXPECT_DOUBLE_EQ(sink_.sent.back().go_to().speed_m_s(), 0.0);
+}
+
+TEST_F(ConsoleTest, ShippedExampleRouteLoads) {
+  const Route r = loadRouteFile(std::string(INSPECT_SOURCE_DIR) + "/config/routes/warehouse_tour.yaml");
+  EXPECT_EQ(r.name, "warehouse_tour");
+  EXPECT_GE(r.waypoints_m.size(), 4u);
+  EXPECT_EQ(r.waypoints_m.size() % 2, 0u);
+}
+
+TEST_F(ConsoleTest, BadRouteFileIsOneLineNamingFileAndKey) {
+  connectRobot();
+  struct Case {
+    const char* yaml;
+    const char* key_and_reason;
+  };
+  std::string hundred_and_one = "waypoints_m: [";
+  for (int i = 0; i < 101; ++i) hundred_and_one += std::string(i ? ", " : "") + "1, 1";
+  hundred_and_one += "]\n";
+  for (const Case& c : {Case{"waypoint_m: [1, 1]\n", "waypoints_m: required list"},
+                        Case{"waypoints_m: [1, 1]\nspeed: 0.3\n", "speed: unknown key"},
+                        Case{"waypoints_m: [1, 1, 2]\n", "waypoints_m: 3 numbers: needs pairs x, y"},
+                        Case{"waypoints_m: []\n", "waypoints_m: needs at least one point"},
+                        Case{"waypoints_m: [1, .nan]\n", "waypoints_m: element 1 must be finite"},
+                        Case{"waypoints_m: [1, .inf]\n", "waypoints_m: element 1 must be finite"},
+                        Case{"waypoints_m: [1, x]\n", "waypoints_m: element 1 is not a number"},
+                        Case{"waypoints_m: [1, 1]\nspeed_m_s: 3\n", "speed_m_s:"},
+                        Case{"waypoints_m: [1, 1]\nspeed_m_s: 0\n", "speed_m_s: must be > 0"},
+                        Case{hundred_and_one.c_str(), "waypoints_m: 101 points: at most 100"}}) {
+    const TempFile f("bad.yaml", c.yaml);
+    const auto [ok, out] = run("route " + f.path);
+    EXPECT_FALSE(ok) << c.yaml;
+    EXPECT_EQ(out.rfind("route: " + f.path + ": " + c.key_and_reason, 0), 0u) << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  }
+  auto [ok, out] = run("route /nonexistent/route.yaml");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "route: /nonexistent/route.yaml: cannot open file\n");
+  std::tie(ok, out) = run("route");
+  EXPECT_EQ(out, "route: needs one file: route <file>\n");
+  EXPECT_TRUE(sink_.sent.empty());
+}
+
+TEST_F(ConsoleTest, ExpectNavigationFieldsAndStatusLine) {
+  connectRobot();
+  navTelemetry(registry_, "FOLLOW_CW");
+  auto [ok, out] = run("expect nav_mode == FOLLOW_CW");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_HAS(out, "nav_mode = FOLLOW_CW");
+  std::tie(ok, out) = run("expect nav_mode == follow_ccw", 5);
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "EXPECT FAILED (line 5): nav_mode = FOLLOW_CW, wanted == follow_ccw\n");
+  std::tie(ok, out) = run("expect nav_mode == SIDEWAYS");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "or a navigation mode (NONE, GO_TO_GOAL");
+  EXPECT_TRUE(run("expect goal_dist ~ 1.25 0.01").first);
+  EXPECT_TRUE(run("expect goal_index == 1").first);
+  EXPECT_TRUE(run("expect goal_count == 3").first);
+  EXPECT_TRUE(run("expect nav_switches >= 4").first);
+  EXPECT_TRUE(run("expect mode == NAVIGATING").first);
+  std::tie(ok, out) = run("status");
+  EXPECT_HAS(out, "robot1 | NAVIGATING | ");
+  EXPECT_HAS(out, " | nav FOLLOW_CW goal 2/3 1.25 m sw 4 | ");
+  navTelemetry(registry_, "");
+  std::tie(ok, out) = run("expect nav_mode == NONE");
+  EXPECT_TRUE(ok) << out;
+  std::tie(ok, out) = run("status");
+  EXPECT_EQ(out.find(" nav "), std::string::npos) << out;
 }

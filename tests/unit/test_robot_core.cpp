@@ -38,6 +38,7 @@ struct Harness {
   serial::WheelCommand last;
 
   Harness() {
+    f.ultrasonic_mm.fill(serial::kNoEcho);  // nothing in range unless a test says so
     core.onSerialState(true, 0.0);
     core.onLinkUp(0.0);
   }
@@ -195,6 +196,24 @@ v1::Command trackLine(uint64_t id, double len, double v, const std::string& cont
   return c;
 }
 }  // namespace
+
+TEST(RobotCore, TrackingStopsForAnythingCloseAheadAndGoesOnWhenItClears) {
+  Harness h;
+  h.run(0.05);
+  ASSERT_EQ(h.core.onCommand(trackLine(3, 3.0, 0.3, "direct"), h.t).status(), v1::Ack::ACCEPTED);
+  h.run(1.0);
+  EXPECT_GT(h.core.commandedTwist().v_m_s, 0.2);
+  h.f.ultrasonic_mm[serial::kFrontRight] = 300;  // a box 0.30 m ahead of the sensor
+  h.run(1.0);
+  EXPECT_LT(std::abs(h.core.commandedTwist().v_m_s), 0.02);
+  EXPECT_EQ(h.core.mode(), v1::TRACKING) << "a stop on the path, not the end of the run";
+  bool told = false;
+  for (const auto& e : h.core.takeEvents()) told = told || e.text.find("obstacle 30 cm ahead") != std::string::npos;
+  EXPECT_TRUE(told);
+  h.f.ultrasonic_mm[serial::kFrontRight] = serial::kNoEcho;
+  h.run(1.5);
+  EXPECT_GT(h.core.commandedTwist().v_m_s, 0.2);
+}
 
 TEST(RobotCore, TrackingRunsAPathAndAcksCompletion) {
   Harness h;

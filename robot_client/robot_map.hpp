@@ -1,0 +1,16 @@
+#pragma once
+// The robot's static map for people tracking: the walls and obstacle edges of
+// a world file, in the robot's odometry frame.
+#include <vector>
+
+#include "shared/behavior/human_tracker.hpp"
+#include "sim/world.hpp"
+
+namespace inspect::client {
+
+/// Every wall segment and obstacle edge of `w` (sim::solidEdges), moved from
+/// the world frame into the odometry frame of a robot started at `w.start`
+/// (origin and x axis = the start pose), ready for behavior::HumanAwareness.
+std::vector<behavior::MapSegment> mapFromWorld(const sim::World& w);
+
+}  // namespace inspect::client
