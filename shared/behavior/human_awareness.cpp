@@ -3,8 +3,25 @@
 #include <sys/stat.h>
 
 #include <cmath>
+#include <stdexcept>
 
 namespace inspect::behavior {
+
+const char* toString(SpeedPolicy p) {
+  switch (p) {
+    case SpeedPolicy::kFuzzy: return "fuzzy";
+    case SpeedPolicy::kNone: return "none";
+    case SpeedPolicy::kStopAndWait: return "stop_and_wait";
+  }
+  return "?";
+}
+
+SpeedPolicy parseSpeedPolicy(const std::string& s) {
+  if (s == "fuzzy") return SpeedPolicy::kFuzzy;
+  if (s == "none") return SpeedPolicy::kNone;
+  if (s == "stop_and_wait") return SpeedPolicy::kStopAndWait;
+  throw std::invalid_argument("unknown speed policy '" + s + "' (fuzzy, none or stop_and_wait)");
+}
 
 HumanAwareness::HumanAwareness(const config::UltrasonicConfig& sonar, const AwarenessConfig& cfg,
                                SpeedStrategy strategy, std::vector<MapSegment> map)
@@ -14,6 +31,12 @@ const Awareness& HumanAwareness::step(const control::Pose2& pose, const std::arr
   const double dt = last_t_s_ < 0 ? 0.0 : std::max(0.0, t_s - last_t_s_);
   last_t_s_ = t_s;
   tracker_.step(pose, ranges_m, t_s);
+  if (dt > 0) {  // the robot's own velocity, for the person's range rate
+    constexpr double kAlpha = 0.2;
+    robot_vx_ += kAlpha * ((pose.x_m - last_pose_.x_m) / dt - robot_vx_);
+    robot_vy_ += kAlpha * ((pose.y_m - last_pose_.y_m) / dt - robot_vy_);
+  }
+  last_pose_ = pose;
   Awareness a;
   int people = 0;
   for (const auto& t : tracker_.tracks()) people += t.isPerson() ? 1 : 0;
@@ -23,13 +46,34 @@ const Awareness& HumanAwareness::step(const control::Pose2& pose, const std::arr
     a.distance_m = std::hypot(n->x[0] - pose.x_m, n->x[1] - pose.y_m);
     a.person_speed_m_s = n->speed();
     a.pattern = classifier_.step(pose, n->x[0], n->x[1], n->x[2], n->x[3], dt);
+    const double rx = n->x[0] - pose.x_m, ry = n->x[1] - pose.y_m;
+    const double d = std::max(std::hypot(rx, ry), 1e-6);
+    a.range_rate_m_s = (rx * (n->x[2] - robot_vx_) + ry * (n->x[3] - robot_vy_)) / d;
+    const double ahead = rx * std::cos(pose.theta_rad) + ry * std::sin(pose.theta_rad);
+    a.passing = ahead < cfg_.passing_ahead_m && a.range_rate_m_s > cfg_.passing_rate_m_s;
   } else {
     a.pattern = classifier_.stepNone(dt);
   }
   // A person without a settled pattern still slows the robot as the most
   // cautious pattern would (crossing/confronting share the cautious ramp).
   const Pattern for_speed = a.person && a.pattern == Pattern::kNone ? Pattern::kConfronting : a.pattern;
-  a.speed_factor = !cfg_.enabled || !a.person ? 1.0 : strategy_.speedFactor(a.distance_m, a.person_speed_m_s, for_speed);
+  const SpeedPolicy policy = cfg_.enabled ? cfg_.policy : SpeedPolicy::kNone;
+  if (!a.person || policy == SpeedPolicy::kNone) {
+    a.target_factor = 1.0;
+  } else if (policy == SpeedPolicy::kStopAndWait) {
+    a.target_factor = a.distance_m < cfg_.speed.max_avoidance_m ? 0.0 : 1.0;
+  } else if (a.passing) {
+    a.target_factor = 1.0;  // beside or behind and moving away: no longer interfering
+  } else {
+    a.target_factor = strategy_.speedFactor(a.distance_m, a.person_speed_m_s, for_speed);  // Eq 9
+  }
+  // Rate limit (no speed steps); the first tick takes the target as it is.
+  a.speed_factor = a.target_factor;
+  if (dt > 0) {
+    const double prev = last_.speed_factor;
+    if (cfg_.factor_fall_per_s > 0) a.speed_factor = std::max(a.speed_factor, prev - cfg_.factor_fall_per_s * dt);
+    if (cfg_.factor_rise_per_s > 0) a.speed_factor = std::min(a.speed_factor, prev + cfg_.factor_rise_per_s * dt);
+  }
   last_ = a;
   return last_;
 }
@@ -38,12 +82,23 @@ AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::s
   AwarenessConfig c;
   const auto a = root.optChild("awareness");
   c.enabled = a.boolean("enabled", c.enabled);
+  if (a.has("policy")) {
+    try {
+      c.policy = parseSpeedPolicy(a.string("policy", "fuzzy"));
+    } catch (const std::invalid_argument& e) {
+      a.fail("policy", e.what());
+    }
+  }
   c.speed_fis = a.string("speed_fis", c.speed_fis);
   struct stat st {};
   if (!c.speed_fis.empty() && c.speed_fis[0] != '/' && ::stat(c.speed_fis.c_str(), &st) != 0) {
     const std::string alt = base_dir + "/../" + c.speed_fis;
     if (::stat(alt.c_str(), &st) == 0) c.speed_fis = alt;
   }
+  c.factor_fall_per_s = a.number("factor_fall_per_s", c.factor_fall_per_s, 0, 100);
+  c.factor_rise_per_s = a.number("factor_rise_per_s", c.factor_rise_per_s, 0, 100);
+  c.passing_ahead_m = a.number("passing_ahead_m", c.passing_ahead_m, -5, 5);
+  c.passing_rate_m_s = a.number("passing_rate_m_s", c.passing_rate_m_s, 0, 5);
   c.speed.max_avoidance_m = a.number("max_avoidance_m", c.speed.max_avoidance_m, 0.5, 10.0);
   c.speed.sensitive_m = a.number("sensitive_m", c.speed.sensitive_m, 0.1, 5.0);
   const auto t = root.optChild("tracker");
@@ -54,8 +109,10 @@ AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::s
   c.tracker.coast_s = t.number("coast_s", c.tracker.coast_s, 0.05, 10);
   c.tracker.min_person_speed_m_s = t.number("min_person_speed_m_s", c.tracker.min_person_speed_m_s, 0, 2);
   c.tracker.static_after_s = t.number("static_after_s", c.tracker.static_after_s, 0.1, 60);
+  c.tracker.person_hold_s = t.number("person_hold_s", c.tracker.person_hold_s, 0.1, 3600);
   c.tracker.moving_for_s = t.number("moving_for_s", c.tracker.moving_for_s, 0, 10);
   c.tracker.grid_static_s = t.number("grid_static_s", c.tracker.grid_static_s, 0.1, 60);
+  c.tracker.triangulate_front = t.boolean("triangulate_front", c.tracker.triangulate_front);
   const auto p = root.optChild("pattern");
   c.pattern.min_speed_m_s = p.number("min_speed_m_s", c.pattern.min_speed_m_s, 0, 2);
   c.pattern.crossing_deg = p.number("crossing_deg", c.pattern.crossing_deg, 45, 90);

@@ -17,8 +17,30 @@
 
 namespace inspect::behavior {
 
+/// How people change the robot's speed.
+enum class SpeedPolicy {
+  kFuzzy,        // the paper's strategy: Eq 9 factor from distance, speed and pattern
+  kNone,         // baseline: people are tracked and reported, the speed is never changed
+  kStopAndWait,  // baseline: stop while anyone is within max_avoidance_m, full speed otherwise
+};
+const char* toString(SpeedPolicy p);
+/// Parses "fuzzy", "none", "stop_and_wait"; throws std::invalid_argument otherwise.
+SpeedPolicy parseSpeedPolicy(const std::string& s);
+
 struct AwarenessConfig {
-  bool enabled = true;
+  bool enabled = true;  // false = SpeedPolicy::kNone
+  SpeedPolicy policy = SpeedPolicy::kFuzzy;
+  // The factor applied moves toward the rule base's output at most this fast,
+  // so the robot's speed has no steps (jerk); falling 2/s stops from full
+  // speed within 0.5 s. 0 = no limit.
+  double factor_fall_per_s = 2.0;
+  double factor_rise_per_s = 0.5;
+  // A person beside or behind the robot (ahead of the axle by less than
+  // passing_ahead_m) whose distance grows faster than passing_rate_m_s is
+  // passing: they no longer interfere and the fuzzy policy keeps full speed
+  // (the paper's robot "returns to its initial speed after the person passes").
+  double passing_ahead_m = 0.2;
+  double passing_rate_m_s = 0.1;
   std::string speed_fis = "config/fuzzy/speed_strategy.fis";
   SpeedStrategyParams speed;
   HumanTrackerParams tracker;
@@ -31,8 +53,11 @@ struct Awareness {
   bool person = false;
   double distance_m = -1.0;      // to the nearest tracked person (centre), < 0 = none
   double person_speed_m_s = 0.0;
-  double speed_factor = 1.0;     // Eq 9: 1 - dV
+  double speed_factor = 1.0;     // Eq 9: 1 - dV, rate-limited: the factor applied
+  double target_factor = 1.0;    // this tick's output of the policy before the rate limit
   int people = 0;                // confirmed people tracked
+  bool passing = false;          // the nearest person is passing (beside or behind, moving away)
+  double range_rate_m_s = 0.0;   // d(distance)/dt of the nearest person, > 0 = moving apart
 };
 
 class HumanAwareness {
@@ -52,6 +77,8 @@ class HumanAwareness {
   SpeedStrategy strategy_;
   Awareness last_;
   double last_t_s_ = -1.0;
+  control::Pose2 last_pose_;
+  double robot_vx_ = 0.0, robot_vy_ = 0.0;  // low-passed from the pose (odometry frame)
 };
 
 /// Reads the `awareness:` settings (config/behavior.yaml); `base_dir` resolves a relative .fis path.

@@ -13,6 +13,12 @@ double segmentDistance(const MapSegment& s, double x, double y) {
   u = std::clamp(u, 0.0, 1.0);
   return std::hypot(x - (s.x0 + u * dx), y - (s.y0 + u * dy));
 }
+
+Eigen::Matrix2d beamCovariance(double yaw, double along, double across) {
+  Eigen::Matrix2d rot;
+  rot << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
+  return rot * Eigen::Vector2d(along * along, across * across).asDiagonal() * rot.transpose();
+}
 }  // namespace
 
 HumanTracker::HumanTracker(const config::UltrasonicConfig& sonar, const HumanTrackerParams& params,
@@ -21,6 +27,43 @@ HumanTracker::HumanTracker(const config::UltrasonicConfig& sonar, const HumanTra
       grid_(static_cast<std::size_t>(params.grid_size) * static_cast<std::size_t>(params.grid_size)) {
   tracks_.reserve(static_cast<std::size_t>(p_.max_tracks));
   grid_origin_x_ = grid_origin_y_ = -0.5 * p_.grid_size * p_.grid_cell_m;
+}
+
+std::optional<std::pair<Eigen::Vector2d, Eigen::Matrix2d>> HumanTracker::triangulate(const control::Pose2& pose,
+                                                                                     double r0, double r1) const {
+  const auto& m0 = sonar_.mounts[0];
+  const auto& m1 = sonar_.mounts[1];
+  if (std::abs(m0.yaw_rad - m1.yaw_rad) > 1e-6) return std::nullopt;  // not a parallel pair
+  // Beam frame of the pair: u along the beams, w across (left positive).
+  const double cy = std::cos(m0.yaw_rad), sy = std::sin(m0.yaw_rad);
+  const double u0 = cy * m0.x_m + sy * m0.y_m, w0 = -sy * m0.x_m + cy * m0.y_m;
+  const double u1 = cy * m1.x_m + sy * m1.y_m, w1 = -sy * m1.x_m + cy * m1.y_m;
+  const double base = w1 - w0;
+  if (std::abs(base) < 0.05 || std::abs(u0 - u1) > 0.02) return std::nullopt;
+  if (std::abs(r0 - r1) >= std::abs(base)) return std::nullopt;  // no common point: two objects
+  const double w = (r0 * r0 - r1 * r1 + w1 * w1 - w0 * w0) / (2 * base);
+  const double du2 = r0 * r0 - (w - w0) * (w - w0);
+  if (du2 <= 0) return std::nullopt;
+  const double u = 0.5 * (u0 + u1) + std::sqrt(du2);
+  const double half = sonar_.beam_width_rad / 2;
+  const double uc = 0.5 * (u0 + u1);
+  // Range noise can put the solution outside the cones: the object is in both,
+  // so clamp it to their overlap at that distance.
+  const double reach = (u - uc) * std::tan(half);
+  const double lo = std::max(w0, w1) - reach, hi = std::min(w0, w1) + reach;
+  if (lo > hi) return std::nullopt;  // the cones do not overlap yet at this distance
+  const double wc = std::clamp(w, lo, hi);
+  // Robot frame, then odometry frame.
+  const double rx = cy * u - sy * wc, ry = sy * u + cy * wc;
+  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  const Eigen::Vector2d z(pose.x_m + c * rx - s * ry, pose.y_m + s * rx + c * ry);
+  // Lateral sigma from the two range errors (uniform +-range_sigma: sigma / sqrt 3),
+  // never worse than a single cone.
+  const double sr = std::max(p_.range_sigma_m, 0.01) / std::sqrt(3.0);
+  const double mean_r = 0.5 * (r0 + r1);
+  const double across = std::clamp(std::hypot(r0, r1) * sr / std::abs(base), 0.03,
+                                   std::max(0.05, mean_r * std::tan(half) / 2));
+  return std::make_pair(z, beamCovariance(pose.theta_rad + m0.yaw_rad, std::max(p_.range_sigma_m, 0.01), across));
 }
 
 bool HumanTracker::nearMap(double x, double y) const {
@@ -70,6 +113,15 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
   last_t_s_ = t_s;
   if (dt > 0) predict(dt);
   const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  person_echo_.fill(false);
+  // 1. Echoes to points; drop those explained by the map or by persistence.
+  struct Echo {
+    bool use = false;
+    Eigen::Vector2d z;
+    Eigen::Matrix2d r;
+    double range = 0;
+  };
+  std::array<Echo, 4> echo{};
   for (std::size_t i = 0; i < 4; ++i) {
     const double r = ranges_m[i];
     if (!(r > 0) || !std::isfinite(r) || r >= sonar_.max_range_m) continue;
@@ -91,8 +143,12 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
       continue;
     }
     // Persistence: a person passes through a 0.2 m cell in well under a
-    // second; structure keeps being hit in the same place for longer.
-    if (Cell* ce = cell(px, py)) {
+    // second; structure keeps being hit in the same place for longer. Echoes
+    // at a tracked person are exempt: a person who stops is still a person.
+    bool at_person = false;
+    for (const auto& t : tracks_)
+      at_person = at_person || (t.isPerson() && std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m);
+    if (Cell* ce = cell(px, py); ce && !at_person) {
       const auto now = static_cast<float>(t_s);
       if (ce->last_s < 0 || now - ce->last_s > p_.grid_forget_s) ce->first_s = now;
       ce->last_s = now;
@@ -104,34 +160,87 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     // Measurement covariance: range noise along the beam, the cone's width across it.
     const double along = std::max(p_.range_sigma_m, 0.01);
     const double across = std::max(0.05, r * std::tan(sonar_.beam_width_rad / 2) / 2);
-    Eigen::Matrix2d rot;
-    rot << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
-    const Eigen::Matrix2d rm = rot * Eigen::Vector2d(along * along, across * across).asDiagonal() * rot.transpose();
-    const Eigen::Vector2d z(px, py);
+    echo[i] = {true, Eigen::Vector2d(px, py), beamCovariance(yaw, along, across), r};
+  }
+  // 2a. Only one of the two front sensors hears the object: it is more likely
+  // on that sensor's outer side (the other cone covers the inner side).
+  if (p_.triangulate_front && echo[0].use != echo[1].use && !(ranges_m[0] > 0 && ranges_m[1] > 0)) {
+    const std::size_t i = echo[0].use ? 0 : 1, o = 1 - i;
+    const auto& mi = sonar_.mounts[i];
+    const auto& mo = sonar_.mounts[o];
+    if (std::abs(mi.yaw_rad - mo.yaw_rad) < 1e-6) {
+      const double side = (mi.y_m - mo.y_m) * std::cos(mi.yaw_rad) - (mi.x_m - mo.x_m) * std::sin(mi.yaw_rad);
+      const double r = echo[i].range, half = sonar_.beam_width_rad / 2;
+      const double shift = std::copysign(r * std::tan(half) / 2, side);  // centre of the outer half
+      const double yaw = pose.theta_rad + mi.yaw_rad;
+      echo[i].z += Eigen::Vector2d(-std::sin(yaw), std::cos(yaw)) * shift;
+      echo[i].r = beamCovariance(yaw, std::max(p_.range_sigma_m, 0.01), std::max(0.05, r * std::tan(half) / 4));
+    }
+  }
+  // 2. The two front sensors see the same person: the two ranges fix its
+  // bearing (trilateration across the 0.24 m baseline), which the cone alone
+  // cannot; the fused point replaces both.
+  if (p_.triangulate_front && echo[0].use && echo[1].use) {
+    if (const auto fused = triangulate(pose, echo[0].range, echo[1].range)) {
+      echo[0].z = fused->first;
+      echo[0].r = fused->second;
+      echo[1].use = false;
+      ++counters_.triangulated;
+    }
+  }
+  // 3. Association with tracks (nearest within the gate) or a new track.
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (!echo[i].use) continue;
+    const Eigen::Vector2d& z = echo[i].z;
     HumanTrack* best = nullptr;
     double best_d = p_.gate_m;
     for (auto& t : tracks_) {
-      const double d = std::hypot(t.x[0] - px, t.x[1] - py);
+      const double d = std::hypot(t.x[0] - z.x(), t.x[1] - z.y());
       if (d < best_d) {
         best_d = d;
         best = &t;
       }
     }
     if (best) {
-      update(*best, z, rm, t_s);
+      update(*best, z, echo[i].r, t_s);
       ++counters_.associated;
+      const bool person = best->isPerson();
+      person_echo_[i] = person;
+      if (i == 0 && p_.triangulate_front && !echo[1].use && ranges_m[1] > 0) person_echo_[1] = person;
     } else if (static_cast<int>(tracks_.size()) < p_.max_tracks) {
       HumanTrack t;
       t.id = next_id_++;
-      t.x << px, py, 0, 0;
+      t.x << z.x(), z.y(), 0, 0;
       t.p = Eigen::Matrix4d::Zero();
-      t.p.block<2, 2>(0, 0) = rm;
+      t.p.block<2, 2>(0, 0) = echo[i].r;
       t.p(2, 2) = t.p(3, 3) = 1.0;  // unknown velocity: up to ~1-2 m/s
       t.first_seen_s = t.last_seen_s = t_s;
       t.hits = 1;
       tracks_.push_back(t);
       ++counters_.tracks_created;
     }
+  }
+  // 4. Negative information: a sensor whose cone covers a track's predicted
+  // position but hears nothing there (no echo, or one well beyond it) says
+  // the person is not there; a track contradicted on a few ticks in a row is
+  // dropped instead of coasting on a wrong velocity.
+  for (auto& t : tracks_) {
+    if (t.last_seen_s >= t_s) {
+      t.contradicted = 0;
+      continue;
+    }
+    bool contradicted = false;
+    for (std::size_t i = 0; i < 4 && !contradicted; ++i) {
+      const auto& m = sonar_.mounts[i];
+      const double bx = pose.x_m + c * m.x_m - s * m.y_m, by = pose.y_m + s * m.x_m + c * m.y_m;
+      const double dx = t.x[0] - bx, dy = t.x[1] - by, d = std::hypot(dx, dy);
+      if (d < 0.1 || d > sonar_.max_range_m - 0.3) continue;
+      const double bearing = std::remainder(std::atan2(dy, dx) - (pose.theta_rad + m.yaw_rad), 2 * M_PI);
+      if (std::abs(bearing) > 0.6 * sonar_.beam_width_rad / 2) continue;
+      const double r = ranges_m[i];
+      contradicted = !(r > 0) || !std::isfinite(r) || r > d + p_.contradiction_margin_m;
+    }
+    t.contradicted = contradicted ? t.contradicted + 1 : 0;
   }
   // Confirm, reclassify, drop.
   for (auto& t : tracks_) {
@@ -146,10 +255,15 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
       t.slow_since_s = -1;
       if (t.moving_since_s < 0) t.moving_since_s = t_s;
     }
-    // Once a person, a short slow-down (a pause) keeps it one until static_after_s.
+    // Once a person, standing still keeps it one for person_hold_s.
     if (t.confirmed && t.moving_since_s >= 0 && t_s - t.moving_since_s >= p_.moving_for_s) t.person = true;
   }
   std::erase_if(tracks_, [&](const HumanTrack& t) {
+    if (t.contradicted >= p_.contradiction_ticks) {
+      ++counters_.tracks_contradicted;
+      if (!t.confirmed) ++counters_.tracks_unconfirmed_dropped;
+      return true;
+    }
     if (t_s - t.last_seen_s > p_.coast_s) {
       if (!t.confirmed) ++counters_.tracks_unconfirmed_dropped;
       return true;
@@ -158,7 +272,7 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
       ++counters_.tracks_unconfirmed_dropped;
       return true;
     }
-    if (t.slow_since_s >= 0 && t_s - t.slow_since_s > p_.static_after_s) {
+    if (t.slow_since_s >= 0 && t_s - t.slow_since_s > (t.person ? p_.person_hold_s : p_.static_after_s)) {
       ++counters_.tracks_static_dropped;
       return true;
     }

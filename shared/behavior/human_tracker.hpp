@@ -13,6 +13,8 @@
 // as static. Deterministic; time enters as dt; no allocation per step.
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -35,6 +37,7 @@ struct HumanTrackerParams {
   double coast_s = 1.5;               // drop a track not seen for this long
   double min_person_speed_m_s = 0.15; // slower confirmed tracks count as static objects after static_after_s
   double static_after_s = 3.0;
+  double person_hold_s = 30.0;        // a person standing still stays a tracked person this long
   double moving_for_s = 0.3;          // ...and faster ones count as people after moving this long
   double process_accel_m_s2 = 1.0;    // white-acceleration process noise
   double range_sigma_m = 0.03;        // sonar range noise (paper +-0.03 m)
@@ -43,6 +46,9 @@ struct HumanTrackerParams {
   double grid_static_s = 1.5;         // a cell hit continuously for this long is static structure
   double grid_forget_s = 1.0;         // a cell not hit for this long starts afresh
   int max_tracks = 8;
+  bool triangulate_front = true;      // fuse the two front echoes into one point when they agree
+  double contradiction_margin_m = 0.4;  // a sensor hearing this much beyond a track's position contradicts it
+  int contradiction_ticks = 3;        // ...on this many ticks in a row: the track is dropped
 };
 
 /// One tracked object (odometry frame); a person once confirmed and moving.
@@ -56,6 +62,7 @@ struct HumanTrack {
   double slow_since_s = -1;    // time the track became slower than min_person_speed
   double moving_since_s = -1;  // time it became faster
   bool person = false;         // confirmed and moving for moving_for_s
+  int contradicted = 0;        // ticks in a row a sensor looked through its position
   bool isPerson() const { return person; }
   double speed() const { return std::hypot(x[2], x[3]); }
   double positionSigma() const { return std::sqrt(std::max(p(0, 0), p(1, 1))); }
@@ -71,6 +78,8 @@ struct TrackerCounters {
   uint64_t tracks_confirmed = 0;
   uint64_t tracks_unconfirmed_dropped = 0;  // likely false detections
   uint64_t tracks_static_dropped = 0;       // became static objects
+  uint64_t triangulated = 0;                // front echo pairs fused into one point
+  uint64_t tracks_contradicted = 0;         // dropped: a sensor saw through them
 };
 
 class HumanTracker {
@@ -85,6 +94,9 @@ class HumanTracker {
   const TrackerCounters& counters() const { return counters_; }
   /// The confirmed person nearest to `pose` (nullptr if none).
   const HumanTrack* nearest(const control::Pose2& pose) const;
+  /// Per sensor, last step: its echo went to a track that is a person (such
+  /// echoes are people, not obstacles to steer round: they get the Eq 9 factor).
+  const std::array<bool, 4>& personEchoes() const { return person_echo_; }
 
  private:
   void predict(double dt);
@@ -95,6 +107,9 @@ class HumanTracker {
     float last_s = -1.0f;
   };
   Cell* cell(double x, double y);
+  /// The point both front sensors see (odometry frame) and its covariance, when the two ranges agree.
+  std::optional<std::pair<Eigen::Vector2d, Eigen::Matrix2d>> triangulate(const control::Pose2& pose, double r0,
+                                                                          double r1) const;
   void update(HumanTrack& t, const Eigen::Vector2d& z, const Eigen::Matrix2d& r, double t_s);
 
   config::UltrasonicConfig sonar_;
@@ -107,6 +122,7 @@ class HumanTracker {
   double last_t_s_ = 0;
   int next_id_ = 1;
   TrackerCounters counters_;
+  std::array<bool, 4> person_echo_{};
 };
 
 }  // namespace inspect::behavior

@@ -52,6 +52,17 @@ TrackerOutput TrajectoryTracker::step(const Pose2& pose, const WheelSpeeds& meas
                                       double dt_s) {
   TrackerOutput out;
   out.ref = advance(*path_, progress_, speed_factor, dt_s);
+  if (speed_factor < 1.0 && !progress_.done) {
+    // Slowed or stopped for a person: the robot may be ahead of a reference
+    // that slowed faster than the motors could (tau 0.2 s). Move the reference
+    // up to the robot instead of backing the robot up towards someone.
+    const double ahead = std::cos(out.ref.pose.theta_rad) * (pose.x_m - out.ref.pose.x_m) +
+                         std::sin(out.ref.pose.theta_rad) * (pose.y_m - out.ref.pose.y_m);
+    if (ahead > 0.0) {
+      progress_.s_m = std::min(progress_.s_m + ahead, path_->length_m());
+      out.ref = advance(*path_, progress_, speed_factor, 0.0);
+    }
+  }
   out.error = trackingError(pose, out.ref.pose);  // Eq 10
   out.done = progress_.done;
   if (out.done) return out;  // zero command: the path is complete

@@ -1,0 +1,51 @@
+#pragma once
+// Synthetic sonar echoes for the behavior tests: each sensor's nearest hit of
+// 7 rays across its cone against circles (people) and segments (walls), with
+// optional uniform noise, as sim/ultrasonic_model does.
+#include <array>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "shared/behavior/human_tracker.hpp"
+
+namespace inspect::test {
+
+struct Circle {
+  double x, y, r;
+};
+
+// Echo of each sensor: nearest hit of 7 rays across its cone against circles and segments (+- noise).
+inline std::array<double, 4> echoes(const config::UltrasonicConfig& u, const control::Pose2& pose,
+                             const std::vector<Circle>& people, const std::vector<behavior::MapSegment>& walls,
+                             std::mt19937* rng = nullptr) {
+  std::array<double, 4> out{};
+  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  std::uniform_real_distribution<double> noise(-u.noise_m, u.noise_m);
+  for (int i = 0; i < 4; ++i) {
+    const auto& m = u.mounts[static_cast<std::size_t>(i)];
+    const double ox = pose.x_m + c * m.x_m - s * m.y_m, oy = pose.y_m + s * m.x_m + c * m.y_m;
+    double best = u.max_range_m;
+    for (int ray = -3; ray <= 3; ++ray) {
+    const double yaw = pose.theta_rad + m.yaw_rad + ray * u.beam_width_rad / 6.0, dx = std::cos(yaw), dy = std::sin(yaw);
+    for (const auto& p : people) {
+      const double fx = ox - p.x, fy = oy - p.y;
+      const double b = fx * dx + fy * dy, cc = fx * fx + fy * fy - p.r * p.r, disc = b * b - cc;
+      if (disc < 0) continue;
+      const double t = -b - std::sqrt(disc);
+      if (t > 0) best = std::min(best, t);
+    }
+    for (const auto& w : walls) {
+      const double ex = w.x1 - w.x0, ey = w.y1 - w.y0, den = dx * ey - dy * ex;
+      if (std::abs(den) < 1e-12) continue;
+      const double t = ((w.x0 - ox) * ey - (w.y0 - oy) * ex) / den;
+      const double v = ((w.x0 - ox) * dy - (w.y0 - oy) * dx) / den;
+      if (t > 0 && v >= 0 && v <= 1) best = std::min(best, t);
+    }
+    }
+    out[static_cast<std::size_t>(i)] = best < u.max_range_m ? best + (rng ? noise(*rng) : 0.0) : -1.0;
+  }
+  return out;
+}
+
+}  // namespace inspect::test
