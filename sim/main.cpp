@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
     std::unique_ptr<sim::TruthLog> truth;
     if (!opt.truth_path.empty()) truth = std::make_unique<sim::TruthLog>(opt.truth_path);
     sim::Simulation simulation(robot, std::move(world), opt.seed, truth.get());
+    simulation.setPeopleWaitForMotion(opt.people_wait_motion);
     sim::PtyPort port(opt.pty_link);
 
     std::printf("mcu_sim: serial device %s\n", port.slavePath().c_str());

@@ -28,6 +28,9 @@ std::string simUsage() {
          "  --rate F         run F times faster than real time, F in [0.1, 100] (default 1)\n"
          "  --duration S     stop after S seconds of simulated time, S in (0, 1e6] (default: until SIGINT/SIGTERM)\n"
          "  --seed N         seed of the sensor noise, integer >= 0 (default 1)\n"
+         "  --people-wait-motion  pedestrians stand at their start points and their clock (start_s,\n"
+         "                   pauses) starts when the robot is first commanded to move, so a scenario\n"
+         "                   plays the same however long the robot takes to connect\n"
          "  --help           print this help and exit\n";
 }
 
@@ -61,6 +64,8 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     } else if (flag == "--truth") {
       o.truth_path = value();
       if (o.truth_path.empty()) throw UsageError("--truth: empty path");
+    } else if (flag == "--people-wait-motion") {
+      o.people_wait_motion = true;
     } else if (flag == "--rate") {
       o.rate = parseNumber(flag, value(), 0.1, 100.0, "[0.1, 100]");
     } else if (flag == "--duration") {

@@ -23,6 +23,7 @@ struct SimOptions {
   double rate = 1.0;                 // sim seconds per wall second, [0.1, 100]
   std::optional<double> duration_s;  // sim seconds; empty: until SIGINT/SIGTERM
   uint64_t seed = 1;
+  bool people_wait_motion = false;   // pedestrians' clock starts at the robot's first wheel motion
   bool help = false;
 };
 

@@ -84,7 +84,15 @@ void Simulation::step() {
   if (t_ms_ % kFramePeriod_ms == 0) emitFrame();
   const double dt_s = static_cast<double>(kStep_ms) / 1000.0;
   // Both from the state at t: the people react to where the robot is now.
-  crowd_.step(timeS(), dt_s, robotBody());
+  if (people_wait_ && !people_started_) {
+    const auto sp = mcu_.setpoints();
+    if (sp.left_rad_s != 0.0 || sp.right_rad_s != 0.0) {
+      people_started_ = true;
+      people_t0_s_ = timeS();
+      if (observer_) observer_->onEvent(timeS(), "people_clock_start", "first wheel motion");
+    }
+  }
+  if (!people_wait_ || people_started_) crowd_.step(timeS() - people_t0_s_, dt_s, robotBody());
   const auto r = plant_.step(state_, mcu_.setpoints(), dt_s);
   state_ = r.state;
   checkPersonContacts();

@@ -32,6 +32,13 @@ class Simulation {
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
 
+  /// When on, the pedestrians stand at their start points and their clock
+  /// (start_s, pauses) starts at the first non-zero wheel set-point, so that a
+  /// scenario plays the same whenever the robot starts. Off by default.
+  void setPeopleWaitForMotion(bool on) { people_wait_ = on; }
+  /// Sim time at which the pedestrians' clock started (0 unless waiting; < 0 while still waiting).
+  double peopleClockStartS() const { return people_wait_ && !people_started_ ? -1.0 : people_t0_s_; }
+
   /// Bytes from the host, applied at the current sim time.
   void receive(std::span<const uint8_t> bytes);
   /// One 1 ms step: MCU timers, a sensor frame when due, physics (robot and pedestrians).
@@ -74,6 +81,9 @@ class Simulation {
   std::vector<bool> person_contact_;  // per pedestrian: overlapping the robot now
   uint64_t person_collisions_ = 0;
   std::vector<uint8_t> tx_;
+  bool people_wait_ = false;
+  bool people_started_ = false;
+  double people_t0_s_ = 0.0;
 };
 
 }  // namespace inspect::sim

@@ -43,6 +43,13 @@ std::string renderPng(const std::string& png_path, const std::vector<Panel>& pan
   for (std::size_t p = 0; p < panels.size(); ++p) {
     const auto& pa = panels[p];
     g << "unset object\n";
+    g << "unset label\n";
+    for (std::size_t l = 0; l < pa.labels.size(); ++l) {
+      const auto& lb = pa.labels[l];
+      if (!std::isfinite(lb.x) || !std::isfinite(lb.y)) continue;
+      g << "set label " << l + 1 << " " << quote(lb.text) << " at first " << lb.x << ", first " << lb.y
+        << " offset 0.4,0.4 font ',8' tc rgb " << quote(lb.color) << " front\n";
+    }
     g << "set title " << quote(pa.title) << "\n";
     g << "set xlabel " << quote(pa.xlabel) << "\n";
     g << "set ylabel " << quote(pa.ylabel) << "\n";

@@ -25,6 +25,13 @@ struct Band {
   std::string label;
 };
 
+/// A text placed at a data point (e.g. a time mark on a path).
+struct Label {
+  double x = 0, y = 0;
+  std::string text;
+  std::string color = "#333333";
+};
+
 /// One panel of a figure.
 struct Panel {
   std::string title;
@@ -32,6 +39,7 @@ struct Panel {
   std::string ylabel;
   std::vector<Series> series;
   std::vector<Band> bands;
+  std::vector<Label> labels;
   bool equal_axes = false;  // same scale on x and y (trajectories)
   std::string key = "top right";
 };

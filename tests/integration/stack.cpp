@@ -36,6 +36,9 @@ Truth readTruth(const std::string& path) {
       } else if (line[0] == 'C' && f.size() >= 7) {
         t.commands.push_back({std::stoll(f[1]), std::stod(f[2]), std::stoi(f[3]), std::stoi(f[4]), std::stoi(f[5]),
                               std::stoi(f[6])});
+      } else if (line[0] == 'P' && f.size() >= 9) {
+        t.people.push_back({std::stod(f[2]), f[3], std::stod(f[4]), std::stod(f[5]), std::stod(f[6]), std::stod(f[7]),
+                            std::stod(f[8])});
       } else if (line[0] == 'E' && f.size() >= 4) {
         t.events.push_back({std::stoll(f[1]), std::stod(f[2]), f[3], f.size() > 4 ? f[4] : ""});
       }
@@ -70,7 +73,8 @@ bool Stack::startServer(const std::string& script, const std::vector<std::string
 }
 
 RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
-                              const std::vector<std::string>& relay_args, const std::vector<std::string>& sim_args) {
+                              const std::vector<std::string>& relay_args, const std::vector<std::string>& sim_args,
+                              const std::vector<std::string>& client_args) {
   auto r = std::make_unique<RobotProcs>();
   r->id = id;
   r->truth = dir_ / (id + "-truth.csv");
@@ -89,10 +93,13 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     relays_.emplace(id, Process::spawn(argv, dir_ / (id + "-relay.out"), dir_ / (id + "-relay.err")));
     waitUntil([&] { return exists(r->pty); }, 10.0);
   }
-  r->client = Process::spawn({binPath("robot_client"), "--config", srcPath("config/client.yaml"), "--robot-config",
-                              srcPath("config/robot.yaml"), "--control-config", srcPath("config/control.yaml"), "--behavior-config", srcPath("config/behavior.yaml"), "--serial", r->pty, "--server",
-                              "127.0.0.1:" + std::to_string(port_), "--id", id, "--cmd-log", r->cmd_log},
-                             dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
+  std::vector<std::string> client_argv = {binPath("robot_client"), "--config", srcPath("config/client.yaml"),
+                                          "--robot-config", srcPath("config/robot.yaml"), "--control-config",
+                                          srcPath("config/control.yaml"), "--behavior-config",
+                                          srcPath("config/behavior.yaml"), "--serial", r->pty, "--server",
+                                          "127.0.0.1:" + std::to_string(port_), "--id", id, "--cmd-log", r->cmd_log};
+  client_argv.insert(client_argv.end(), client_args.begin(), client_args.end());
+  r->client = Process::spawn(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
   robots_.push_back(std::move(r));
   return *robots_.back();
 }

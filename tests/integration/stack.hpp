@@ -28,8 +28,15 @@ struct TruthEvent {
   double t = 0;
   std::string name, detail;
 };
+/// One `P` row: a present pedestrian (10 Hz of sim time).
+struct TruthPerson {
+  double t = 0;
+  std::string id;
+  double x = 0, y = 0, vx = 0, vy = 0, robot_dist = 0;
+};
 struct Truth {
   std::vector<TruthRow> rows;
+  std::vector<TruthPerson> people;
   std::vector<TruthCommand> commands;
   std::vector<TruthEvent> events;
 };
@@ -62,7 +69,8 @@ class Stack {
   /// `relay_args` non-empty puts tests' serial_relay between them.
   RobotProcs& startRobot(const std::string& id, const std::string& world = "square_room.yaml",
                          const std::vector<std::string>& relay_args = {},
-                         const std::vector<std::string>& sim_args = {});
+                         const std::vector<std::string>& sim_args = {},
+                         const std::vector<std::string>& client_args = {});
   Process& server() { return server_; }
   int port() const { return port_; }
   std::string serverOutput() const { return readFile(dir_ / "server.out"); }
