@@ -175,8 +175,18 @@ void RobotCore::endAutonomy() {
 
 control::Twist RobotCore::navigationTwist(double dt_s) {
   if (dt_s <= 0.0) return nav_twist_;  // a command-time refresh: no tick
-  const navigation::NavigationOutput& out =
-      navigator_->step(pose_, navigation::rangesFromMm(last_frame_.ultrasonic_mm), dt_s);
+  // People are not obstacles to steer round: their echoes get the Eq 9 factor
+  // (below) instead, so a worker crossing the robot's way makes it wait, not
+  // detour round them along the nearest wall. Anything closer than the
+  // navigator's safety distance is always kept for its AVOID mode.
+  navigation::SonarRanges ranges = navigation::rangesFromMm(last_frame_.ultrasonic_mm);
+  if (awareness_) {
+    const auto& person = awareness_->tracker().personEchoes();
+    const double keep_m = navigator_->params().safety_distance_m;
+    for (std::size_t i = 0; i < ranges.size(); ++i)
+      if (person[i] && ranges[i] > keep_m) ranges[i] = std::numeric_limits<double>::quiet_NaN();
+  }
+  const navigation::NavigationOutput& out = navigator_->step(pose_, ranges, dt_s);
   goal_distance_m_ = out.distance_to_goal_m;
   if (out.mode == navigation::Mode::kAtGoal) {
     const navigation::Vec2 g = goals_[goal_index_];
