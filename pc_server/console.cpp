@@ -220,6 +220,9 @@ std::string Console::background() {
     if (a && a->status() == v1::Ack::COMPLETED) {
       s += it->robot_id + ": " + it->name + " completed\n";
       it = runs_.erase(it);
+    } else if (a && a->status() == v1::Ack::FAILED) {
+      s += it->robot_id + ": " + it->name + " failed: " + a->reason() + "\n";
+      it = runs_.erase(it);
     } else {
       ++it;
     }
@@ -466,6 +469,10 @@ bool Console::sendAndReport(const std::string& name, v1::Command cmd, bool runs)
       }
       return true;
     case v1::Ack::COMPLETED: out_ << *robot << ": " << name << " completed\n"; return true;
+    case v1::Ack::FAILED:
+      out_ << *robot << ": " << name << " failed: " << ack->reason() << "\n";
+      ++tally_.errors;
+      return false;
     case v1::Ack::REJECTED:
       out_ << *robot << ": " << name << " rejected: " << ack->reason() << "\n";
       ++tally_.errors;

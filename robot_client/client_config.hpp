@@ -16,6 +16,10 @@ struct SafetyParams {
   // anti-collision stop), whatever the obstacle; people get Eq 9 as well.
   double obstacle_stop_m = 0.35;
   double obstacle_slow_m = 0.9;
+  // Navigation: a goal whose distance has not shrunk by 0.1 m in this much
+  // time allowed to move (time scaled by the Eq 9 factor, so waiting for
+  // people does not count) is given up: Ack FAILED, IDLE.
+  double nav_stall_s = 120.0;
 };
 
 struct ClientConfig {

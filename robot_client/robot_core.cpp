@@ -150,6 +150,8 @@ v1::Ack RobotCore::startGoTo(const v1::Command& cmd) {
   nav_command_id_ = cmd.id();
   nav_switches_done_ = 0;
   nav_twist_ = {};
+  nav_stall_clock_s_ = nav_best_clock_s_ = 0.0;
+  nav_best_m_ = std::numeric_limits<double>::infinity();
   navigator_->setGoal(goals_.front());
   goal_distance_m_ = std::hypot(goals_.front().x - pose_.x_m, goals_.front().y - pose_.y_m);
   setpoint_ = {};
@@ -188,6 +190,24 @@ control::Twist RobotCore::navigationTwist(double dt_s) {
   }
   const navigation::NavigationOutput& out = navigator_->step(pose_, ranges, dt_s);
   goal_distance_m_ = out.distance_to_goal_m;
+  // Stall: no 0.1 m of progress in nav_stall_s of time the robot was allowed to move.
+  const double allowed = awareness_ ? awareness_->last().speed_factor : 1.0;
+  nav_stall_clock_s_ += dt_s * allowed;
+  if (goal_distance_m_ < nav_best_m_ - 0.1) {
+    nav_best_m_ = goal_distance_m_;
+    nav_best_clock_s_ = nav_stall_clock_s_;
+  } else if (nav_stall_clock_s_ - nav_best_clock_s_ > safety_.nav_stall_s) {
+    const navigation::Vec2 g = goals_[goal_index_];
+    const std::string why = "goal " + std::to_string(goal_index_ + 1) + "/" + std::to_string(goals_.size()) + " " +
+                            fmtPoint(g.x, g.y) + " not reached: no progress for " +
+                            std::to_string(static_cast<int>(safety_.nav_stall_s)) + " s, " + fmt2(goal_distance_m_) +
+                            " m away";
+    acks_.push_back(ackOf(nav_command_id_, v1::Ack::FAILED, why));
+    events_.push_back({v1::Event::INFO, why});
+    endAutonomy();
+    setMode(v1::IDLE, "route given up");
+    return {};
+  }
   if (out.mode == navigation::Mode::kAtGoal) {
     const navigation::Vec2 g = goals_[goal_index_];
     events_.push_back({v1::Event::INFO, "goal " + std::to_string(goal_index_ + 1) + "/" +
@@ -196,6 +216,7 @@ control::Twist RobotCore::navigationTwist(double dt_s) {
     if (++goal_index_ < goals_.size()) {
       nav_switches_done_ += out.switch_count;
       navigator_->setGoal(goals_[goal_index_]);  // the obstacle memory is kept
+      nav_best_m_ = std::numeric_limits<double>::infinity();
     } else {
       acks_.push_back(ackOf(nav_command_id_, v1::Ack::COMPLETED));
       endAutonomy();

@@ -4,6 +4,7 @@
 // input carries its time (`now_s`, monotonic seconds); no I/O, no clock
 // reads, no allocation in the per-tick path.
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -154,6 +155,9 @@ class RobotCore {
   uint64_t nav_command_id_ = 0;
   uint32_t nav_switches_done_ = 0;  // automaton switches of the goals already reached
   double goal_distance_m_ = 0.0;
+  double nav_stall_clock_s_ = 0.0;  // time allowed to move (dt x Eq 9 factor) since the command
+  double nav_best_m_ = std::numeric_limits<double>::infinity();  // closest to the current goal so far
+  double nav_best_clock_s_ = 0.0;
   control::Twist nav_twist_;          // the last tick's navigation twist (after Eq 9)
 
   // Human awareness.

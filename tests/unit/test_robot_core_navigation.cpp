@@ -67,7 +67,7 @@ struct KinematicRobot {
   std::vector<v1::Ack> acks;
   std::vector<client::CoreEvent> events;
 
-  KinematicRobot() {
+  explicit KinematicRobot(const client::SafetyParams& s = {}) : safety(s) {
     f.ultrasonic_mm = {serial::kNoEcho, serial::kNoEcho, serial::kNoEcho, serial::kNoEcho};
     core.onSerialState(true, 0.0);
     core.onLinkUp(0.0);
@@ -401,4 +401,23 @@ obstacles:
   EXPECT_TRUE(corner);
   // The start pose itself is the odometry origin: an empty world gives an empty map.
   EXPECT_TRUE(client::mapFromWorld(sim::loadWorldText("name: empty\n", "empty.yaml")).empty());
+}
+
+TEST(RobotCoreNavigation, AGoalWithoutProgressIsGivenUpWithFailed) {
+  client::SafetyParams safety;
+  safety.nav_stall_s = 3.0;
+  KinematicRobot r(safety);
+  r.run(0.05);
+  // Boxed in: every sonar hears something 0.3 m away wherever the robot turns.
+  r.f.ultrasonic_mm = {300, 300, 300, 300};
+  ASSERT_EQ(r.core.onCommand(goTo(5, {{4.0, 0.0}}), r.t).status(), v1::Ack::ACCEPTED);
+  ASSERT_TRUE(r.runUntilAck(20.0));
+  const v1::Ack& a = r.acks.back();
+  EXPECT_EQ(a.command_id(), 5u);
+  EXPECT_EQ(a.status(), v1::Ack::FAILED);
+  EXPECT_NE(a.reason().find("no progress for 3 s"), std::string::npos) << a.reason();
+  EXPECT_EQ(r.core.mode(), v1::IDLE);
+  EXPECT_GE(r.t, 3.0);
+  EXPECT_LT(r.t, 6.0);
+  EXPECT_EQ(r.countEvents("not reached"), 1);
 }
