@@ -330,6 +330,11 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
     }
   }
   m.duration_s = sim.timeS();
+  {
+    v1::Telemetry tl;  // the navigation automaton's switches (kept after COMPLETED)
+    core.fillTelemetry(tl, m.duration_s);
+    m.mode_switches += tl.nav_switches();
+  }
   m.person_collisions = sim.personCollisions();
   m.wall_collisions = sim.collisions();
   if (pattern_ticks > 0) m.pattern_accuracy = static_cast<double>(pattern_hits) / static_cast<double>(pattern_ticks);
