@@ -135,7 +135,8 @@ int main(int argc, char** argv) {
     }
     std::unique_ptr<behavior::HumanAwareness> awareness;
     if (!behavior_path.empty()) {
-      const auto acfg = behavior::loadAwarenessConfigFile(behavior_path);
+      auto acfg = behavior::loadAwarenessConfigFile(behavior_path);
+      acfg.robot_radius_m = robot.geometry.body_radius_m;
       try {
         awareness = std::make_unique<behavior::HumanAwareness>(
             robot.ultrasonic, acfg, behavior::loadSpeedStrategy(acfg.speed_fis, acfg.speed), std::move(map));

@@ -25,7 +25,15 @@ SpeedPolicy parseSpeedPolicy(const std::string& s) {
 
 HumanAwareness::HumanAwareness(const config::UltrasonicConfig& sonar, const AwarenessConfig& cfg,
                                SpeedStrategy strategy, std::vector<MapSegment> map)
-    : cfg_(cfg), tracker_(sonar, cfg.tracker, std::move(map)), classifier_(cfg.pattern), strategy_(std::move(strategy)) {}
+    : cfg_(cfg), tracker_(sonar, cfg.tracker, map), classifier_(cfg.pattern), strategy_(std::move(strategy)) {
+  walls_.reserve(map.size());
+  for (const auto& m : map) {
+    WallSegment w;
+    w.a_m = {m.x0, m.y0};
+    w.b_m = {m.x1, m.y1};
+    walls_.push_back(w);
+  }
+}
 
 const Awareness& HumanAwareness::step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s) {
   const double dt = last_t_s_ < 0 ? 0.0 : std::max(0.0, t_s - last_t_s_);
@@ -51,6 +59,7 @@ const Awareness& HumanAwareness::step(const control::Pose2& pose, const std::arr
     a.range_rate_m_s = (rx * (n->x[2] - robot_vx_) + ry * (n->x[3] - robot_vy_)) / d;
     const double ahead = rx * std::cos(pose.theta_rad) + ry * std::sin(pose.theta_rad);
     a.passing = ahead < cfg_.passing_ahead_m && a.range_rate_m_s > cfg_.passing_rate_m_s;
+    predict(pose, *n, a);
   } else {
     a.pattern = classifier_.stepNone(dt);
   }
@@ -65,7 +74,8 @@ const Awareness& HumanAwareness::step(const control::Pose2& pose, const std::arr
   } else if (a.passing) {
     a.target_factor = 1.0;  // beside or behind and moving away: no longer interfering
   } else {
-    a.target_factor = strategy_.speedFactor(a.distance_m, a.person_speed_m_s, for_speed);  // Eq 9
+    const double d_in = a.anticipating ? std::min(a.distance_m, a.predicted_min_m) : a.distance_m;
+    a.target_factor = strategy_.speedFactor(d_in, a.person_speed_m_s, for_speed);  // Eq 9
   }
   // Rate limit (no speed steps); the first tick takes the target as it is.
   a.speed_factor = a.target_factor;
@@ -76,6 +86,40 @@ const Awareness& HumanAwareness::step(const control::Pose2& pose, const std::arr
   }
   last_ = a;
   return last_;
+}
+
+void HumanAwareness::predict(const control::Pose2& pose, const HumanTrack& n, Awareness& a) {
+  constexpr double kStep_s = 0.1;
+  const auto steps = static_cast<std::size_t>(std::clamp(cfg_.predict_horizon_s / kStep_s, 0.0,
+                                                         static_cast<double>(predicted_.size())));
+  if (steps == 0) return;
+  Agent person;
+  person.position_m = {n.x[0], n.x[1]};
+  person.velocity_m_s = {n.x[2], n.x[3]};
+  person.radius_m = 0.25;
+  Agent robot;
+  robot.position_m = {pose.x_m, pose.y_m};
+  robot.velocity_m_s = {robot_vx_, robot_vy_};
+  robot.radius_m = cfg_.robot_radius_m;
+  // Eq 7 prediction of the person (walls from the map, the robot keeping its velocity).
+  const std::size_t k_n = predictPath(person, &robot, walls_, cfg_.social_force, kStep_s,
+                                      std::span<Eigen::Vector2d>(predicted_.data(), steps));
+  double best = -1.0, best_t = 0.0;
+  for (std::size_t k = 0; k < k_n; ++k) {
+    const double t = kStep_s * static_cast<double>(k + 1);
+    const Eigen::Vector2d r = robot.position_m + robot.velocity_m_s * t;
+    const double d = (predicted_[k] - r).norm();
+    if (best < 0 || d < best) {
+      best = d;
+      best_t = t;
+    }
+  }
+  if (best < 0) return;
+  a.predicted_min_m = best;
+  a.predicted_at_s = best_t;
+  // Eq 8: what is left of the robot's avoidance distance when it gets there.
+  a.avoid_m = avoidanceDistance(cfg_.speed.max_avoidance_m, std::hypot(robot_vx_, robot_vy_), best_t);
+  a.anticipating = best < a.distance_m && best < a.avoid_m;
 }
 
 AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::string& base_dir) {
@@ -99,6 +143,7 @@ AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::s
   c.factor_rise_per_s = a.number("factor_rise_per_s", c.factor_rise_per_s, 0, 100);
   c.passing_ahead_m = a.number("passing_ahead_m", c.passing_ahead_m, -5, 5);
   c.passing_rate_m_s = a.number("passing_rate_m_s", c.passing_rate_m_s, 0, 5);
+  c.predict_horizon_s = a.number("predict_horizon_s", c.predict_horizon_s, 0, 6.4);
   c.speed.max_avoidance_m = a.number("max_avoidance_m", c.speed.max_avoidance_m, 0.5, 10.0);
   c.speed.sensitive_m = a.number("sensitive_m", c.speed.sensitive_m, 0.1, 5.0);
   const auto t = root.optChild("tracker");
@@ -113,6 +158,7 @@ AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::s
   c.tracker.moving_for_s = t.number("moving_for_s", c.tracker.moving_for_s, 0, 10);
   c.tracker.grid_static_s = t.number("grid_static_s", c.tracker.grid_static_s, 0.1, 60);
   c.tracker.triangulate_front = t.boolean("triangulate_front", c.tracker.triangulate_front);
+  c.social_force = readSocialForceParams(root.optChild("social_force"));
   const auto p = root.optChild("pattern");
   c.pattern.min_speed_m_s = p.number("min_speed_m_s", c.pattern.min_speed_m_s, 0, 2);
   c.pattern.crossing_deg = p.number("crossing_deg", c.pattern.crossing_deg, 45, 90);

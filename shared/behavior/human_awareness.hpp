@@ -12,6 +12,7 @@
 
 #include "shared/behavior/human_tracker.hpp"
 #include "shared/behavior/pattern_classifier.hpp"
+#include "shared/behavior/social_force.hpp"
 #include "shared/behavior/speed_strategy.hpp"
 #include "shared/config/config_node.hpp"
 
@@ -41,6 +42,14 @@ struct AwarenessConfig {
   // (the paper's robot "returns to its initial speed after the person passes").
   double passing_ahead_m = 0.2;
   double passing_rate_m_s = 0.1;
+  // Anticipation (Eqs 7-8): the nearest person's path is predicted with the
+  // social force model (walls from the map, the robot keeping its velocity)
+  // over predict_horizon_s; if the predicted closest approach falls inside the
+  // robot's remaining avoidance distance at that time (Eq 8: R_r,avoid - v t),
+  // the strategy is given that predicted distance instead of today's.
+  double predict_horizon_s = 0.5;  // about the time to stop (tau 0.2 s + the factor rate limit); 0 = off
+  double robot_radius_m = 0.35;    // the robot's body as the predicted person sees it
+  SocialForceParams social_force;
   std::string speed_fis = "config/fuzzy/speed_strategy.fis";
   SpeedStrategyParams speed;
   HumanTrackerParams tracker;
@@ -58,6 +67,10 @@ struct Awareness {
   int people = 0;                // confirmed people tracked
   bool passing = false;          // the nearest person is passing (beside or behind, moving away)
   double range_rate_m_s = 0.0;   // d(distance)/dt of the nearest person, > 0 = moving apart
+  double predicted_min_m = -1.0; // predicted closest approach (centres) within the horizon, < 0 = none
+  double predicted_at_s = 0.0;   // ...how far ahead
+  double avoid_m = -1.0;         // Eq 8: the robot's remaining avoidance distance at that time
+  bool anticipating = false;     // the predicted distance was used for the speed factor
 };
 
 class HumanAwareness {
@@ -71,12 +84,17 @@ class HumanAwareness {
   const PatternClassifier& classifier() const { return classifier_; }
 
  private:
+  /// Social force prediction of the nearest person and Eq 8 (fills the predicted_* fields of a).
+  void predict(const control::Pose2& pose, const HumanTrack& n, Awareness& a);
+
   AwarenessConfig cfg_;
   HumanTracker tracker_;
   PatternClassifier classifier_;
   SpeedStrategy strategy_;
   Awareness last_;
   double last_t_s_ = -1.0;
+  std::vector<WallSegment> walls_;            // the map, for the prediction
+  std::array<Eigen::Vector2d, 64> predicted_{};  // prediction buffer (no allocation per tick)
   control::Pose2 last_pose_;
   double robot_vx_ = 0.0, robot_vy_ = 0.0;  // low-passed from the pose (odometry frame)
 };

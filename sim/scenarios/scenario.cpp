@@ -156,6 +156,7 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
   behavior::AwarenessConfig acfg = ctx.awareness;
   acfg.enabled = true;
   acfg.policy = opt.policy;
+  acfg.robot_radius_m = ctx.robot.geometry.body_radius_m;
   auto awareness = std::make_unique<behavior::HumanAwareness>(
       ctx.robot.ultrasonic, acfg, behavior::loadSpeedStrategy(ctx.speed_fis, acfg.speed), client::mapFromWorld(world));
   const behavior::HumanAwareness* aw = awareness.get();

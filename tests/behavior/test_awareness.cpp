@@ -188,3 +188,36 @@ TEST(HumanTracker, APersonWhoStopsIsStillAPerson) {
   EXPECT_EQ(lost_ticks, 0);
   EXPECT_EQ(tr.counters().tracks_static_dropped, 0u);
 }
+
+TEST(HumanAwareness, PredictsAnOncomingPersonAndUsesEq8) {
+  AwarenessConfig cfg;
+  cfg.predict_horizon_s = 1.0;
+  auto a = make(SpeedPolicy::kFuzzy, cfg);
+  const config::UltrasonicConfig u;
+  bool anticipated = false;
+  for (int k = 0; k < 400; ++k) {
+    const double t = k * 0.01;
+    const control::Pose2 robot{0.4 * t, 0, 0};  // the robot drives at 0.4 m/s
+    const auto& r = a.step(robot, echoes(u, robot, {{4.4 - 0.5 * t, 0.1, 0.25}}, {}), t);
+    if (r.person && r.predicted_min_m >= 0 && r.distance_m > 2.0) {
+      // Closing at ~0.9 m/s: in 1 s the gap shrinks by ~0.9 m (nearer, the
+      // model has the person give way to the robot, as the simulator's do).
+      EXPECT_LT(r.predicted_min_m, r.distance_m - 0.5) << "t " << t;
+      EXPECT_NEAR(r.predicted_at_s, 1.0, 1e-9);
+      // Eq 8: R_avoid - v t with v ~ 0.4 m/s and t = 1 s.
+      EXPECT_NEAR(r.avoid_m, cfg.speed.max_avoidance_m - 0.4, 0.1);
+      anticipated = anticipated || r.anticipating;
+    }
+  }
+  EXPECT_TRUE(anticipated);
+
+  cfg.predict_horizon_s = 0.0;
+  auto off = make(SpeedPolicy::kFuzzy, cfg);
+  for (int k = 0; k < 400; ++k) {
+    const double t = k * 0.01;
+    const control::Pose2 robot{0.4 * t, 0, 0};
+    const auto& r = off.step(robot, echoes(u, robot, {{4.4 - 0.5 * t, 0.1, 0.25}}, {}), t);
+    ASSERT_FALSE(r.anticipating);
+    ASSERT_LT(r.predicted_min_m, 0.0);
+  }
+}
