@@ -63,6 +63,17 @@ std::vector<std::vector<uint8_t>> packetizeAll(const Stream& s, H264Packetizer& 
   return pkts;
 }
 
+// Packetizes every frame (timestamp 3000 f, capture time f) and notes each packet's frame.
+std::vector<std::vector<uint8_t>> packetizeTracked(const Stream& s, H264Packetizer& pz,
+                                                  std::vector<std::size_t>& frame_of) {
+  std::vector<std::vector<uint8_t>> pkts;
+  for (std::size_t f = 0; f < s.frames.size(); ++f) {
+    const std::size_t n = pz.packetize(s.frames[f], static_cast<uint32_t>(3000 * f), f, pkts);
+    frame_of.insert(frame_of.end(), n, f);
+  }
+  return pkts;
+}
+
 struct Received {
   std::vector<Frame> frames;
   std::vector<bool> need_after;  // needKeyframe() just after each frame came out
@@ -158,12 +169,8 @@ TEST(RtpH264, ALostPacketDropsItsFrameAndAsksForAKeyframeUntilOneArrives) {
   std::mt19937 rng(3);
   const Stream s = makeStream(rng);
   H264Packetizer pz(9, 1100);
-  std::vector<std::vector<uint8_t>> pkts;
   std::vector<std::size_t> frame_of;
-  for (std::size_t f = 0; f < s.frames.size(); ++f) {
-    const std::size_t n = pz.packetize(s.frames[f], static_cast<uint32_t>(3000 * f), f, pkts);
-    frame_of.insert(frame_of.end(), n, f);
-  }
+  const auto pkts = packetizeTracked(s, pz, frame_of);
   // Lose the middle packet of the first P frame after frame 10 that has at least 3 packets.
   std::size_t lost = 0, victim = 0;
   for (std::size_t f = 11; f < 20 && !victim; ++f) {
@@ -254,12 +261,8 @@ TEST(RtpH264, AWholeLostFrameCostsOnlyThatFrame) {
   std::mt19937 rng(5);
   const Stream s = makeStream(rng);
   H264Packetizer pz(11, 1100);
-  std::vector<std::vector<uint8_t>> pkts;
   std::vector<std::size_t> frame_of;
-  for (std::size_t f = 0; f < s.frames.size(); ++f) {
-    const std::size_t n = pz.packetize(s.frames[f], static_cast<uint32_t>(3000 * f), f, pkts);
-    frame_of.insert(frame_of.end(), n, f);
-  }
+  const auto pkts = packetizeTracked(s, pz, frame_of);
   Received r;
   for (std::size_t i = 0; i < pkts.size(); ++i)
     if (frame_of[i] != 5) r.feed(pkts[i]);  // every packet of frame 5 lost
