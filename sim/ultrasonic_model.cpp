@@ -11,11 +11,9 @@ UltrasonicModel::UltrasonicModel(const config::UltrasonicConfig& cfg, uint64_t s
 
 std::optional<double> UltrasonicModel::trueRange(const World& world, const control::Pose2& pose, int index,
                                                  std::span<const Circle> people) const {
-  const auto& m = cfg_.mounts.at(static_cast<std::size_t>(index));
-  const double c = std::cos(pose.theta_rad);
-  const double s = std::sin(pose.theta_rad);
-  const Vec2 origin{pose.x_m + c * m.x_m - s * m.y_m, pose.y_m + s * m.x_m + c * m.y_m};
-  const double axis = pose.theta_rad + m.yaw_rad;
+  const control::Pose2 sensor = config::mountPose(pose, cfg_.mounts.at(static_cast<std::size_t>(index)));
+  const Vec2 origin{sensor.x_m, sensor.y_m};
+  const double axis = sensor.theta_rad;
   std::optional<double> best;
   for (int k = 0; k < kRaysPerBeam; ++k) {
     const double frac = static_cast<double>(k) / (kRaysPerBeam - 1) - 0.5;  // -0.5 .. 0.5

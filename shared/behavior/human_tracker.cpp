@@ -55,8 +55,8 @@ std::optional<std::pair<Eigen::Vector2d, Eigen::Matrix2d>> HumanTracker::triangu
   const double wc = std::clamp(w, lo, hi);
   // Robot frame, then odometry frame.
   const double rx = cy * u - sy * wc, ry = sy * u + cy * wc;
-  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
-  const Eigen::Vector2d z(pose.x_m + c * rx - s * ry, pose.y_m + s * rx + c * ry);
+  const control::Pose2 at = config::mountPose(pose, {rx, ry, 0.0});
+  const Eigen::Vector2d z(at.x_m, at.y_m);
   // Lateral sigma from the two range errors (uniform +-range_sigma: sigma / sqrt 3),
   // never worse than a single cone.
   const double sr = std::max(p_.range_sigma_m, 0.01) / std::sqrt(3.0);
@@ -112,7 +112,6 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
   have_time_ = true;
   last_t_s_ = t_s;
   if (dt > 0) predict(dt);
-  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
   person_echo_.fill(false);
   // 1. Echoes to points; drop those explained by the map or by persistence.
   struct Echo {
@@ -126,9 +125,8 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     const double r = ranges_m[i];
     if (!(r > 0) || !std::isfinite(r) || r >= sonar_.max_range_m) continue;
     ++counters_.echoes;
-    const auto& m = sonar_.mounts[i];
-    const double bx = pose.x_m + c * m.x_m - s * m.y_m, by = pose.y_m + s * m.x_m + c * m.y_m;
-    const double yaw = pose.theta_rad + m.yaw_rad;
+    const control::Pose2 sensor = config::mountPose(pose, sonar_.mounts[i]);
+    const double bx = sensor.x_m, by = sensor.y_m, yaw = sensor.theta_rad;
     const double px = bx + r * std::cos(yaw), py = by + r * std::sin(yaw);
     // An echo is explained by the map when any point of its range arc within
     // the cone touches known structure (a corridor's side walls reach the
@@ -231,11 +229,10 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     }
     bool contradicted = false;
     for (std::size_t i = 0; i < 4 && !contradicted; ++i) {
-      const auto& m = sonar_.mounts[i];
-      const double bx = pose.x_m + c * m.x_m - s * m.y_m, by = pose.y_m + s * m.x_m + c * m.y_m;
-      const double dx = t.x[0] - bx, dy = t.x[1] - by, d = std::hypot(dx, dy);
+      const control::Pose2 sensor = config::mountPose(pose, sonar_.mounts[i]);
+      const double dx = t.x[0] - sensor.x_m, dy = t.x[1] - sensor.y_m, d = std::hypot(dx, dy);
       if (d < 0.1 || d > sonar_.max_range_m - 0.3) continue;
-      const double bearing = std::remainder(std::atan2(dy, dx) - (pose.theta_rad + m.yaw_rad), 2 * M_PI);
+      const double bearing = std::remainder(std::atan2(dy, dx) - sensor.theta_rad, 2 * M_PI);
       if (std::abs(bearing) > 0.6 * sonar_.beam_width_rad / 2) continue;
       const double r = ranges_m[i];
       contradicted = !(r > 0) || !std::isfinite(r) || r > d + p_.contradiction_margin_m;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "shared/config/config_node.hpp"
+#include "shared/control/diff_drive.hpp"
 
 namespace inspect::config {
 
@@ -40,6 +41,12 @@ struct UltrasonicMount {
   double y_m = 0.0;
   double yaw_rad = 0.0;
 };
+
+/// Where a sensor is and where it looks, in the frame `robot` is given in.
+inline control::Pose2 mountPose(const control::Pose2& robot, const UltrasonicMount& m) {
+  const double c = std::cos(robot.theta_rad), s = std::sin(robot.theta_rad);
+  return {robot.x_m + c * m.x_m - s * m.y_m, robot.y_m + s * m.x_m + c * m.y_m, robot.theta_rad + m.yaw_rad};
+}
 
 /// The 4 ultrasonic sensors (front-left, front-right, left, right).
 struct UltrasonicConfig {

@@ -209,10 +209,15 @@ void ReorderBuffer::flush(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>
 
 // --- depacketizer -------------------------------------------------------------
 
+void H264Depacketizer::noteType(uint8_t type) {
+  cur_.keyframe = cur_.keyframe || type == kNalIdr;
+  cur_sps_ = cur_sps_ || type == kNalSps;
+  cur_pps_ = cur_pps_ || type == kNalPps;
+}
+
 void H264Depacketizer::appendNal(std::span<const uint8_t> nal) {
   if (nal.empty()) return;
-  const uint8_t t = nalType(nal[0]);
-  cur_.keyframe = cur_.keyframe || t == kNalIdr;
+  noteType(nalType(nal[0]));
   cur_.annexb.insert(cur_.annexb.end(), kStartCode, kStartCode + 4);
   cur_.annexb.insert(cur_.annexb.end(), nal.begin(), nal.end());
 }
@@ -224,17 +229,13 @@ std::optional<Frame> H264Depacketizer::finish() {
   cur_broken_ = in_fu_ = false;
   Frame f = std::move(cur_);
   cur_ = {};
+  f.has_parameter_sets = cur_sps_ && cur_pps_;
+  cur_sps_ = cur_pps_ = false;
   if (broken) {
     ++c_.frames_dropped;
     need_keyframe_ = true;
     return std::nullopt;
   }
-  bool sps = false, pps = false;
-  for (const auto nal : splitAnnexB(f.annexb)) {
-    sps = sps || nalType(nal[0]) == kNalSps;
-    pps = pps || nalType(nal[0]) == kNalPps;
-  }
-  f.has_parameter_sets = sps && pps;
   if (f.keyframe) need_keyframe_ = false;
   ++c_.frames;
   return f;
@@ -244,10 +245,9 @@ std::optional<Frame> H264Depacketizer::push(const RtpPacket& p, uint32_t skipped
   ++c_.packets;
   c_.lost_packets += skipped;
   if (skipped > 0) need_keyframe_ = true;  // whatever was lost, the decoder's references are now suspect
-  std::optional<Frame> done;
   if (have_cur_ && p.timestamp != cur_.timestamp) {
-    cur_broken_ = true;  // the previous frame never saw its marker packet
-    done = finish();
+    cur_broken_ = true;  // the previous frame never saw its marker packet: dropped
+    (void)finish();
   }
   if (!have_cur_) {
     have_cur_ = true;
@@ -294,7 +294,7 @@ std::optional<Frame> H264Depacketizer::push(const RtpPacket& p, uint32_t skipped
         if (in_fu_) cur_broken_ = true;
         in_fu_ = true;
         const uint8_t hdr = static_cast<uint8_t>((pl[0] & 0xE0) | nalType(pl[1]));
-        cur_.keyframe = cur_.keyframe || nalType(pl[1]) == kNalIdr;
+        noteType(nalType(pl[1]));
         cur_.annexb.insert(cur_.annexb.end(), kStartCode, kStartCode + 4);
         cur_.annexb.push_back(hdr);
       } else if (!in_fu_) {
@@ -307,11 +307,8 @@ std::optional<Frame> H264Depacketizer::push(const RtpPacket& p, uint32_t skipped
       cur_broken_ = true;
     }
   }
-  if (p.marker) {
-    auto f = finish();
-    if (f) return f;
-  }
-  return done;
+  if (p.marker) return finish();
+  return std::nullopt;
 }
 
 }  // namespace inspect::video

@@ -135,8 +135,9 @@ struct DepacketizerCounters {
 class H264Depacketizer {
  public:
   /// One in-order packet; `skipped` = sequence numbers lost just before it.
-  /// Returns a frame when this packet completes one (marker bit, or the
-  /// timestamp moved on). A frame with a loss anywhere in it is dropped.
+  /// Returns a frame when this packet (its marker bit) completes an intact
+  /// one. A frame with a loss anywhere in it (or whose marker packet never
+  /// came) is dropped.
   std::optional<Frame> push(const RtpPacket& p, uint32_t skipped);
 
   const DepacketizerCounters& counters() const { return c_; }
@@ -147,10 +148,12 @@ class H264Depacketizer {
  private:
   std::optional<Frame> finish();
   void appendNal(std::span<const uint8_t> nal);
+  void noteType(uint8_t nal_type);
 
   DepacketizerCounters c_;
   Frame cur_;
   bool have_cur_ = false;
+  bool cur_sps_ = false, cur_pps_ = false;
   bool cur_broken_ = false;
   bool in_fu_ = false;
   bool need_keyframe_ = true;  // nothing decodable before the first keyframe

@@ -60,12 +60,11 @@ std::optional<double> optSeconds(const config::ConfigNode& n, const std::string&
 
 // True when some part of a person's body is inside a sonar cone within range.
 bool inSomeCone(const config::UltrasonicConfig& u, const control::Pose2& pose, const behavior::Agent& a) {
-  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
   for (const auto& m : u.mounts) {
-    const double bx = pose.x_m + c * m.x_m - s * m.y_m, by = pose.y_m + s * m.x_m + c * m.y_m;
-    const double dx = a.position_m.x() - bx, dy = a.position_m.y() - by, d = std::hypot(dx, dy);
+    const control::Pose2 sensor = config::mountPose(pose, m);
+    const double dx = a.position_m.x() - sensor.x_m, dy = a.position_m.y() - sensor.y_m, d = std::hypot(dx, dy);
     if (d - a.radius_m > u.max_range_m) continue;
-    const double bearing = std::remainder(std::atan2(dy, dx) - (pose.theta_rad + m.yaw_rad), 2 * M_PI);
+    const double bearing = std::remainder(std::atan2(dy, dx) - sensor.theta_rad, 2 * M_PI);
     const double size = d > a.radius_m ? std::asin(a.radius_m / d) : M_PI;
     if (std::abs(bearing) - size < u.beam_width_rad / 2) return true;
   }

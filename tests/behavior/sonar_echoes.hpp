@@ -20,14 +20,13 @@ inline std::array<double, 4> echoes(const config::UltrasonicConfig& u, const con
                              const std::vector<Circle>& people, const std::vector<behavior::MapSegment>& walls,
                              std::mt19937* rng = nullptr) {
   std::array<double, 4> out{};
-  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
   std::uniform_real_distribution<double> noise(-u.noise_m, u.noise_m);
   for (int i = 0; i < 4; ++i) {
-    const auto& m = u.mounts[static_cast<std::size_t>(i)];
-    const double ox = pose.x_m + c * m.x_m - s * m.y_m, oy = pose.y_m + s * m.x_m + c * m.y_m;
+    const control::Pose2 sensor = config::mountPose(pose, u.mounts[static_cast<std::size_t>(i)]);
+    const double ox = sensor.x_m, oy = sensor.y_m;
     double best = u.max_range_m;
     for (int ray = -3; ray <= 3; ++ray) {
-    const double yaw = pose.theta_rad + m.yaw_rad + ray * u.beam_width_rad / 6.0, dx = std::cos(yaw), dy = std::sin(yaw);
+    const double yaw = sensor.theta_rad + ray * u.beam_width_rad / 6.0, dx = std::cos(yaw), dy = std::sin(yaw);
     for (const auto& p : people) {
       const double fx = ox - p.x, fy = oy - p.y;
       const double b = fx * dx + fy * dy, cc = fx * fx + fy * fy - p.r * p.r, disc = b * b - cc;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sim/world.hpp"
+#include "tests/sim/world_text.hpp"
 
 using namespace inspect::sim;
 using inspect::config::ConfigError;
@@ -19,14 +20,7 @@ World worldOf(const std::string& yaml) {
   return loadWorldText(yaml, "peds.yaml");
 }
 
-std::string errorOf(const std::string& yaml) {
-  try {
-    (void)worldOf(yaml);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string errorOf(const std::string& yaml) { return inspect::test::worldError(yaml, "peds.yaml"); }
 
 double dist(Vec2 a, Vec2 b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
 

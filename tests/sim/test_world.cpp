@@ -9,6 +9,7 @@
 #include <string>
 
 #include "sim/world.hpp"
+#include "tests/sim/world_text.hpp"
 
 using namespace inspect::sim;
 using inspect::config::ConfigError;
@@ -22,14 +23,7 @@ World worldOf(const std::string& yaml) {
   return loadWorldText(yaml, "test_world.yaml");
 }
 
-std::string errorOf(const std::string& yaml) {
-  try {
-    (void)worldOf(yaml);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string errorOf(const std::string& yaml) { return inspect::test::worldError(yaml, "test_world.yaml"); }
 
 }  // namespace
 
