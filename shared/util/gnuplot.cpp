@@ -36,7 +36,7 @@ std::string renderPng(const std::string& png_path, const std::vector<Panel>& pan
       g << "EOD\n";
     }
   g << "set terminal pngcairo size " << width_px << "," << panel_height_px * static_cast<int>(panels.size())
-    << " font 'DejaVu Sans,10'\n";
+    << " font 'DejaVu Sans,10' noenhanced\n";  // titles are literal text (ids have underscores)
   g << "set output " << quote(png_path) << "\n";
   g << "set grid\n";
   if (panels.size() > 1) g << "set multiplot layout " << panels.size() << ",1\n";
@@ -54,6 +54,7 @@ std::string renderPng(const std::string& png_path, const std::vector<Panel>& pan
     g << "set xlabel " << quote(pa.xlabel) << "\n";
     g << "set ylabel " << quote(pa.ylabel) << "\n";
     g << "set key " << pa.key << "\n";
+    g << "set yrange " << (pa.yrange.empty() ? "[*:*]" : pa.yrange) << "\n";
     if (pa.equal_axes)
       g << "set size ratio -1\n";
     else

@@ -42,6 +42,7 @@ struct Panel {
   std::vector<Label> labels;
   bool equal_axes = false;  // same scale on x and y (trajectories)
   std::string key = "top right";
+  std::string yrange;       // gnuplot range, e.g. "[0:*]"; empty = automatic
 };
 
 /// Writes `png_path` with the panels stacked vertically. Returns an empty

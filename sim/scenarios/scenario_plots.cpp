@@ -89,6 +89,7 @@ std::string plotScenario(const std::string& dir, const ScenarioSpec& spec, const
   plot::Panel speed{"robot speed", "t (s)", "v (m/s)", {}, {}, {}, false, "top right"};
   plot::Panel dist{"distance to the nearest person (centres); zones: intimate < 0.45 m, personal < 1.2 m",
                    "t (s)", "distance (m)", {}, {}, {}, false, "top right"};
+  dist.yrange = "[0:*]";  // the zones start at 0
   dist.bands.push_back({0.0, 0.45, "#f4b6b6", "intimate"});
   dist.bands.push_back({0.45, 1.2, "#fbe3b5", "personal"});
   for (const auto& r : runs) {
