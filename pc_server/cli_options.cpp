@@ -31,6 +31,16 @@ const std::map<std::string, FlagSpec>& flags() {
           if (!n || *n < 0 || *n > 65535) throw UsageError("--port: '" + v + "' is not a port number (0-65535)");
           o.port = static_cast<uint16_t>(*n);
         }}},
+      {"--video-port",
+       {true,
+        [](CliOptions& o, const std::string& v) {
+          const auto n = parseInteger(v);
+          if (!n || *n < 0 || *n > 65535) throw UsageError("--video-port: '" + v + "' is not a port number (0-65535)");
+          o.video_port = static_cast<uint16_t>(*n);
+        }}},
+      {"--video-port-file", {true, [](CliOptions& o, const std::string& v) { o.video_port_file = v; }}},
+      {"--video-dir", {true, [](CliOptions& o, const std::string& v) { o.video_dir = v; }}},
+      {"--no-video", {false, [](CliOptions& o, const std::string&) { o.no_video = true; }}},
       {"--port-file", {true, [](CliOptions& o, const std::string& v) { o.port_file = v; }}},
       {"--script", {true, [](CliOptions& o, const std::string& v) { o.script_path = v; }}},
       {"--interactive", {false, [](CliOptions& o, const std::string&) { o.interactive = true; }}},
@@ -81,6 +91,10 @@ std::string usageText() {
          "  --bind ADDR       listen address, numeric IPv4/IPv6 (overrides 'bind'; default 0.0.0.0)\n"
          "  --port N          TCP port, 0 = ephemeral (overrides 'port'; default 7600)\n"
          "  --port-file FILE  write the listening port to FILE (atomically) once listening\n"
+         "  --video-port N    UDP port of the video receiver, 0 = ephemeral (overrides video.port; default 5600)\n"
+         "  --video-port-file FILE  write the video receiver's UDP port to FILE once bound\n"
+         "  --video-dir DIR   SDP files and snapshots (overrides video.dir; default video)\n"
+         "  --no-video        do not receive video (overrides video.enabled)\n"
          "  --script FILE     run the console commands in FILE, then exit (0 = all expects passed, 1 = not)\n"
          "  --interactive     after --script, stay in the interactive console; alone, force the interactive console\n"
          "  --no-console      serve until SIGINT/SIGTERM without reading stdin (service mode)\n"

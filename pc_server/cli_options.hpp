@@ -22,6 +22,10 @@ struct CliOptions {
   std::optional<uint16_t> port;
   std::optional<std::string> port_file;
   std::optional<std::string> script_path;
+  std::optional<uint16_t> video_port;
+  std::optional<std::string> video_dir;
+  std::optional<std::string> video_port_file;
+  bool no_video = false;
   bool interactive = false;
   bool no_console = false;
   bool help = false;

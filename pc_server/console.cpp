@@ -12,6 +12,7 @@
 #include "pc_server/route_file.hpp"
 #include "pc_server/status_line.hpp"
 #include "pc_server/text_util.hpp"
+#include "pc_server/video_hub.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/util/clock.hpp"
 
@@ -113,6 +114,26 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  Clears the set-point and sends EStop; waits up to 1 s for the Ack.\n", &Console::cmdEstop},
       {"resume", "resume", "clear a latched e-stop or failsafe",
        "  Waits up to 1 s for the Ack; e.g. 'robot1: resume rejected: <reason>'.\n", &Console::cmdResume},
+      {"video", "video on|off|keyframe|stats | video res <W>x<H> | video fps <n> | video bitrate <kbit/s>",
+       "control the selected robot's camera stream; show its figures",
+       "  on/off start and stop streaming; keyframe asks for an IDR now (the server also asks by\n"
+       "  itself, at most every 0.3 s, when it lost part of a picture).\n"
+       "  res: even width and height, 64 to 4096 (e.g. 1280x720); fps: 1 to 120; bitrate: 50 to\n"
+       "  50000 kbit/s. A new size or bitrate restarts the robot's encoder with an IDR.\n"
+       "  stats: received/decoded fps, kbit/s, packet loss, glass-to-glass latency (mean, p50, p99),\n"
+       "  counters, the SDP file for players, and the robot's encoder figures.\n"
+       "  Play the stream elsewhere: ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer\n"
+       "    -flags low_delay video/robot1.sdp   (the server forwards the RTP to the SDP's port)\n"
+       "  example: video res 1280x720\n",
+       &Console::cmdVideo},
+      {"ptz", "ptz <pan_deg> <tilt_deg> | ptz home", "point the camera mount (sent to the MCU)",
+       "  pan counter-clockwise positive, [-180, 180] degrees; tilt up positive, [-90, 90].\n"
+       "  example: ptz 30 -10\n",
+       &Console::cmdPtz},
+      {"snapshot", "snapshot [file.png]", "save the selected robot's latest decoded picture as PNG",
+       "  Default file: <video.dir>/<robot>_<n>.png. Without a display the server also keeps\n"
+       "  <video.dir>/<robot>_latest.png fresh (video.snapshot_period_s).\n",
+       &Console::cmdSnapshot},
       {"wait", "wait <seconds>", "pause the console (events still print)",
        "  example: wait 2.5\n", &Console::cmdWait},
       {"expect", "expect <field> <op> <value> [<tol>] [within <seconds>]", "check a value (scripts, tests)",
@@ -316,7 +337,7 @@ bool Console::cmdStatus(const Args& args, const std::string&, int) {
   if (args.size() > 1) return fail("status", "takes at most one robot id");
   const std::string robot = args.empty() ? selected_ : args[0];
   if (robot.empty()) return fail("status", "no robot selected");
-  out_ << statusLine(robot, registry_.snapshot(robot, monoNowNs())) << "\n";
+  out_ << statusLine(robot, registry_.snapshot(robot, monoNowNs()), video_) << "\n";
   return true;
 }
 
@@ -367,6 +388,80 @@ bool Console::cmdTeleop(const Args& args, const std::string&, int) {
     return false;
   }
   return true;
+}
+
+bool Console::cmdVideo(const Args& args, const std::string&, int) {
+  static const char* kSyntax =
+      "syntax: video on|off|keyframe|stats | video res <W>x<H> | video fps <n> | video bitrate <kbit/s>";
+  if (args.empty() || args.size() > 2) return fail("video", kSyntax);
+  const std::string& what = args[0];
+  if (what == "stats") {
+    if (args.size() != 1) return fail("video", kSyntax);
+    const auto robot = connectedRobot("video");
+    if (!robot) return false;
+    out_ << videoReport(*robot, registry_.snapshot(*robot, monoNowNs()), video_);
+    return true;
+  }
+  v1::Command c;
+  auto* v = c.mutable_video();
+  if ((what == "on" || what == "off" || what == "keyframe") && args.size() == 1) {
+    if (what == "keyframe") v->set_keyframe(true);
+    else v->set_enabled(what == "on");
+    return sendAndReport("video " + what, std::move(c));
+  }
+  if (what != "res" && what != "fps" && what != "bitrate" && what != "on" && what != "off" && what != "keyframe")
+    return fail("video", "unknown '" + what + "'; " + kSyntax);
+  if (args.size() != 2) return fail("video", kSyntax);
+  if (what == "res") {
+    const auto x = args[1].find('x');
+    const auto w = x == std::string::npos ? std::nullopt : parseInteger(args[1].substr(0, x));
+    const auto h = x == std::string::npos ? std::nullopt : parseInteger(args[1].substr(x + 1));
+    if (!w || !h || *w < 64 || *h < 64 || *w > 4096 || *h > 4096 || *w % 2 || *h % 2)
+      return fail("video", "res '" + args[1] + "': want <W>x<H>, even, 64 to 4096 (e.g. 1280x720)");
+    v->set_width(static_cast<uint32_t>(*w));
+    v->set_height(static_cast<uint32_t>(*h));
+  } else if (what == "fps") {
+    const auto f = parseNumber(args[1]);
+    if (!f || !(*f >= 1 && *f <= 120)) return fail("video", "fps '" + args[1] + "': want 1 to 120");
+    v->set_fps(*f);
+  } else if (what == "bitrate") {
+    const auto b = parseInteger(args[1]);
+    if (!b || *b < 50 || *b > 50000) return fail("video", "bitrate '" + args[1] + "': want 50 to 50000 kbit/s");
+    v->set_bitrate_kbps(static_cast<uint32_t>(*b));
+  } else {
+    return fail("video", "unknown '" + what + "'; " + kSyntax);
+  }
+  return sendAndReport("video " + what, std::move(c));
+}
+
+bool Console::cmdPtz(const Args& args, const std::string&, int) {
+  v1::Command c;
+  auto* p = c.mutable_ptz();
+  if (args.size() == 1 && args[0] == "home") {
+    p->set_home(true);
+    return sendAndReport("ptz", std::move(c));
+  }
+  const auto pan = args.size() == 2 ? parseNumber(args[0]) : std::nullopt;
+  const auto tilt = args.size() == 2 ? parseNumber(args[1]) : std::nullopt;
+  if (!pan || !tilt) return fail("ptz", "syntax: ptz <pan_deg> <tilt_deg> | ptz home");
+  if (std::abs(*pan) > 180 || std::abs(*tilt) > 90)
+    return fail("ptz", "pan must be within [-180, 180] and tilt within [-90, 90] degrees");
+  p->set_pan_rad(*pan * M_PI / 180.0);
+  p->set_tilt_rad(*tilt * M_PI / 180.0);
+  return sendAndReport("ptz", std::move(c));
+}
+
+bool Console::cmdSnapshot(const Args& args, const std::string&, int) {
+  if (args.size() > 1) return fail("snapshot", "syntax: snapshot [file.png]");
+  if (!video_) return fail("snapshot", "the server runs without video (video.enabled: false or --no-video)");
+  if (selected_.empty()) return fail("snapshot", "no robot selected");
+  try {
+    const std::string path = video_->snapshot(selected_, args.empty() ? "" : args[0]);
+    out_ << selected_ << ": snapshot " << path << "\n";
+    return true;
+  } catch (const std::exception& e) {
+    return fail("snapshot", e.what());
+  }
 }
 
 bool Console::simpleCommand(const std::string& name, const Args& args, v1::Command cmd) {

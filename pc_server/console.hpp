@@ -16,6 +16,8 @@
 
 namespace inspect::server {
 
+class VideoHub;
+
 class Console {
  public:
   struct Options {
@@ -59,6 +61,9 @@ class Console {
   const Tally& tally() const { return tally_; }
   const Options& options() const { return options_; }
   RobotRegistry& registry() { return registry_; }
+  /// Enables snapshot and the video figures (null: the server has no video).
+  void setVideo(VideoHub* hub) { video_ = hub; }
+  VideoHub* video() const { return video_; }
   CommandSink& sink() { return sink_; }
 
   /// The text of `help` (all commands) or `help <command>`; empty for an unknown command.
@@ -89,6 +94,9 @@ class Console {
   bool cmdStop(const Args& args, const std::string& rest, int line_no);
   bool cmdEstop(const Args& args, const std::string& rest, int line_no);
   bool cmdResume(const Args& args, const std::string& rest, int line_no);
+  bool cmdVideo(const Args& args, const std::string& rest, int line_no);
+  bool cmdPtz(const Args& args, const std::string& rest, int line_no);
+  bool cmdSnapshot(const Args& args, const std::string& rest, int line_no);
   bool cmdWait(const Args& args, const std::string& rest, int line_no);
   bool cmdExpect(const Args& args, const std::string& rest, int line_no);
   bool cmdEcho(const Args& args, const std::string& rest, int line_no);
@@ -115,6 +123,7 @@ class Console {
   Options options_;
   std::function<void()> idle_hook_;
   TeleopHandler teleop_handler_;
+  VideoHub* video_ = nullptr;
   std::string selected_;
   bool quit_ = false;
   Tally tally_;

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -53,6 +54,14 @@ class LinkServer : public CommandSink {
   /// False when the console watchdog is on and the console went quiet.
   bool consoleResponsive() const;
 
+  /// Called on a session's strand with every telemetry envelope (robot id,
+  /// its "ip:port", the envelope, receive time in µs). Set before listen().
+  using TelemetryObserver =
+      std::function<void(const std::string& robot_id, const std::string& address, const v1::Envelope& env,
+                         uint64_t recv_us)>;
+  void setTelemetryObserver(TelemetryObserver f) { telemetry_observer_ = std::move(f); }
+  const TelemetryObserver& telemetryObserver() const { return telemetry_observer_; }
+
   /// A fresh command id: > 0 and increasing over the server's lifetime.
   uint64_t nextCommandId() { return next_command_id_.fetch_add(1); }
   /// Called by a session whose Hello was accepted; closes an older session of the same robot.
@@ -74,6 +83,8 @@ class LinkServer : public CommandSink {
   std::atomic<bool> log_events_{false};
   std::atomic<int64_t> console_watchdog_ns_{0};
   std::atomic<int64_t> console_alive_ns_{0};
+
+  TelemetryObserver telemetry_observer_;
 
   mutable std::mutex mu_;
   std::condition_variable all_closed_cv_;

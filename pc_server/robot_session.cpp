@@ -179,6 +179,7 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
       return true;  // last_rx_ already counts it
     case v1::Envelope::kTelemetry:
       registry_.onTelemetry(robot_id_, serial_, env.telemetry(), monoNowNs());
+      if (const auto& observe = server_.telemetryObserver()) observe(robot_id_, address_, env, monoNowUs());
       return true;
     case v1::Envelope::kEvent:
       registry_.onEvent(robot_id_, serial_, env.event());

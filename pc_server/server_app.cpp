@@ -22,6 +22,7 @@
 #include "pc_server/robot_registry.hpp"
 #include "pc_server/startup_error.hpp"
 #include "pc_server/stop_flag.hpp"
+#include "pc_server/video_hub.hpp"
 #include "shared/util/log.hpp"
 
 namespace inspect::server {
@@ -58,6 +59,9 @@ ServerConfig resolveConfig(const CliOptions& options) {
   }
   if (options.bind_address) c.bind_address = *options.bind_address;
   if (options.port) c.port = *options.port;
+  if (options.video_port) c.video.port = *options.video_port;
+  if (options.video_dir) c.video.dir = *options.video_dir;
+  if (options.no_video) c.video.enabled = false;
   return c;
 }
 
@@ -101,6 +105,19 @@ int runServer(const CliOptions& options) {
   std::cout << "pc_server: listening on " << endpoint.address().to_string() << ":" << endpoint.port() << std::endl;
   if (options.port_file) writePortFile(*options.port_file, endpoint.port());
 
+  std::unique_ptr<VideoHub> video;
+  if (config.video.enabled) {
+    video = std::make_unique<VideoHub>(config.video, config.bind_address, link);
+    link.setTelemetryObserver([hub = video.get()](const std::string& id, const std::string& address,
+                                                  const v1::Envelope& env, uint64_t recv_us) {
+      hub->onTelemetry(id, address, env, recv_us);
+    });
+    video->start();
+    std::cout << "pc_server: video on UDP port " << video->port() << ", SDP files in " << config.video.dir << "/"
+              << std::endl;
+    if (options.video_port_file) writePortFile(*options.video_port_file, video->port());
+  }
+
   StopFlag stop;
   asio::signal_set signals(ioc, SIGINT, SIGTERM);
   signals.async_wait([&stop](const boost::system::error_code& ec, int sig) {
@@ -117,6 +134,7 @@ int runServer(const CliOptions& options) {
   {
     Console::Options copt;
     Console console(registry, link, std::cout, stop, copt);
+    console.setVideo(video.get());
     ConsoleRunner runner(console, stop, config.status_refresh_hz);
     switch (mode) {
       case ConsoleMode::kNone:
@@ -143,6 +161,7 @@ int runServer(const CliOptions& options) {
     boost::system::error_code ignored;
     signals.cancel(ignored);
   });
+  if (video) video->stop();
   work.reset();
   return status;  // io stops and joins the threads
 

@@ -27,6 +27,21 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   c.max_frame_bytes = static_cast<std::size_t>(root.integer("max_frame_bytes", static_cast<long>(c.max_frame_bytes),
                                                             1024, 64L * 1024 * 1024));
   c.status_refresh_hz = root.number("status_refresh_hz", c.status_refresh_hz, 0.5, 30);
+  const auto v = root.optChild("video");
+  auto& vc = c.video;
+  vc.enabled = v.boolean("enabled", vc.enabled);
+  vc.bind = v.string("bind", vc.bind);
+  if (!vc.bind.empty() && !validBindAddress(vc.bind)) v.fail("bind", "'" + vc.bind + "' is not a numeric IP address");
+  vc.port = static_cast<uint16_t>(v.integer("port", vc.port, 0, 65535));
+  vc.dir = v.string("dir", vc.dir);
+  if (vc.dir.empty()) v.fail("dir", "must not be empty");
+  vc.forward_base_port = static_cast<uint16_t>(v.integer("forward_base_port", vc.forward_base_port, 0, 65000));
+  vc.window = v.string("window", vc.window);
+  if (vc.window != "auto" && vc.window != "on" && vc.window != "off")
+    v.fail("window", "'" + vc.window + "' is not one of auto, on, off");
+  vc.snapshot_period_s = v.number("snapshot_period_s", vc.snapshot_period_s, 0, 3600);
+  vc.reorder_window = static_cast<std::size_t>(v.integer("reorder_window", static_cast<long>(vc.reorder_window), 1, 1024));
+  vc.keyframe_min_interval_s = v.number("keyframe_min_interval_s", vc.keyframe_min_interval_s, 0.05, 10);
   return c;
 }
 

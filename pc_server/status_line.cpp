@@ -5,6 +5,7 @@
 
 #include "pc_server/expect_check.hpp"
 #include "pc_server/text_util.hpp"
+#include "pc_server/video_hub.hpp"
 
 namespace inspect::server {
 
@@ -21,7 +22,72 @@ std::string faultNames(uint32_t faults) {
   return s;
 }
 
-std::string statusLine(const std::string& robot_id, const std::optional<RobotSnapshot>& snap) {
+namespace {
+std::string videoFigures(const RobotSnapshot& snap, const VideoHub* video) {
+  if (!snap.telemetry.has_video()) return {};
+  const auto& tv = snap.telemetry.video();
+  if (!tv.enabled()) return " | video off";
+  const auto st = video ? video->stats(snap.id) : std::nullopt;
+  if (!st || !st->active) return " | video no packets" + (tv.error().empty() ? std::string() : " (" + tv.error() + ")");
+  return " | video " + fmtFixed(st->fps_received, 0) + "/" + fmtFixed(st->fps_decoded, 0) + " fps " +
+         fmtFixed(st->kbps, 0) + " kbit/s loss " + fmtFixed(st->loss_pct, 1) + "% lat " +
+         (st->latency_ms < 0 ? std::string("--") : fmtFixed(st->latency_ms, 0)) + " ms";
+}
+}  // namespace
+
+std::string videoReport(const std::string& robot_id, const std::optional<RobotSnapshot>& snap, const VideoHub* video) {
+  std::string s;
+  const auto line = [&s](const std::string& k, const std::string& v) { s += "  " + k + ": " + v + "\n"; };
+  s += robot_id + " video\n";
+  if (snap && snap->has_telemetry && snap->telemetry.has_video()) {
+    const auto& v = snap->telemetry.video();
+    line("robot", std::string(v.enabled() ? "on" : "off") + ", " + v.source() + " " + std::to_string(v.width()) + "x" +
+                      std::to_string(v.height()) + " @ " + fmtShort(v.fps()) + " fps, " + v.encoder() + " " +
+                      std::to_string(v.bitrate_kbps()) + " kbit/s, SSRC " + std::to_string(v.ssrc()) + ", to UDP port " +
+                      std::to_string(v.port()));
+    line("robot frames", "captured " + std::to_string(v.frames_captured()) + ", encoded " +
+                             std::to_string(v.frames_encoded()) + ", dropped " + std::to_string(v.frames_dropped()) +
+                             ", keyframes " + std::to_string(v.keyframes()) + " (" +
+                             std::to_string(v.keyframe_requests()) + " requested), encode " +
+                             fmtFixed(v.encode_ms(), 1) + " ms/frame");
+    if (!v.error().empty()) line("robot error", v.error());
+  } else {
+    line("robot", "no video in telemetry");
+  }
+  if (!video) {
+    line("server", "video off (video.enabled: false or --no-video)");
+    return s;
+  }
+  const auto st = video->stats(robot_id);
+  if (!st) {
+    line("server", "no stream yet");
+  } else {
+    line("received", fmtFixed(st->fps_received, 1) + " fps, decoded " + fmtFixed(st->fps_decoded, 1) + " fps, " +
+                         fmtFixed(st->kbps, 0) + " kbit/s, loss " + fmtFixed(st->loss_pct, 2) + "%, " +
+                         std::to_string(st->width) + "x" + std::to_string(st->height));
+    line("latency", "mean " + fmtFixed(st->latency_ms, 1) + " ms (last second), p50 " + fmtFixed(st->latency_p50_ms, 1) +
+                        " ms, p99 " + fmtFixed(st->latency_p99_ms, 1) + " ms (last 300 frames)");
+    line("counters", "packets " + std::to_string(st->packets) + ", lost " + std::to_string(st->lost_packets) +
+                         ", duplicates " + std::to_string(st->duplicates) + ", late " + std::to_string(st->late) +
+                         ", frames " + std::to_string(st->frames) + ", dropped " + std::to_string(st->frames_dropped) +
+                         ", decoded " + std::to_string(st->decoded) + ", skipped awaiting a keyframe " +
+                         std::to_string(st->frames_skipped) + ", decode errors " +
+                         std::to_string(st->decode_errors) + ", keyframe requests " +
+                         std::to_string(st->keyframe_requests));
+  }
+  const auto c = video->counters();
+  line("rejected datagrams", "not RTP " + std::to_string(c.not_rtp) + ", unknown SSRC " + std::to_string(c.unknown_ssrc) +
+                                 ", wrong source " + std::to_string(c.wrong_source) + ", wrong payload type " +
+                                 std::to_string(c.wrong_payload_type) +
+                                 (c.last_reject.empty() ? std::string() : " (last: " + c.last_reject + ")"));
+  const auto sdp = video->sdpPath(robot_id);
+  if (!sdp.empty())
+    line("play", "ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay " + sdp +
+                     "   (RTP forwarded to 127.0.0.1:" + std::to_string(video->forwardPort(robot_id)) + ")");
+  return s;
+}
+
+std::string statusLine(const std::string& robot_id, const std::optional<RobotSnapshot>& snap, const VideoHub* video) {
   if (!snap) return robot_id + " | not connected yet";
   std::string s = robot_id;
   if (!snap->connected)
@@ -59,6 +125,7 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
   s += " | tlm " + fmtFixed(snap->telemetry_hz, 0) + " Hz";
   if (snap->connected && snap->telemetry_age_s > 0.5) s += " (stale " + fmtFixed(snap->telemetry_age_s, 1) + " s)";
   s += (t.faults() & v1::FAULT_SERIAL_DOWN) ? " | serial DOWN" : " | serial ok";
+  if (snap->connected) s += videoFigures(*snap, video);
   return s;
 }
 

@@ -42,6 +42,29 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   if (c.safety.obstacle_slow_m <= c.safety.obstacle_stop_m && c.safety.obstacle_slow_m > 0)
     sa.fail("obstacle_slow_m", "must be above obstacle_stop_m (or 0 to turn the obstacle stop off)");
   c.map_file = root.string("map", c.map_file);
+  const auto v = root.optChild("video");
+  auto& vp = c.video;
+  vp.enabled = v.boolean("enabled", vp.enabled);
+  vp.source = v.string("source", vp.source);
+  if (vp.source.empty()) v.fail("source", "must not be empty (\"synthetic\", \"v4l2:/dev/videoN\" or \"file:PATH\")");
+  vp.width = static_cast<int>(v.integer("width", vp.width, 64, 4096));
+  vp.height = static_cast<int>(v.integer("height", vp.height, 64, 4096));
+  if (vp.width % 2 || vp.height % 2) v.fail("width", "width and height must be even (4:2:0 video)");
+  vp.fps = v.number("fps", vp.fps, 1, 120);
+  vp.pixel_format = v.string("pixel_format", vp.pixel_format);
+  if (!vp.pixel_format.empty() && vp.pixel_format.size() != 4) v.fail("pixel_format", "a FOURCC is 4 characters, e.g. MJPG");
+  vp.encoder = v.string("encoder", vp.encoder);
+  if (vp.encoder != "libx264" && vp.encoder != "h264_v4l2m2m" && vp.encoder != "auto")
+    v.fail("encoder", "'" + vp.encoder + "' is not one of libx264, h264_v4l2m2m, auto");
+  vp.preset = v.string("preset", vp.preset);
+  if (vp.preset != "ultrafast" && vp.preset != "superfast" && vp.preset != "veryfast")
+    v.fail("preset", "'" + vp.preset + "' is not one of ultrafast, superfast, veryfast");
+  vp.bitrate_kbps = static_cast<int>(v.integer("bitrate_kbps", vp.bitrate_kbps, 50, 50000));
+  vp.gop = static_cast<int>(v.integer("gop", vp.gop, 1, 600));
+  vp.intra_refresh = v.boolean("intra_refresh", vp.intra_refresh);
+  vp.host = v.string("host", vp.host);
+  vp.port = static_cast<int>(v.integer("port", vp.port, 1, 65535));
+  vp.mtu = static_cast<int>(v.integer("mtu", vp.mtu, 256, 9000));
   return c;
 }
 

@@ -22,6 +22,24 @@ struct SafetyParams {
   double nav_stall_s = 120.0;
 };
 
+/// Camera stream (docs/video.md); becomes video::SenderSettings.
+struct VideoParams {
+  bool enabled = true;
+  std::string source = "synthetic";  // "synthetic", "v4l2:/dev/videoN", "file:PATH"
+  int width = 640;
+  int height = 480;
+  double fps = 30.0;
+  std::string pixel_format;          // V4L2 FOURCC asked of a camera ("MJPG", "YUYV"); "" = driver's
+  std::string encoder = "libx264";   // "libx264", "h264_v4l2m2m" (Pi) or "auto"
+  std::string preset = "ultrafast";
+  int bitrate_kbps = 2000;
+  int gop = 30;
+  bool intra_refresh = false;
+  std::string host;                  // "" = the server's host
+  int port = 5600;
+  int mtu = 1200;
+};
+
 struct ClientConfig {
   std::string robot_id = "robot1";
   std::string server_host = "127.0.0.1";
@@ -36,6 +54,7 @@ struct ClientConfig {
   double serial_reopen_period_s = 1.0;
   double mcu_heartbeat_period_s = 0.1;
   SafetyParams safety;
+  VideoParams video;
   std::string map_file;  // world file whose walls people tracking ignores ("" = no map); --map overrides
 };
 

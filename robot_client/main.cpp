@@ -42,6 +42,10 @@ options:
                        pose), people tracking treats as static (overrides
                        map: in the client config)
   --cmd-log FILE       write every wheel command sent to the MCU (CSV; for tests)
+  --video-source URI   camera stream source (overrides video.source): synthetic,
+                       v4l2:/dev/videoN or file:PATH
+  --video-port PORT    UDP port of the server's video receiver (overrides video.port)
+  --no-video           do not stream video (overrides video.enabled)
   --version            print the version and exit
   --help               print this help and exit
 
@@ -66,7 +70,8 @@ int main(int argc, char** argv) {
   std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
   std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
   std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
-  std::string serial_dev, server, id, cmd_log, map_path;
+  std::string serial_dev, server, id, cmd_log, map_path, video_source, video_port;
+  bool no_video = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -97,6 +102,12 @@ int main(int argc, char** argv) {
       cmd_log = value();
     } else if (a == "--map") {
       map_path = value();
+    } else if (a == "--video-source") {
+      video_source = value();
+    } else if (a == "--video-port") {
+      video_port = value();
+    } else if (a == "--no-video") {
+      no_video = true;
     } else {
       usageError("unknown option '" + a + "'");
     }
@@ -121,6 +132,15 @@ int main(int argc, char** argv) {
       const long port = std::strtol(server.c_str() + colon + 1, &end, 10);
       if (*end != '\0' || port < 1 || port > 65535) usageError("--server '" + server + "': bad port");
       cfg.server_port = static_cast<int>(port);
+    }
+
+    if (!video_source.empty()) cfg.video.source = video_source;
+    if (no_video) cfg.video.enabled = false;
+    if (!video_port.empty()) {
+      char* end = nullptr;
+      const long port = std::strtol(video_port.c_str(), &end, 10);
+      if (*end != '\0' || port < 1 || port > 65535) usageError("--video-port '" + video_port + "': bad port");
+      cfg.video.port = static_cast<int>(port);
     }
 
     config::ControlConfig control;

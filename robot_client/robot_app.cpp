@@ -1,6 +1,7 @@
 #include "robot_client/robot_app.hpp"
 
 #include <chrono>
+#include <cmath>
 
 #include "shared/config/config_node.hpp"
 #include "shared/util/clock.hpp"
@@ -15,6 +16,34 @@ namespace {
 steady_clock::duration secs(double s) {
   return std::chrono::duration_cast<steady_clock::duration>(std::chrono::duration<double>(s));
 }
+
+video::SenderSettings senderSettings(const ClientConfig& cfg) {
+  const VideoParams& v = cfg.video;
+  video::SenderSettings s;
+  s.enabled = v.enabled;
+  s.source.uri = v.source;
+  s.source.width = v.width;
+  s.source.height = v.height;
+  s.source.fps = v.fps;
+  s.source.pixel_format = v.pixel_format;
+  s.encoder.codec = v.encoder;
+  s.encoder.preset = v.preset;
+  s.encoder.bitrate_kbps = v.bitrate_kbps;
+  s.encoder.gop = v.gop;
+  s.encoder.intra_refresh = v.intra_refresh;
+  s.host = v.host.empty() ? cfg.server_host : v.host;
+  s.port = static_cast<uint16_t>(v.port);
+  s.mtu = static_cast<std::size_t>(v.mtu);
+  return s;
+}
+
+v1::Ack ack(uint64_t id, v1::Ack::Status status, const std::string& reason = {}) {
+  v1::Ack a;
+  a.set_command_id(id);
+  a.set_status(status);
+  a.set_reason(reason);
+  return a;
+}
 }  // namespace
 
 RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::RobotConfig& robot,
@@ -28,6 +57,11 @@ RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::
     if (!cmd_log_) throw config::ConfigError("--cmd-log: cannot write " + cmd_log_path);
     std::setvbuf(cmd_log_, nullptr, _IOLBF, 0);  // readers see every command at once
     std::fprintf(cmd_log_, "# seq,left_mrad_s,right_mrad_s,flags\n");
+  }
+  try {
+    video_ = std::make_unique<video::VideoSender>(senderSettings(cfg));
+  } catch (const video::VideoError& e) {
+    log::error("video", e.what(), ": no video stream");
   }
 }
 
@@ -57,12 +91,14 @@ void RobotApp::start() {
   tick10ms();
   sendTelemetry();
   mcuHeartbeat();
+  if (video_) video_->start();
 }
 
 void RobotApp::stop() {
   tick_timer_.cancel();
   telemetry_timer_.cancel();
   mcu_hb_timer_.cancel();
+  if (video_) video_->stop();
   // Leave the motors commanded to zero before going.
   if (serial_.isOpen()) sendWheels(serial::WheelCommand{});
   link_.stop();
@@ -87,6 +123,12 @@ void RobotApp::onServerMessage(const v1::Envelope& env) {
     case v1::Envelope::kHeartbeat: core_.onLinkActivity(now()); break;
     case v1::Envelope::kCommand: {
       v1::Envelope reply;
+      if (env.command().has_video() || env.command().has_ptz()) {
+        // Camera commands do not touch the motion state.
+        *reply.mutable_ack() = env.command().has_video() ? onVideoCommand(env.command()) : onPtzCommand(env.command());
+        link_.send(reply);
+        break;
+      }
       *reply.mutable_ack() = core_.onCommand(env.command(), now());
       link_.send(reply);
       // A stop takes effect now, not at the next sensor frame.
@@ -96,6 +138,71 @@ void RobotApp::onServerMessage(const v1::Envelope& env) {
     default: log::debug("link", "ignoring message type ", static_cast<int>(env.body_case()));
   }
   flushEvents();
+}
+
+v1::Ack RobotApp::onVideoCommand(const v1::Command& cmd) {
+  const auto& v = cmd.video();
+  if (!video_) return ack(cmd.id(), v1::Ack::REJECTED, "video: this robot has no video stream (see its log)");
+  video::SenderChange c;
+  if (v.has_enabled()) c.enabled = v.enabled();
+  if (v.width() || v.height()) {
+    c.width = static_cast<int>(v.width());
+    c.height = static_cast<int>(v.height());
+  }
+  if (v.fps() != 0) c.fps = v.fps();
+  if (v.bitrate_kbps()) c.bitrate_kbps = static_cast<int>(v.bitrate_kbps());
+  if (const auto why = video_->apply(c); !why.empty()) return ack(cmd.id(), v1::Ack::REJECTED, why);
+  if (v.keyframe()) video_->requestKeyframe();
+  return ack(cmd.id(), v1::Ack::ACCEPTED);
+}
+
+v1::Ack RobotApp::onPtzCommand(const v1::Command& cmd) {
+  const auto& p = cmd.ptz();
+  if (!std::isfinite(p.pan_rad()) || !std::isfinite(p.tilt_rad()) || std::abs(p.pan_rad()) > M_PI ||
+      std::abs(p.tilt_rad()) > M_PI / 2)
+    return ack(cmd.id(), v1::Ack::REJECTED, "ptz: pan must be within [-pi, pi] and tilt within [-pi/2, pi/2] rad");
+  if (!serial_.isOpen()) return ack(cmd.id(), v1::Ack::REJECTED, "ptz: the MCU's serial line is down");
+  serial::PtzCommand c;
+  if (p.home()) {
+    c.flags = 0x01;
+    ptz_pan_rad_ = ptz_tilt_rad_ = 0;
+  } else {
+    c.pan_0p1mrad = static_cast<int16_t>(std::lround(p.pan_rad() * 1e4));
+    c.tilt_0p1mrad = static_cast<int16_t>(std::lround(p.tilt_rad() * 1e4));
+    ptz_pan_rad_ = p.pan_rad();
+    ptz_tilt_rad_ = p.tilt_rad();
+  }
+  serial_.send(c);
+  return ack(cmd.id(), v1::Ack::ACCEPTED);
+}
+
+void RobotApp::fillVideoStatus(v1::Telemetry& t) const {
+  t.set_ptz_pan_rad(ptz_pan_rad_);
+  t.set_ptz_tilt_rad(ptz_tilt_rad_);
+  if (!video_) {
+    t.clear_video();
+    return;
+  }
+  const auto s = video_->stats();
+  auto* v = t.mutable_video();
+  v->set_enabled(s.enabled);
+  v->set_ssrc(s.ssrc);
+  v->set_width(static_cast<uint32_t>(s.width));
+  v->set_height(static_cast<uint32_t>(s.height));
+  v->set_fps(s.fps);
+  v->set_bitrate_kbps(static_cast<uint32_t>(s.bitrate_kbps));
+  v->set_encoder(s.encoder);
+  v->set_source(s.source);
+  v->set_frames_captured(s.captured);
+  v->set_frames_encoded(s.encoded);
+  v->set_frames_dropped(s.dropped);
+  v->set_keyframes(s.keyframes);
+  v->set_packets_sent(s.packets);
+  v->set_bytes_sent(s.bytes);
+  v->set_encode_ms(s.encode_ms);
+  v->set_port(s.port);
+  v->set_error(s.error);
+  v->set_keyframe_requests(s.keyframe_requests);
 }
 
 void RobotApp::flushEvents() {
@@ -128,6 +235,7 @@ void RobotApp::sendTelemetry() {
   core_.setSerialCounters(serial_.rxCounters(), serial_.bytesTx(), serial_.framesTx());
   if (link_.isUp()) {
     core_.fillTelemetry(*telemetry_env_.mutable_telemetry(), now());
+    fillVideoStatus(*telemetry_env_.mutable_telemetry());
     link_.send(telemetry_env_);
   }
   telemetry_timer_.expires_after(secs(1.0 / cfg_.telemetry_hz));

@@ -14,6 +14,7 @@
 #include "robot_client/server_link.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
+#include "shared/video/video_sender.hpp"
 
 namespace inspect::client {
 
@@ -36,6 +37,9 @@ class RobotApp {
   void tick10ms();
   void sendTelemetry();
   void mcuHeartbeat();
+  v1::Ack onVideoCommand(const v1::Command& cmd);
+  v1::Ack onPtzCommand(const v1::Command& cmd);
+  void fillVideoStatus(v1::Telemetry& t) const;
 
   boost::asio::io_context& io_;
   ClientConfig cfg_;
@@ -47,6 +51,8 @@ class RobotApp {
   boost::asio::steady_timer mcu_hb_timer_;
   int64_t t0_ns_;
   std::FILE* cmd_log_ = nullptr;
+  std::unique_ptr<video::VideoSender> video_;  // null when the stream could not be set up
+  double ptz_pan_rad_ = 0, ptz_tilt_rad_ = 0;
   v1::Envelope telemetry_env_;  // reused to avoid reallocating repeated fields
 };
 

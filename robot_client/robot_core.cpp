@@ -352,6 +352,9 @@ v1::Ack RobotCore::onCommand(const v1::Command& cmd, double now_s) {
       }
       ack.set_status(v1::Ack::ACCEPTED);
       return ack;
+    case v1::Command::kVideo:
+    case v1::Command::kPtz:
+      return reject("camera commands are handled by the robot's video sender, not the motion core");
     case v1::Command::KIND_NOT_SET: break;
   }
   return reject("unknown or empty command");

@@ -73,6 +73,8 @@ void ServerLink::onConnected() {
   h->set_robot_id(cfg_.robot_id);
   h->set_protocol_version(net::kProtocolVersion);
   h->add_capabilities("teleop");
+  h->add_capabilities("video");
+  h->add_capabilities("ptz");
   h->set_software_version(INSPECT_VERSION);
   send(hello);
   const uint64_t gen = generation_;

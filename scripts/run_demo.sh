@@ -46,15 +46,21 @@ head -n 1 "$OUT/mcu_sim.out"
 
 # robot_client starts once pc_server has reported its port.
 (
-  for _ in $(seq 200); do [ -s "$OUT/port" ] && break; sleep 0.05; done
+  for _ in $(seq 200); do [ -s "$OUT/port" ] && [ -s "$OUT/video_port" ] && break; sleep 0.05; done
   exec "$BIN/robot_client" --config config/client.yaml --robot-config config/robot.yaml \
-    --serial "$OUT/mcu" --server "127.0.0.1:$(cat "$OUT/port")" --id robot1 2>"$OUT/robot_client.err"
+    --serial "$OUT/mcu" --server "127.0.0.1:$(cat "$OUT/port")" --video-port "$(cat "$OUT/video_port")" \
+    --id robot1 2>"$OUT/robot_client.err"
 ) &
 CLIENT=$!
 PIDS+=("$CLIENT")
 
+# Video on an ephemeral UDP port (5600 may be taken); SDP and snapshots in $OUT/video.
 ARGS=(--config config/server.yaml --bind 127.0.0.1 --port "$PORT" --port-file "$OUT/port"
+      --video-port 0 --video-port-file "$OUT/video_port" --video-dir "$OUT/video"
       --script scripts/demo/square.console)
+echo "demo: camera: $OUT/video/robot1.sdp (play it while the console runs:"
+echo "        ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay $OUT/video/robot1.sdp)"
+echo "      snapshots: $OUT/video/robot1_latest.png (refreshed every 5 s), 'snapshot' at the console" 
 status=0
 if [ "$MODE" = interactive ]; then
   echo "demo: the script runs first; then the console is yours (try 'help', 'teleop', 'quit')"
@@ -78,5 +84,6 @@ awk -F, '$1=="T"{ if(!n){x0=$4;y0=$5;t0=$6;n=1} x=$4;y=$5;t=$6 }
        printf "ground truth, relative to the start pose: x=%.3f m  y=%.3f m  theta=%.3f rad\n", c*dx+s*dy, -s*dx+c*dy, d }' "$OUT/truth.csv"
 LAST=$(grep -E 'x [-+]?[0-9]' "$OUT/pc_server.out" 2>/dev/null | tail -n 1 || true)
 [ -n "$LAST" ] && echo "last telemetry status line:               $LAST"
+ls "$OUT"/video/*.png 2>/dev/null | sed 's/^/camera snapshot:                          /' || true
 if [ "$status" -eq 0 ]; then echo "demo: all console checks passed"; else echo "demo: console checks FAILED (exit $status)"; fi
 exit "$status"

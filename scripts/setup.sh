@@ -13,6 +13,10 @@ PACKAGES=(
   nlohmann-json3-dev
   fuzzylite libfuzzylite-dev
   gnuplot-nox
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
+  ffmpeg
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev libopencv-highgui-dev
+  gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-plugins-ugly gstreamer1.0-libav
 )
 
 missing=()

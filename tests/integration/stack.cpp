@@ -65,11 +65,23 @@ bool Stack::startServer(const std::string& script, const std::vector<std::string
                                    "--bind",            "127.0.0.1", "--port",
                                    "0",                 "--port-file", dir_ / "port",
                                    "--script",          dir_ / "script.txt"};
+  if (video_) {
+    for (const std::string a : {"--video-port", "0", "--video-port-file"}) argv.push_back(a);
+    argv.push_back(dir_ / "video_port");
+    argv.push_back("--video-dir");
+    argv.push_back(videoDir());
+  } else {
+    argv.push_back("--no-video");
+  }
   argv.insert(argv.end(), extra.begin(), extra.end());
   server_ = Process::spawn(argv, dir_ / "server.out", dir_ / "server.err");
   if (!waitUntil([&] { return exists(dir_ / "port"); }, 10.0)) return false;
   port_ = std::atoi(readFile(dir_ / "port").c_str());
-  return port_ > 0;
+  if (video_) {
+    if (!waitUntil([&] { return exists(dir_ / "video_port"); }, 10.0)) return false;
+    video_port_ = std::atoi(readFile(dir_ / "video_port").c_str());
+  }
+  return port_ > 0 && (!video_ || video_port_ > 0);
 }
 
 RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
@@ -98,6 +110,12 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
                                           srcPath("config/control.yaml"), "--behavior-config",
                                           srcPath("config/behavior.yaml"), "--serial", r->pty, "--server",
                                           "127.0.0.1:" + std::to_string(port_), "--id", id, "--cmd-log", r->cmd_log};
+  if (video_) {
+    client_argv.push_back("--video-port");
+    client_argv.push_back(std::to_string(video_port_));
+  } else {
+    client_argv.push_back("--no-video");
+  }
   client_argv.insert(client_argv.end(), client_args.begin(), client_args.end());
   r->client = Process::spawn(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
   robots_.push_back(std::move(r));

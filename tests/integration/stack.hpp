@@ -62,6 +62,13 @@ class Stack {
 
   const TempDir& dir() const { return dir_; }
 
+  /// Video on for the programs started after this call (off by default: it
+  /// costs CPU that the timing of other tests should not share). The server
+  /// gets an ephemeral UDP port and <dir>/video; robots send to that port.
+  void enableVideo() { video_ = true; }
+  int videoPort() const { return video_port_; }
+  std::string videoDir() const { return dir_ / "video"; }
+
   /// Starts pc_server on an ephemeral port running `script` (console commands).
   /// Returns false if it did not report its port within 10 s.
   bool startServer(const std::string& script, const std::vector<std::string>& extra = {});
@@ -83,6 +90,8 @@ class Stack {
   TempDir dir_;
   Process server_;
   int port_ = 0;
+  bool video_ = false;
+  int video_port_ = 0;
   std::vector<std::unique_ptr<RobotProcs>> robots_;
   std::map<std::string, Process> relays_;
 };

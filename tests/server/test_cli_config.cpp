@@ -43,6 +43,31 @@ TEST(Cli, FlagsAndValues) {
   EXPECT_FALSE(parseCli({}).port.has_value());
 }
 
+TEST(Cli, VideoFlags) {
+  const auto o = parseCli({"--video-port", "0", "--video-port-file", "vp", "--video-dir", "/tmp/v", "--no-video"});
+  EXPECT_EQ(o.video_port, 0);
+  EXPECT_EQ(o.video_port_file, "vp");
+  EXPECT_EQ(o.video_dir, "/tmp/v");
+  EXPECT_TRUE(o.no_video);
+  EXPECT_EQ(cliError({"--video-port", "x"}), "--video-port: 'x' is not a port number (0-65535)");
+}
+
+TEST(ServerConfig, Video) {
+  const auto c = loadServerConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/server.yaml");
+  const VideoServerConfig d;
+  EXPECT_EQ(c.video.enabled, d.enabled);
+  EXPECT_EQ(c.video.port, 5600);
+  EXPECT_EQ(c.video.forward_base_port, 5700);
+  EXPECT_EQ(c.video.dir, "video");
+  EXPECT_EQ(c.video.window, "auto");
+  EXPECT_DOUBLE_EQ(c.video.keyframe_min_interval_s, 0.3);
+  EXPECT_EQ(configError("video:\n  window: maybe\n"), "server.yaml: video.window: 'maybe' is not one of auto, on, off");
+  EXPECT_EQ(configError("video:\n  port: 70000\n"), "server.yaml: video.port: 70000 is out of range [0, 65535]");
+  EXPECT_EQ(configError("video:\n  bind: here\n"), "server.yaml: video.bind: 'here' is not a numeric IP address");
+  EXPECT_EQ(configError("video:\n  keyframe_min_interval_s: 0\n"),
+            "server.yaml: video.keyframe_min_interval_s: 0 is out of range [0.05, 10]");
+}
+
 TEST(Cli, ErrorsNameTheFlag) {
   EXPECT_EQ(cliError({"--prot", "1"}), "unknown flag '--prot'");
   EXPECT_EQ(cliError({"--port", "70000"}), "--port: '70000' is not a port number (0-65535)");
@@ -57,7 +82,7 @@ TEST(Cli, ErrorsNameTheFlag) {
 TEST(Cli, UsageMentionsEveryFlag) {
   const auto u = usageText();
   for (const char* f : {"--config", "--bind", "--port", "--port-file", "--script", "--interactive", "--no-console",
-                        "--help"})
+                        "--video-port", "--video-port-file", "--video-dir", "--no-video", "--help"})
     EXPECT_NE(u.find(f), std::string::npos) << f;
 }
 

@@ -2,6 +2,8 @@
 // answers like a robot through the registry.
 #include <gtest/gtest.h>
 
+#include <numbers>
+
 #include <stdlib.h>
 
 #include <algorithm>
@@ -541,4 +543,66 @@ TEST_F(ConsoleTest, ExpectNavigationFieldsAndStatusLine) {
   EXPECT_TRUE(ok) << out;
   std::tie(ok, out) = run("status");
   EXPECT_EQ(out.find(" nav "), std::string::npos) << out;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Video, ConsoleBadArgs,
+    ::testing::Values(BadArgsCase{"video", "syntax: video on|off"}, BadArgsCase{"video loud", "unknown 'loud'"},
+                      BadArgsCase{"video res 7x5", "video: res '7x5': want <W>x<H>, even, 64 to 4096"},
+                      BadArgsCase{"video res 640", "video: res '640'"},
+                      BadArgsCase{"video res 641x480", "video: res '641x480'"},
+                      BadArgsCase{"video fps 0", "video: fps '0': want 1 to 120"},
+                      BadArgsCase{"video fps many", "video: fps 'many'"},
+                      BadArgsCase{"video bitrate 10", "video: bitrate '10': want 50 to 50000 kbit/s"},
+                      BadArgsCase{"video on now", "syntax: video"},
+                      BadArgsCase{"ptz 200 0", "ptz: pan must be within [-180, 180] and tilt within [-90, 90]"},
+                      BadArgsCase{"ptz 10", "syntax: ptz <pan_deg> <tilt_deg> | ptz home"},
+                      BadArgsCase{"ptz left up", "syntax: ptz"},
+                      BadArgsCase{"snapshot a.png b.png", "syntax: snapshot [file.png]"},
+                      BadArgsCase{"snapshot", "snapshot: the server runs without video"}));
+
+TEST_F(ConsoleTest, VideoAndPtzCommandsReachTheRobot) {
+  connectRobot();
+  auto [ok, out] = run("video res 1280x720");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_HAS(out, "robot1: video res accepted");
+  ASSERT_EQ(sink_.sent.size(), 1u);
+  EXPECT_EQ(sink_.sent[0].video().width(), 1280u);
+  EXPECT_EQ(sink_.sent[0].video().height(), 720u);
+  EXPECT_FALSE(sink_.sent[0].video().has_enabled());
+  std::tie(ok, out) = run("video off");
+  EXPECT_TRUE(ok) << out;
+  ASSERT_TRUE(sink_.sent.back().video().has_enabled());
+  EXPECT_FALSE(sink_.sent.back().video().enabled());
+  std::tie(ok, out) = run("video keyframe");
+  EXPECT_TRUE(sink_.sent.back().video().keyframe());
+  std::tie(ok, out) = run("video bitrate 800");
+  EXPECT_EQ(sink_.sent.back().video().bitrate_kbps(), 800u);
+  std::tie(ok, out) = run("video fps 15");
+  EXPECT_DOUBLE_EQ(sink_.sent.back().video().fps(), 15.0);
+  std::tie(ok, out) = run("ptz 90 -45");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_NEAR(sink_.sent.back().ptz().pan_rad(), std::numbers::pi / 2, 1e-12);
+  EXPECT_NEAR(sink_.sent.back().ptz().tilt_rad(), -std::numbers::pi / 4, 1e-12);
+  std::tie(ok, out) = run("ptz home");
+  EXPECT_TRUE(sink_.sent.back().ptz().home());
+  sink_.reply = v1::Ack::REJECTED;
+  sink_.reason = "video: this robot has no video stream (see its log)";
+  std::tie(ok, out) = run("video on");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "robot1: video on rejected: video: this robot has no video stream");
+}
+
+TEST_F(ConsoleTest, VideoStatsWithoutAServerStreamSaysSo) {
+  connectRobot();
+  v1::Telemetry t;
+  t.mutable_video()->set_enabled(true);
+  t.mutable_video()->set_ssrc(42);
+  t.mutable_video()->set_frames_encoded(300);
+  registry_.onTelemetry("robot1", kSerial, t, monoNowNs());
+  const auto [ok, out] = run("video stats");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_HAS(out, "SSRC 42");
+  EXPECT_HAS(out, "encoded 300");
+  EXPECT_HAS(out, "server: video off");
 }

@@ -1,5 +1,6 @@
 // The real pc_server binary: script mode with a test robot, piped stdin,
 // exit statuses, config errors and shutdown by signal.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -56,6 +57,8 @@ class Program {
     const auto in_path = file("stdin.txt", stdin_text);
     const auto out_path = path("stdout.txt");
     const auto err_path = path("stderr.txt");
+    // No UDP video port 5600 (tests run in parallel); the video tests ask for an ephemeral one.
+    if (std::find(args.begin(), args.end(), "--video-port") == args.end()) args.push_back("--no-video");
     args.insert(args.begin(), kBinary);
     pid_ = ::fork();
     ASSERT_GE(pid_, 0);

@@ -40,3 +40,24 @@ TEST(ClientConfig, RobotIds) {
   EXPECT_FALSE(client::validRobotId(std::string(65, 'a')));
   EXPECT_FALSE(client::validRobotId("a b"));
 }
+
+TEST(ClientConfig, Video) {
+  const auto c = client::loadClientConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/client.yaml");
+  const client::VideoParams d;
+  EXPECT_EQ(c.video.enabled, d.enabled);
+  EXPECT_EQ(c.video.source, "synthetic");
+  EXPECT_EQ(c.video.width, 640);
+  EXPECT_EQ(c.video.port, 5600);
+  EXPECT_EQ(c.video.mtu, 1200);
+  EXPECT_EQ(c.video.encoder, "libx264");
+  EXPECT_NE(errorOf("video:\n  width: 641\n").find("video.width: width and height must be even"), std::string::npos);
+  EXPECT_NE(errorOf("video:\n  fps: 0\n").find("video.fps: 0 is out of range"), std::string::npos);
+  EXPECT_NE(errorOf("video:\n  encoder: h265\n").find("video.encoder: 'h265' is not one of"), std::string::npos);
+  EXPECT_NE(errorOf("video:\n  preset: slow\n").find("video.preset: 'slow'"), std::string::npos);
+  EXPECT_NE(errorOf("video:\n  bitrate_kbps: 10\n").find("video.bitrate_kbps: 10 is out of range"), std::string::npos);
+  EXPECT_NE(errorOf("video:\n  mtu: 100\n").find("video.mtu: 100 is out of range"), std::string::npos);
+  EXPECT_NE(errorOf("video:\n  pixel_format: MJPEG\n").find("video.pixel_format: a FOURCC is 4 characters"),
+            std::string::npos);
+  EXPECT_NE(errorOf("video:\n  source: ''\n").find("video.source: must not be empty"), std::string::npos);
+  EXPECT_NE(errorOf("video:\n  gopp: 3\n").find("video.gopp: unknown key"), std::string::npos);
+}

@@ -1,0 +1,365 @@
+#include "shared/video/video_receiver.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include <boost/asio/post.hpp>
+
+#include "shared/util/clock.hpp"
+#include "shared/util/log.hpp"
+
+namespace inspect::video {
+
+namespace asio = boost::asio;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+constexpr std::string_view kTag = "video";
+constexpr std::size_t kMaxDatagram = 65536;
+constexpr auto kTick = std::chrono::milliseconds(100);
+constexpr int kTicksPerWindow = 10;            // rates over 1 s
+constexpr std::size_t kLatencyHistory = 300;
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return -1;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+}  // namespace
+
+struct VideoReceiver::Stream {
+  Stream(uint32_t ssrc_, asio::ip::address source_, int64_t offset, std::size_t window, bool decode)
+      : ssrc(ssrc_), source(std::move(source_)), offset_us(offset), reorder(window) {
+    if (decode) decoder = std::make_unique<H264Decoder>();
+  }
+  uint32_t ssrc;
+  asio::ip::address source;
+  int64_t offset_us;
+  ReorderBuffer reorder;
+  H264Depacketizer depack;
+  std::unique_ptr<H264Decoder> decoder;
+  // The picture is damaged (a frame was dropped or skipped, or the decoder
+  // failed) until a keyframe decodes: request keyframes, freeze the picture.
+  bool damaged = false;
+  Clock::time_point last_request{};
+  Clock::time_point gap_since{};  // packets held behind a missing one since; {} = none held
+  Clock::time_point last_packet{};
+  StreamStats st;
+  std::vector<uint8_t> sps, pps;
+  std::deque<double> latencies;  // ms, last kLatencyHistory decoded frames
+  // Current 1 s window.
+  uint64_t w_bytes = 0, w_frames = 0, w_decoded = 0, w_packets = 0, w_lost = 0;
+  double w_latency_sum = 0;
+  uint64_t w_latency_n = 0;
+  std::vector<std::pair<uint32_t, std::vector<uint8_t>>> ready;  // scratch
+};
+
+VideoReceiver::VideoReceiver(ReceiverSettings s)
+    : settings_(std::move(s)), socket_(io_), tick_timer_(io_), rx_buf_(kMaxDatagram) {
+  boost::system::error_code ec;
+  const auto addr = asio::ip::make_address(settings_.bind, ec);
+  if (ec) throw VideoError("video receiver: bad bind address '" + settings_.bind + "'");
+  const asio::ip::udp::endpoint ep(addr, settings_.port);
+  socket_.open(ep.protocol(), ec);
+  if (!ec) socket_.set_option(asio::socket_base::receive_buffer_size(4 << 20), ec);
+  ec.clear();
+  if (!ec) socket_.bind(ep, ec);
+  if (ec)
+    throw VideoError("video receiver: cannot bind UDP " + settings_.bind + ":" + std::to_string(settings_.port) +
+                     ": " + ec.message());
+  port_ = socket_.local_endpoint().port();
+}
+
+VideoReceiver::~VideoReceiver() { stop(); }
+
+void VideoReceiver::start() {
+  if (started_) return;
+  started_ = true;
+  doReceive();
+  tick_timer_.expires_after(kTick);
+  tick_timer_.async_wait([this](const boost::system::error_code& ec) {
+    if (!ec) tick();
+  });
+  thread_ = std::thread([this] { io_.run(); });
+}
+
+void VideoReceiver::stop() {
+  if (!started_) return;
+  started_ = false;
+  io_.stop();
+  if (thread_.joinable()) thread_.join();
+}
+
+void VideoReceiver::setStream(const std::string& name, uint32_t ssrc, const asio::ip::address& source,
+                              int64_t clock_offset_us) {
+  {
+    std::lock_guard lk(mu_);
+    published_[name].stats.ssrc = ssrc;
+  }
+  asio::post(io_, [this, name, ssrc, source, clock_offset_us] {
+    auto& s = streams_[name];
+    if (s && s->ssrc == ssrc && s->source == source) {
+      s->offset_us = clock_offset_us;
+      return;
+    }
+    s = std::make_unique<Stream>(ssrc, source, clock_offset_us, settings_.reorder_window, settings_.decode);
+    s->st.ssrc = ssrc;
+    log::info(kTag, name, ": expecting SSRC ", ssrc, " from ", source.is_unspecified() ? "any address" : source.to_string());
+  });
+}
+
+void VideoReceiver::setClockOffset(const std::string& name, int64_t clock_offset_us) {
+  asio::post(io_, [this, name, clock_offset_us] {
+    if (auto it = streams_.find(name); it != streams_.end()) it->second->offset_us = clock_offset_us;
+  });
+}
+
+void VideoReceiver::removeStream(const std::string& name) {
+  asio::post(io_, [this, name] {
+    streams_.erase(name);
+    std::lock_guard lk(mu_);
+    published_[name].stats.active = false;
+  });
+}
+
+void VideoReceiver::setKeyframeRequest(KeyframeRequest f) {
+  std::lock_guard lk(mu_);
+  keyframe_request_ = std::move(f);
+}
+void VideoReceiver::setFrameHook(FrameHook f) {
+  std::lock_guard lk(mu_);
+  frame_hook_ = std::move(f);
+}
+void VideoReceiver::setPacketHook(PacketHook f) {
+  std::lock_guard lk(mu_);
+  packet_hook_ = std::move(f);
+}
+
+std::optional<StreamStats> VideoReceiver::stats(const std::string& name) const {
+  std::lock_guard lk(mu_);
+  auto it = published_.find(name);
+  if (it == published_.end()) return std::nullopt;
+  return it->second.stats;
+}
+
+ReceiverCounters VideoReceiver::counters() const {
+  std::lock_guard lk(mu_);
+  return counters_;
+}
+
+bool VideoReceiver::latestFrame(const std::string& name, cv::Mat& bgr, uint64_t* capture_us) const {
+  std::lock_guard lk(mu_);
+  auto it = published_.find(name);
+  if (it == published_.end() || it->second.latest.empty()) return false;
+  bgr = it->second.latest;
+  if (capture_us) *capture_us = it->second.latest_capture_us;
+  return true;
+}
+
+bool VideoReceiver::parameterSets(const std::string& name, std::vector<uint8_t>& sps, std::vector<uint8_t>& pps) const {
+  std::lock_guard lk(mu_);
+  auto it = published_.find(name);
+  if (it == published_.end() || it->second.sps.empty() || it->second.pps.empty()) return false;
+  sps = it->second.sps;
+  pps = it->second.pps;
+  return true;
+}
+
+void VideoReceiver::doReceive() {
+  socket_.async_receive_from(asio::buffer(rx_buf_), sender_, [this](const boost::system::error_code& ec, std::size_t n) {
+    if (ec == asio::error::operation_aborted) return;
+    if (!ec) onDatagram(n);
+    doReceive();
+  });
+}
+
+void VideoReceiver::onDatagram(std::size_t n) {
+  const std::span<const uint8_t> data(rx_buf_.data(), n);
+  RtpPacket p;
+  const RtpError err = parseRtp(data, p);
+  const auto reject = [&](uint64_t ReceiverCounters::*counter, const std::string& why) {
+    std::lock_guard lk(mu_);
+    ++counters_.datagrams;
+    ++(counters_.*counter);
+    counters_.last_reject = "from " + sender_.address().to_string() + ":" + std::to_string(sender_.port()) + ": " + why;
+  };
+  if (err != RtpError::kNone) return reject(&ReceiverCounters::not_rtp, std::string("not RTP: ") + toString(err));
+  if (p.payload_type != kPayloadType)
+    return reject(&ReceiverCounters::wrong_payload_type, "payload type " + std::to_string(p.payload_type));
+  for (auto& [name, s] : streams_) {
+    if (s->ssrc != p.ssrc) continue;
+    if (!s->source.is_unspecified() && s->source != sender_.address())
+      return reject(&ReceiverCounters::wrong_source, "SSRC " + std::to_string(p.ssrc) + " of " + name +
+                                                         " from another address than the robot's");
+    {
+      std::lock_guard lk(mu_);
+      ++counters_.datagrams;
+    }
+    handlePacket(*s, name, std::vector<uint8_t>(data.begin(), data.end()));
+    return;
+  }
+  reject(&ReceiverCounters::unknown_ssrc, "unknown SSRC " + std::to_string(p.ssrc));
+}
+
+void VideoReceiver::handlePacket(Stream& s, const std::string& name, std::vector<uint8_t> datagram) {
+  const auto now = Clock::now();
+  s.last_packet = now;
+  ++s.st.packets;
+  ++s.w_packets;
+  s.st.bytes += datagram.size();
+  s.w_bytes += datagram.size();
+  PacketHook packet_hook;
+  {
+    std::lock_guard lk(mu_);
+    packet_hook = packet_hook_;
+  }
+  if (packet_hook) packet_hook(name, datagram);
+  RtpPacket probe;
+  parseRtp(datagram, probe);
+  s.reorder.push(probe.seq, std::move(datagram));
+  s.ready.clear();
+  s.reorder.pop(s.ready);
+  // A gap is given up after reorder_timeout_s even when fewer than `window`
+  // packets wait behind it: a loss must freeze the picture and ask for a
+  // keyframe at once, not 16 packets later.
+  if (s.reorder.held() == 0) {
+    s.gap_since = {};
+  } else if (s.gap_since == Clock::time_point{}) {
+    s.gap_since = now;
+  } else if (now - s.gap_since >= std::chrono::duration<double>(settings_.reorder_timeout_s)) {
+    s.reorder.flush(s.ready);
+    s.gap_since = {};
+  }
+  depacketizeReady(s, name);
+  maybeRequestKeyframe(s, name);
+}
+
+void VideoReceiver::depacketizeReady(Stream& s, const std::string& name) {
+  for (auto& [skipped, dgram] : s.ready) {
+    RtpPacket p;
+    if (parseRtp(dgram, p) != RtpError::kNone) continue;
+    const uint64_t dropped_before = s.depack.counters().frames_dropped;
+    auto f = s.depack.push(p, skipped);
+    if (s.depack.counters().frames_dropped != dropped_before) s.damaged = true;
+    if (f) onFrame(s, name, *f);
+  }
+  s.ready.clear();
+}
+
+void VideoReceiver::maybeRequestKeyframe(Stream& s, const std::string& name) {
+  const auto now = Clock::now();
+  if (!s.damaged || now - s.last_request < std::chrono::duration<double>(settings_.keyframe_min_interval_s)) return;
+  s.last_request = now;
+  ++s.st.keyframe_requests;
+  KeyframeRequest request;
+  {
+    std::lock_guard lk(mu_);
+    request = keyframe_request_;
+  }
+  if (request) request(name);
+}
+
+void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) {
+  ++s.w_frames;
+  if (f.has_parameter_sets) {
+    for (auto nal : splitAnnexB(f.annexb)) {
+      if (nalType(nal[0]) == kNalSps) s.sps.assign(nal.begin(), nal.end());
+      if (nalType(nal[0]) == kNalPps) s.pps.assign(nal.begin(), nal.end());
+    }
+  }
+  if (!s.decoder) return;
+  // After a loss the picture stays frozen until a keyframe: P frames that
+  // reference a lost frame would only smear the damage (as WebRTC does).
+  // The same before the first keyframe (a stream joined mid-GOP).
+  if (!f.keyframe && (s.damaged || s.depack.needKeyframe())) {
+    ++s.st.frames_skipped;
+    s.damaged = true;
+    return;
+  }
+  cv::Mat bgr;  // fresh per picture: published by reference count
+  if (!s.decoder->decode(f.annexb.data(), f.annexb.size(), bgr)) {
+    if (s.decoder->counters().errors > s.st.decode_errors) {
+      s.st.decode_errors = s.decoder->counters().errors;
+      s.damaged = true;
+      log::debug(kTag, name, ": decode error: ", s.decoder->lastError());
+    }
+    return;
+  }
+  if (f.keyframe) s.damaged = false;
+  ++s.st.decoded;
+  ++s.w_decoded;
+  s.st.width = bgr.cols;
+  s.st.height = bgr.rows;
+  uint64_t capture_server_us = 0;
+  if (f.capture_us) {
+    capture_server_us = static_cast<uint64_t>(static_cast<int64_t>(*f.capture_us) + s.offset_us);
+    const double ms = (static_cast<double>(monoNowUs()) - static_cast<double>(capture_server_us)) / 1000.0;
+    s.w_latency_sum += ms;
+    ++s.w_latency_n;
+    s.latencies.push_back(ms);
+    if (s.latencies.size() > kLatencyHistory) s.latencies.pop_front();
+  }
+  FrameHook hook;
+  {
+    std::lock_guard lk(mu_);
+    auto& pub = published_[name];
+    pub.latest = bgr;
+    pub.latest_capture_us = capture_server_us;
+    hook = frame_hook_;
+  }
+  if (hook) hook(name, bgr, capture_server_us);
+}
+
+void VideoReceiver::tick() {
+  const auto now = Clock::now();
+  const bool window_end = ++tick_count_ % kTicksPerWindow == 0;
+  for (auto& [name, sp] : streams_) {
+    Stream& s = *sp;
+    // A gap nobody will fill (the stream paused): release what is held.
+    if (s.reorder.held() > 0 && s.gap_since != Clock::time_point{} &&
+        now - s.gap_since >= std::chrono::duration<double>(settings_.reorder_timeout_s)) {
+      s.ready.clear();
+      s.reorder.flush(s.ready);
+      s.gap_since = {};
+      depacketizeReady(s, name);
+      maybeRequestKeyframe(s, name);
+    }
+    const auto& dc = s.depack.counters();
+    s.w_lost += dc.lost_packets - s.st.lost_packets;
+    s.st.frames = dc.frames;
+    s.st.frames_dropped = dc.frames_dropped;
+    s.st.lost_packets = dc.lost_packets;
+    s.st.bad_payload = dc.bad_payload;
+    s.st.duplicates = s.reorder.duplicates();
+    s.st.late = s.reorder.late();
+    s.st.active = s.last_packet != Clock::time_point{} && now - s.last_packet < std::chrono::seconds(2);
+    if (window_end) {
+      s.st.fps_received = static_cast<double>(s.w_frames);
+      s.st.fps_decoded = static_cast<double>(s.w_decoded);
+      s.st.kbps = static_cast<double>(s.w_bytes) * 8.0 / 1000.0;
+      const uint64_t expected = s.w_packets + s.w_lost;
+      s.st.loss_pct = expected ? 100.0 * static_cast<double>(s.w_lost) / static_cast<double>(expected) : 0;
+      if (s.w_latency_n) s.st.latency_ms = s.w_latency_sum / static_cast<double>(s.w_latency_n);
+      std::vector<double> lat(s.latencies.begin(), s.latencies.end());
+      s.st.latency_p50_ms = percentile(lat, 0.5);
+      s.st.latency_p99_ms = percentile(lat, 0.99);
+      s.w_bytes = s.w_frames = s.w_decoded = s.w_packets = s.w_lost = 0;
+      s.w_latency_sum = 0;
+      s.w_latency_n = 0;
+    }
+    std::lock_guard lk(mu_);
+    auto& pub = published_[name];
+    pub.stats = s.st;
+    if (!s.sps.empty() && !s.pps.empty()) {
+      pub.sps = s.sps;
+      pub.pps = s.pps;
+    }
+  }
+  tick_timer_.expires_after(kTick);
+  tick_timer_.async_wait([this](const boost::system::error_code& ec) {
+    if (!ec) tick();
+  });
+}
+
+}  // namespace inspect::video

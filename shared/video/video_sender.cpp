@@ -1,0 +1,290 @@
+#include "shared/video/video_sender.hpp"
+
+#include <chrono>
+#include <random>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/udp.hpp>
+
+#include "shared/util/clock.hpp"
+#include "shared/util/log.hpp"
+#include "shared/video/rtp_h264.hpp"
+
+namespace inspect::video {
+
+namespace asio = boost::asio;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+constexpr std::string_view kTag = "video";
+// IPv4 + UDP headers, the RTP header and the capture-time extension on a
+// frame's first packet (docs/video.md).
+constexpr std::size_t kOverhead = 28 + kRtpHeaderSize + 16;
+
+EncoderSettings effectiveEncoder(const SenderSettings& s) {
+  EncoderSettings e = s.encoder;
+  e.width = s.source.width;
+  e.height = s.source.height;
+  e.fps = s.source.fps;
+  return e;
+}
+
+uint32_t randomSsrc() {
+  std::random_device rd;
+  uint32_t v = 0;
+  while (v == 0) v = rd();
+  return v;
+}
+}  // namespace
+
+std::string validate(const SenderSettings& s) {
+  if (s.mtu < 256 || s.mtu > 9000) return "video.mtu: " + std::to_string(s.mtu) + " out of range [256, 9000]";
+  if (s.port == 0) return "video.port: 0 is not a destination port";
+  if (s.host.empty()) return "video.host: empty";
+  return validate(effectiveEncoder(s));
+}
+
+struct VideoSender::Net {
+  asio::io_context io;
+  asio::ip::udp::socket socket{io};
+  asio::ip::udp::endpoint dest;
+};
+
+VideoSender::VideoSender(SenderSettings s) : s_(std::move(s)), net_(std::make_unique<Net>()) {
+  if (auto why = validate(s_); !why.empty()) throw VideoError(why);
+  ssrc_ = s_.ssrc ? s_.ssrc : randomSsrc();
+  boost::system::error_code ec;
+  asio::ip::udp::resolver resolver(net_->io);
+  auto results = resolver.resolve(asio::ip::udp::v4(), s_.host, std::to_string(s_.port), ec);
+  if (ec || results.empty())
+    throw VideoError("video: cannot resolve destination '" + s_.host + "': " + ec.message());
+  net_->dest = *results.begin();
+  net_->socket.open(asio::ip::udp::v4(), ec);
+  if (ec) throw VideoError("video: cannot open a UDP socket: " + ec.message());
+  // Room for a whole 1080p IDR's packets, so a burst is not dropped locally.
+  net_->socket.set_option(asio::socket_base::send_buffer_size(1 << 20), ec);
+  st_.ssrc = ssrc_;
+}
+
+VideoSender::~VideoSender() { stop(); }
+
+void VideoSender::start() {
+  if (running_.exchange(true)) return;
+  keyframe_requested_ = true;
+  capture_thread_ = std::thread([this] { captureLoop(); });
+  encode_thread_ = std::thread([this] { encodeLoop(); });
+}
+
+void VideoSender::stop() {
+  {
+    std::lock_guard lk(mu_);
+    if (!running_.exchange(false)) return;
+  }
+  wake_cv_.notify_all();
+  frame_cv_.notify_all();
+  if (capture_thread_.joinable()) capture_thread_.join();
+  if (encode_thread_.joinable()) encode_thread_.join();
+}
+
+std::string VideoSender::apply(const SenderChange& c) {
+  std::lock_guard lk(mu_);
+  SenderSettings n = s_;
+  if (c.enabled) n.enabled = *c.enabled;
+  if (c.width.has_value() != c.height.has_value()) return "video: width and height go together";
+  if (c.width) {
+    n.source.width = *c.width;
+    n.source.height = *c.height;
+  }
+  if (c.fps) n.source.fps = *c.fps;
+  if (c.bitrate_kbps) n.encoder.bitrate_kbps = *c.bitrate_kbps;
+  if (auto why = validate(n); !why.empty()) return why;
+  const bool restart = n.source.width != s_.source.width || n.source.height != s_.source.height ||
+                       n.source.fps != s_.source.fps || n.encoder.bitrate_kbps != s_.encoder.bitrate_kbps;
+  if (restart) ++generation_;
+  if (n.enabled && !s_.enabled) keyframe_requested_ = true;
+  s_ = n;
+  wake_cv_.notify_all();
+  return {};
+}
+
+void VideoSender::requestKeyframe() {
+  keyframe_requested_ = true;
+  std::lock_guard lk(mu_);
+  ++st_.keyframe_requests;
+}
+
+SenderStats VideoSender::stats() const {
+  std::lock_guard lk(mu_);
+  SenderStats s = st_;
+  s.enabled = s_.enabled;
+  s.width = s_.source.width;
+  s.height = s_.source.height;
+  s.fps = s_.source.fps;
+  s.bitrate_kbps = s_.encoder.bitrate_kbps;
+  s.source = s_.source.uri;
+  s.port = s_.port;
+  return s;
+}
+
+void VideoSender::setError(const std::string& e) {
+  {
+    std::lock_guard lk(mu_);
+    if (st_.error == e) return;
+    st_.error = e;
+  }
+  log::warn(kTag, e);
+}
+
+void VideoSender::captureLoop() {
+  std::unique_ptr<FrameSource> src;
+  uint64_t src_generation = ~0ull;
+  uint32_t index = 0;
+  Clock::time_point next = Clock::now();
+  std::unique_lock lk(mu_);
+  while (running_) {
+    if (!s_.enabled) {
+      src.reset();  // release the camera while off
+      wake_cv_.wait_for(lk, std::chrono::milliseconds(200));
+      continue;
+    }
+    const SourceSettings ss = s_.source;
+    const uint64_t gen = generation_;
+    lk.unlock();
+    if (!src || gen != src_generation) {
+      try {
+        src = openFrameSource(ss);
+        src_generation = gen;
+        next = Clock::now();
+        log::info(kTag, "source ", src->describe(), " ", ss.width, "x", ss.height, " @ ", ss.fps, " fps");
+      } catch (const VideoError& e) {
+        src.reset();
+        setError(e.what());
+        lk.lock();
+        wake_cv_.wait_for(lk, std::chrono::seconds(1), [this] { return !running_; });  // retry later
+        continue;
+      }
+    }
+    const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / ss.fps));
+    if (!src->paced()) {
+      lk.lock();
+      if (wake_cv_.wait_until(lk, next, [this] { return !running_; })) break;
+      lk.unlock();
+      next += period;
+      if (Clock::now() - next > period) next = Clock::now();  // fell behind: no burst to catch up
+    }
+    cv::Mat frame;
+    uint64_t capture_us = monoNowUs();
+    if (!src->read(frame, capture_us, index)) {
+      setError("video: " + src->describe() + ": " + (src->error().empty() ? "no frame" : src->error()));
+      src.reset();
+      lk.lock();
+      wake_cv_.wait_for(lk, std::chrono::seconds(1), [this] { return !running_; });
+      continue;
+    }
+    if (src->paced()) capture_us = monoNowUs();  // a camera's frame is ready when read() returns
+    lk.lock();
+    if (slot_full_) ++st_.dropped;
+    slot_ = std::move(frame);
+    slot_capture_us_ = capture_us;
+    slot_index_ = index++;
+    slot_generation_ = gen;
+    slot_full_ = true;
+    ++st_.captured;
+    frame_cv_.notify_one();
+  }
+}
+
+void VideoSender::encodeLoop() {
+  std::unique_ptr<H264Encoder> enc;
+  uint64_t enc_generation = ~0ull;
+  std::unique_ptr<H264Packetizer> packetizer;
+  std::vector<std::vector<uint8_t>> packets;
+  EncodedFrame out;
+  double window_ms = 0;
+  int window_n = 0;
+  Clock::time_point window_start = Clock::now();
+
+  std::unique_lock lk(mu_);
+  while (running_) {
+    frame_cv_.wait_for(lk, std::chrono::milliseconds(200), [this] { return slot_full_ || !running_; });
+    if (!running_) break;
+    if (!slot_full_) continue;
+    cv::Mat frame = std::move(slot_);
+    slot_full_ = false;
+    const uint64_t capture_us = slot_capture_us_;
+    const uint32_t index = slot_index_;
+    const uint64_t gen = slot_generation_;
+    const EncoderSettings es = effectiveEncoder(s_);
+    const std::size_t mtu = s_.mtu;
+    const bool current = gen == generation_;
+    lk.unlock();
+
+    if (current && (!enc || gen != enc_generation)) {
+      try {
+        enc.reset();
+        enc = std::make_unique<H264Encoder>(es);
+        enc_generation = gen;
+        keyframe_requested_ = true;
+        log::info(kTag, "encoder ", enc->codecName(), " ", es.width, "x", es.height, " @ ", es.fps, " fps, ",
+                  es.bitrate_kbps, " kbit/s, GOP ", es.gop, es.intra_refresh ? ", intra refresh" : "");
+      } catch (const VideoError& e) {
+        enc.reset();
+        setError(e.what());
+      }
+    }
+    if (!packetizer) packetizer = std::make_unique<H264Packetizer>(ssrc_, mtu - kOverhead, static_cast<uint16_t>(ssrc_));
+    bool sent = false;
+    uint64_t bytes = 0, npackets = 0, send_errors = 0;
+    double ms = 0;
+    std::string send_error;
+    if (current && enc && frame.cols == es.width && frame.rows == es.height) {
+      const bool force = keyframe_requested_.exchange(false);
+      const auto t0 = Clock::now();
+      try {
+        sent = enc->encode(frame, capture_us, index, force, out);
+      } catch (const VideoError& e) {
+        setError(e.what());
+        enc.reset();  // reopened with the next frame
+      }
+      ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+      if (sent) {
+        packets.clear();
+        const auto ts = static_cast<uint32_t>(capture_us * 9 / 100);  // 90 kHz from microseconds
+        packetizer->packetize(out.annexb, ts, capture_us, packets);
+        for (const auto& p : packets) {
+          boost::system::error_code ec;
+          net_->socket.send_to(asio::buffer(p), net_->dest, 0, ec);
+          if (ec) {
+            ++send_errors;
+            send_error = "video: send to " + net_->dest.address().to_string() + ":" +
+                         std::to_string(net_->dest.port()) + ": " + ec.message();
+          } else {
+            ++npackets;
+            bytes += p.size();
+          }
+        }
+      }
+    }
+    if (!send_error.empty()) setError(send_error);
+    lk.lock();
+    if (!current) ++st_.dropped;  // captured with the settings before a change
+    if (sent) {
+      ++st_.encoded;
+      if (out.keyframe) ++st_.keyframes;
+      st_.packets += npackets;
+      st_.bytes += bytes;
+      st_.send_errors += send_errors;
+      if (enc) st_.encoder = enc->codecName();
+      window_ms += ms;
+      ++window_n;
+    }
+    if (Clock::now() - window_start >= std::chrono::seconds(1)) {
+      st_.encode_ms = window_n ? window_ms / window_n : 0;
+      window_ms = 0;
+      window_n = 0;
+      window_start = Clock::now();
+    }
+  }
+}
+
+}  // namespace inspect::video

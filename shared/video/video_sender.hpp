@@ -1,0 +1,107 @@
+#pragma once
+// The robot's camera stream: capture -> H.264 encode -> RTP -> UDP, on two
+// threads of its own so that the 100 Hz control loop never waits for video.
+//
+// The capture thread paces the source at the frame rate (a camera paces
+// itself) and leaves each picture in a one-slot mailbox; the encode thread
+// takes the newest picture, encodes, packetizes and sends it. A picture the
+// encoder had no time for is replaced by the next one and counted as
+// dropped: frames are never queued, so latency cannot grow.
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <opencv2/core.hpp>
+
+#include "shared/video/frame_source.hpp"
+#include "shared/video/h264_codec.hpp"
+
+namespace inspect::video {
+
+struct SenderSettings {
+  bool enabled = true;
+  SourceSettings source;    // its width/height/fps are the stream's
+  EncoderSettings encoder;  // width/height/fps are taken from `source`
+  std::string host = "127.0.0.1";  // destination (the server), numeric or a name
+  uint16_t port = 5600;
+  std::size_t mtu = 1200;   // bytes per datagram including IP/UDP headers; [256, 9000]
+  uint32_t ssrc = 0;        // 0 = random
+};
+
+/// Checks the settings (ranges, encoder settings); "" or the first problem.
+std::string validate(const SenderSettings& s);
+
+struct SenderStats {
+  bool enabled = false;
+  uint32_t ssrc = 0;
+  int width = 0, height = 0;
+  double fps = 0;
+  int bitrate_kbps = 0;
+  std::string encoder;      // in use ("" before the first frame)
+  std::string source;
+  uint16_t port = 0;
+  uint64_t captured = 0, encoded = 0, dropped = 0, keyframes = 0;
+  uint64_t packets = 0, bytes = 0, send_errors = 0;
+  uint64_t keyframe_requests = 0;
+  double encode_ms = 0;     // mean over the last second
+  std::string error;        // last error, "" = none
+};
+
+/// A change of settings from the operator; unset fields stay.
+struct SenderChange {
+  std::optional<bool> enabled;
+  std::optional<int> width, height;
+  std::optional<double> fps;
+  std::optional<int> bitrate_kbps;
+};
+
+class VideoSender {
+ public:
+  /// Throws VideoError when the settings are invalid or the destination
+  /// cannot be resolved. Nothing runs until start().
+  explicit VideoSender(SenderSettings s);
+  ~VideoSender();
+  VideoSender(const VideoSender&) = delete;
+  VideoSender& operator=(const VideoSender&) = delete;
+
+  void start();
+  void stop();  // joins the threads; idempotent
+
+  /// Validates and applies a change at the next frame; "" or why it was refused.
+  std::string apply(const SenderChange& c);
+  /// The next encoded frame is an IDR with SPS/PPS.
+  void requestKeyframe();
+  SenderStats stats() const;
+  uint32_t ssrc() const { return ssrc_; }
+
+ private:
+  void captureLoop();
+  void encodeLoop();
+  void setError(const std::string& e);
+
+  mutable std::mutex mu_;
+  std::condition_variable frame_cv_;  // encode thread waits for a picture
+  std::condition_variable wake_cv_;   // capture thread waits for its next frame time, a change or stop
+  SenderSettings s_;          // guarded by mu_
+  uint64_t generation_ = 0;   // bumps on a change of size/fps/bitrate; guarded by mu_
+  // Mailbox: the newest captured picture.
+  cv::Mat slot_;
+  uint64_t slot_capture_us_ = 0;
+  uint32_t slot_index_ = 0;
+  uint64_t slot_generation_ = 0;
+  bool slot_full_ = false;
+  SenderStats st_;            // guarded by mu_
+  std::atomic<bool> keyframe_requested_{false};
+  std::atomic<bool> running_{false};
+  uint32_t ssrc_;
+  std::thread capture_thread_, encode_thread_;
+  struct Net;
+  std::unique_ptr<Net> net_;
+};
+
+}  // namespace inspect::video
