@@ -14,6 +14,7 @@
 #include <string>
 
 #include "tests/integration/stack.hpp"
+#include "tests/tools/udp_relay.hpp"
 
 using namespace inspect::test;
 
@@ -59,8 +60,9 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   s.enableVideo();
   const int player_port = freeUdpPort();
   ASSERT_GT(player_port, 0);
-  // GOP 600 (20 s): the stream decodes within seconds only because the
-  // server's keyframe request (it joined mid-GOP) reaches the robot over TCP.
+  // GOP 600 (20 s) and a burst of 20 lost packets ~1.5 s in (a UDP relay
+  // between robot and server): the picture comes back within the run only
+  // because the server's keyframe request reaches the robot over TCP.
   writeFile(s.dir() / "client.yaml", "video:\n  gop: 600\n");
   writeFile(s.dir() / "server.yaml", "video:\n  forward_base_port: " + std::to_string(player_port) +
                                           "\n  snapshot_period_s: 1\n  window: off\n");
@@ -84,7 +86,12 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
                             "video stats\n",
                             {"--config", s.dir() / "server.yaml"}))
       << s.logs();
-  auto& robot = s.startRobot("robot1", "square_room.yaml", {}, {}, {"--config", s.dir() / "client.yaml"});
+  UdpRelayParams lossy;
+  lossy.burst_from = 250;
+  lossy.burst_len = 20;
+  UdpRelay relay(static_cast<uint16_t>(s.videoPort()), lossy);
+  auto& robot = s.startRobot("robot1", "square_room.yaml", {}, {},
+                             {"--config", s.dir() / "client.yaml", "--video-port", std::to_string(relay.port())});
 
   // A standard player on the forwarded stream, while it runs.
   const std::string sdp = s.videoDir() + "/robot1.sdp";
@@ -119,7 +126,10 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   const auto frames = statsNumbers(out, "robot frames", 0);  // captured, encoded, dropped, keyframes, requested, ms
   ASSERT_GE(frames.size(), 5u) << out;
   EXPECT_GE(frames[4], 1) << "the server asked for a keyframe\n" << out;
-  EXPECT_GE(frames[3], 1) << out;
+  EXPECT_GE(frames[3], 2) << "the first IDR and at least one on request\n" << out;
+  const auto counters = statsNumbers(out, "counters", 0);  // packets, lost, ...
+  ASSERT_GE(counters.size(), 2u) << out;
+  EXPECT_GE(counters[1], 20) << "the relay's burst was seen as lost\n" << out;
   EXPECT_NE(out.find("| video "), std::string::npos) << out;
   EXPECT_NE(out.find("fps"), std::string::npos) << out;
   EXPECT_TRUE(exists(snap)) << out;
