@@ -41,6 +41,8 @@ const std::map<std::string, FlagSpec>& flags() {
       {"--video-port-file", {true, [](CliOptions& o, const std::string& v) { o.video_port_file = v; }}},
       {"--video-dir", {true, [](CliOptions& o, const std::string& v) { o.video_dir = v; }}},
       {"--no-video", {false, [](CliOptions& o, const std::string&) { o.no_video = true; }}},
+      {"--runs-dir", {true, [](CliOptions& o, const std::string& v) { o.runs_dir = v; }}},
+      {"--no-record", {false, [](CliOptions& o, const std::string&) { o.no_record = true; }}},
       {"--port-file", {true, [](CliOptions& o, const std::string& v) { o.port_file = v; }}},
       {"--script", {true, [](CliOptions& o, const std::string& v) { o.script_path = v; }}},
       {"--interactive", {false, [](CliOptions& o, const std::string&) { o.interactive = true; }}},
@@ -95,6 +97,8 @@ std::string usageText() {
          "  --video-port-file FILE  write the video receiver's UDP port to FILE once bound\n"
          "  --video-dir DIR   SDP files and snapshots (overrides video.dir; default video)\n"
          "  --no-video        do not receive video (overrides video.enabled)\n"
+         "  --runs-dir DIR    recorded runs and catalog.sqlite (overrides recording.dir; default runs)\n"
+         "  --no-record       keep no catalog and record nothing (overrides recording.enabled)\n"
          "  --script FILE     run the console commands in FILE, then exit (0 = all expects passed, 1 = not)\n"
          "  --interactive     after --script, stay in the interactive console; alone, force the interactive console\n"
          "  --no-console      serve until SIGINT/SIGTERM without reading stdin (service mode)\n"

@@ -26,6 +26,8 @@ struct CliOptions {
   std::optional<std::string> video_dir;
   std::optional<std::string> video_port_file;
   bool no_video = false;
+  std::optional<std::string> runs_dir;
+  bool no_record = false;
   bool interactive = false;
   bool no_console = false;
   bool help = false;

@@ -12,6 +12,7 @@
 #include "pc_server/route_file.hpp"
 #include "pc_server/status_line.hpp"
 #include "pc_server/text_util.hpp"
+#include "pc_server/recorder.hpp"
 #include "pc_server/video_hub.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/util/clock.hpp"
@@ -134,6 +135,20 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  Default file: <video.dir>/<robot>_<n>.png. Without a display the server also keeps\n"
        "  <video.dir>/<robot>_latest.png fresh (video.snapshot_period_s).\n",
        &Console::cmdSnapshot},
+      {"record", "record start [name] | record stop", "record a run of the selected robot",
+       "  A run is written to <recording.dir>/<run-id>/: run.mcap (telemetry, commands, acks, events,\n"
+       "  camera frames; Foxglove opens it) and video.mp4, and listed in catalog.sqlite with its\n"
+       "  summary. track, goto and route start one by themselves (recording.auto_start) and end it\n"
+       "  when they complete or fail; record stop ends it ('stopped'). The status line shows REC.\n"
+       "  example: record start night round B\n",
+       &Console::cmdRecord},
+      {"runs", "runs [robot|outcome|text] [limit]", "list recorded runs, newest first",
+       "  A filter word is a robot id, an outcome (completed, stopped, failed, incomplete,\n"
+       "  running) or text in the run's name. Default limit 20.\n"
+       "  example: runs robot1\n",
+       &Console::cmdRuns},
+      {"run", "run show <run-id>", "a recorded run's summary, files and counts",
+       "  example: run show 20261122-083015-robot1\n", &Console::cmdRun},
       {"wait", "wait <seconds>", "pause the console (events still print)",
        "  example: wait 2.5\n", &Console::cmdWait},
       {"expect", "expect <field> <op> <value> [<tol>] [within <seconds>]", "check a value (scripts, tests)",
@@ -337,7 +352,7 @@ bool Console::cmdStatus(const Args& args, const std::string&, int) {
   if (args.size() > 1) return fail("status", "takes at most one robot id");
   const std::string robot = args.empty() ? selected_ : args[0];
   if (robot.empty()) return fail("status", "no robot selected");
-  out_ << statusLine(robot, registry_.snapshot(robot, monoNowNs()), video_) << "\n";
+  out_ << statusText(robot) << "\n";
   return true;
 }
 
@@ -462,6 +477,90 @@ bool Console::cmdSnapshot(const Args& args, const std::string&, int) {
   } catch (const std::exception& e) {
     return fail("snapshot", e.what());
   }
+}
+
+std::string Console::statusText(const std::string& robot) const {
+  std::string s = statusLine(robot, registry_.snapshot(robot, monoNowNs()), video_);
+  if (recorder_)
+    if (const auto run = recorder_->activeRun(robot)) s += " | REC " + *run;
+  return s;
+}
+
+bool Console::cmdRecord(const Args& args, const std::string& rest, int) {
+  if (!recorder_) return fail("record", "the server records nothing (recording.enabled: false or --no-record)");
+  if (args.empty() || (args[0] != "start" && args[0] != "stop") || (args[0] == "stop" && args.size() > 1))
+    return fail("record", "syntax: record start [name] | record stop");
+  if (selected_.empty()) return fail("record", "no robot selected");
+  if (args[0] == "stop") {
+    const auto id = recorder_->stop(selected_, "stopped");
+    if (!id) return fail("record", selected_ + " is not recording");
+    out_ << selected_ << ": run " << *id << " stopped\n";
+    return true;
+  }
+  const auto sp = rest.find("start");
+  std::string name = sp == std::string::npos ? "" : rest.substr(sp + 5);
+  name.erase(0, name.find_first_not_of(" \t"));
+  try {
+    const std::string id = recorder_->start(selected_, name);
+    out_ << selected_ << ": recording run " << id << "\n";
+    return true;
+  } catch (const std::exception& e) {
+    return fail("record", e.what());
+  }
+}
+
+bool Console::cmdRuns(const Args& args, const std::string&, int) {
+  if (!recorder_) return fail("runs", "the server records nothing (recording.enabled: false or --no-record)");
+  catalog::RunFilter f;
+  f.limit = 20;
+  for (const auto& a : args) {
+    if (const auto n = parseInteger(a); n && *n > 0) {
+      f.limit = static_cast<int>(*n);
+    } else if (a == "completed" || a == "stopped" || a == "failed" || a == "incomplete" || a == "running") {
+      f.outcome = a;
+    } else if (registry_.snapshot(a, monoNowNs())) {
+      f.robot = a;
+    } else {
+      f.name_contains = a;
+    }
+  }
+  const auto runs = recorder_->catalog().listRuns(f);
+  out_ << padRight("run", 28) << padRight("robot", 10) << padRight("started (UTC)", 26) << padRight("outcome", 12)
+       << "name\n";
+  for (const auto& r : runs)
+    out_ << padRight(r.id, 28) << padRight(r.robot, 10) << padRight(catalog::formatIsoUtc(r.start), 26)
+         << padRight(r.outcome.empty() ? "running" : r.outcome, 12) << r.name << "\n";
+  out_ << runs.size() << " run" << (runs.size() == 1 ? "" : "s") << "\n";
+  return true;
+}
+
+bool Console::cmdRun(const Args& args, const std::string&, int) {
+  if (!recorder_) return fail("run", "the server records nothing (recording.enabled: false or --no-record)");
+  if (args.size() != 2 || args[0] != "show") return fail("run", "syntax: run show <run-id>");
+  const auto d = recorder_->catalog().run(args[1]);
+  if (!d) return fail("run", "no run '" + args[1] + "' in the catalog (see runs)");
+  const auto& i = d->info;
+  out_ << "run " << i.id << " (" << i.robot << ")" << (i.name.empty() ? "" : ": " + i.name) << "\n";
+  out_ << "  started " << catalog::formatIsoUtc(i.start)
+       << (i.end ? ", ended " + catalog::formatIsoUtc(*i.end) : std::string(", still recording"))
+       << (i.outcome.empty() ? "" : ", " + i.outcome) << "\n";
+  if (d->summary) {
+    const auto& s = *d->summary;
+    out_ << "  duration " << fmtFixed(s.duration_s, 1) << " s, distance " << fmtFixed(s.distance_m, 2) << " m"
+         << (s.min_person_m ? ", nearest person " + fmtFixed(*s.min_person_m, 2) + " m" : std::string()) << "\n";
+    if (s.track_max_pos_err_m)
+      out_ << "  tracking: max position error " << fmtFixed(*s.track_max_pos_err_m, 3) << " m, rms "
+           << fmtFixed(s.track_rms_pos_err_m.value_or(0), 3) << " m, max angle error "
+           << fmtFixed(s.track_max_angle_err_rad.value_or(0), 3) << " rad\n";
+    out_ << "  video: " << s.video_frames_received << " frames received, " << s.video_frames_decoded
+         << " decoded, " << s.video_packets_lost << " packets lost\n";
+    for (const auto& g : s.gas)
+      out_ << "  " << g.channel << ": max " << fmtShort(g.max, 3) << " mean " << fmtShort(g.mean, 3) << " " << g.unit
+           << "\n";
+  }
+  out_ << "  events " << d->event_count << ", alarms " << d->alarm_count << "\n";
+  for (const auto& f : d->files) out_ << "  " << f.kind << ": " << f.path << " (" << f.bytes << " bytes)\n";
+  return true;
 }
 
 bool Console::simpleCommand(const std::string& name, const Args& args, v1::Command cmd) {

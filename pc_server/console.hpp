@@ -17,6 +17,7 @@
 namespace inspect::server {
 
 class VideoHub;
+class Recorder;
 
 class Console {
  public:
@@ -64,6 +65,11 @@ class Console {
   /// Enables snapshot and the video figures (null: the server has no video).
   void setVideo(VideoHub* hub) { video_ = hub; }
   VideoHub* video() const { return video_; }
+  /// Enables record/runs/run (null: the server records nothing).
+  void setRecorder(Recorder* r) { recorder_ = r; }
+  Recorder* recorder() const { return recorder_; }
+  /// The robot's status line with the video figures and the recording mark ("| REC <run-id>").
+  std::string statusText(const std::string& robot) const;
   CommandSink& sink() { return sink_; }
 
   /// The text of `help` (all commands) or `help <command>`; empty for an unknown command.
@@ -97,6 +103,9 @@ class Console {
   bool cmdVideo(const Args& args, const std::string& rest, int line_no);
   bool cmdPtz(const Args& args, const std::string& rest, int line_no);
   bool cmdSnapshot(const Args& args, const std::string& rest, int line_no);
+  bool cmdRecord(const Args& args, const std::string& rest, int line_no);
+  bool cmdRuns(const Args& args, const std::string& rest, int line_no);
+  bool cmdRun(const Args& args, const std::string& rest, int line_no);
   bool cmdWait(const Args& args, const std::string& rest, int line_no);
   bool cmdExpect(const Args& args, const std::string& rest, int line_no);
   bool cmdEcho(const Args& args, const std::string& rest, int line_no);
@@ -124,6 +133,7 @@ class Console {
   std::function<void()> idle_hook_;
   TeleopHandler teleop_handler_;
   VideoHub* video_ = nullptr;
+  Recorder* recorder_ = nullptr;
   std::string selected_;
   bool quit_ = false;
   Tally tally_;

@@ -28,7 +28,7 @@ std::string InteractiveConsole::statusText() const {
   const std::string& robot = console_.selected();
   const int n = console_.registry().connectedCount();
   if (robot.empty()) return "no robot selected | " + std::to_string(n) + " connected | type 'help'";
-  return statusLine(robot, console_.registry().snapshot(robot, monoNowNs()), console_.video());
+  return console_.statusText(robot);
 }
 
 void InteractiveConsole::refreshStatus(bool force) {

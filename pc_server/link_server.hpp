@@ -11,6 +11,7 @@
 #include <mutex>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -54,13 +55,17 @@ class LinkServer : public CommandSink {
   /// False when the console watchdog is on and the console went quiet.
   bool consoleResponsive() const;
 
-  /// Called on a session's strand with every telemetry envelope (robot id,
-  /// its "ip:port", the envelope, receive time in µs). Set before listen().
-  using TelemetryObserver =
-      std::function<void(const std::string& robot_id, const std::string& address, const v1::Envelope& env,
-                         uint64_t recv_us)>;
-  void setTelemetryObserver(TelemetryObserver f) { telemetry_observer_ = std::move(f); }
-  const TelemetryObserver& telemetryObserver() const { return telemetry_observer_; }
+  /// Called on a session's strand with every envelope of an accepted robot:
+  /// `inbound` = from the robot (telemetry, events, acks; `time_us` = receive
+  /// time) or to it (commands; `time_us` = send time); `address` is the
+  /// robot's "ip:port". Heartbeats are left out. Set before listen().
+  using EnvelopeObserver = std::function<void(const std::string& robot_id, const std::string& address,
+                                              const v1::Envelope& env, bool inbound, uint64_t time_us)>;
+  void addEnvelopeObserver(EnvelopeObserver f) { observers_.push_back(std::move(f)); }
+  void observe(const std::string& robot_id, const std::string& address, const v1::Envelope& env, bool inbound,
+               uint64_t time_us) const {
+    for (const auto& f : observers_) f(robot_id, address, env, inbound, time_us);
+  }
 
   /// A fresh command id: > 0 and increasing over the server's lifetime.
   uint64_t nextCommandId() { return next_command_id_.fetch_add(1); }
@@ -84,7 +89,7 @@ class LinkServer : public CommandSink {
   std::atomic<int64_t> console_watchdog_ns_{0};
   std::atomic<int64_t> console_alive_ns_{0};
 
-  TelemetryObserver telemetry_observer_;
+  std::vector<EnvelopeObserver> observers_;
 
   mutable std::mutex mu_;
   std::condition_variable all_closed_cv_;

@@ -179,15 +179,17 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
       return true;  // last_rx_ already counts it
     case v1::Envelope::kTelemetry:
       registry_.onTelemetry(robot_id_, serial_, env.telemetry(), monoNowNs());
-      if (const auto& observe = server_.telemetryObserver()) observe(robot_id_, address_, env, monoNowUs());
+      server_.observe(robot_id_, address_, env, true, monoNowUs());
       return true;
     case v1::Envelope::kEvent:
       registry_.onEvent(robot_id_, serial_, env.event());
+      server_.observe(robot_id_, address_, env, true, monoNowUs());
       if (server_.logEvents())
         log::info(kTag, "[", robot_id_, "] ", v1::Event::Kind_Name(env.event().kind()), ": ", env.event().text());
       return true;
     case v1::Envelope::kAck:
       registry_.onAck(robot_id_, serial_, env.ack());
+      server_.observe(robot_id_, address_, env, true, monoNowUs());
       return true;
     case v1::Envelope::kHello:
       closeNow("protocol error: second Hello after the handshake", log::Level::kWarn);
@@ -322,6 +324,7 @@ void RobotSession::enqueue(v1::Envelope& env) {
     return;
   }
   queued_bytes_ += frame.size();
+  if (accepted_ && env.has_command()) server_.observe(robot_id_, address_, env, false, env.send_time_us());
   const bool idle = tx_queue_.empty();
   tx_queue_.push_back(std::move(frame));
   if (idle) doWrite();

@@ -22,6 +22,7 @@
 #include "pc_server/robot_registry.hpp"
 #include "pc_server/startup_error.hpp"
 #include "pc_server/stop_flag.hpp"
+#include "pc_server/recorder.hpp"
 #include "pc_server/video_hub.hpp"
 #include "shared/util/log.hpp"
 
@@ -62,6 +63,8 @@ ServerConfig resolveConfig(const CliOptions& options) {
   if (options.video_port) c.video.port = *options.video_port;
   if (options.video_dir) c.video.dir = *options.video_dir;
   if (options.no_video) c.video.enabled = false;
+  if (options.runs_dir) c.recording.dir = *options.runs_dir;
+  if (options.no_record) c.recording.enabled = false;
   return c;
 }
 
@@ -105,13 +108,39 @@ int runServer(const CliOptions& options) {
   std::cout << "pc_server: listening on " << endpoint.address().to_string() << ":" << endpoint.port() << std::endl;
   if (options.port_file) writePortFile(*options.port_file, endpoint.port());
 
+  std::unique_ptr<Recorder> recorder;
+  if (config.recording.enabled) {
+    try {
+      recorder = std::make_unique<Recorder>(config.recording, INSPECT_VERSION);
+    } catch (const std::exception& e) {
+      throw StartupError(std::string("recording: ") + e.what());
+    }
+    link.addEnvelopeObserver([rec = recorder.get()](const std::string& id, const std::string& address,
+                                                    const v1::Envelope& env, bool inbound, uint64_t time_us) {
+      rec->onEnvelope(id, address, env, inbound, time_us);
+    });
+    std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog.sqlite)";
+    if (!recorder->startupReport().empty()) std::cout << "; " << recorder->startupReport();
+    std::cout << std::endl;
+  }
+
   std::unique_ptr<VideoHub> video;
   if (config.video.enabled) {
     video = std::make_unique<VideoHub>(config.video, config.bind_address, link);
-    link.setTelemetryObserver([hub = video.get()](const std::string& id, const std::string& address,
-                                                  const v1::Envelope& env, uint64_t recv_us) {
-      hub->onTelemetry(id, address, env, recv_us);
+    link.addEnvelopeObserver([hub = video.get()](const std::string& id, const std::string& address,
+                                                 const v1::Envelope& env, bool inbound, uint64_t time_us) {
+      if (inbound && env.has_telemetry()) hub->onTelemetry(id, address, env, time_us);
     });
+    if (recorder) {
+      video->setAccessUnitHook([rec = recorder.get()](const std::string& robot, const video::Frame& f,
+                                                      uint64_t capture_us) { rec->onAccessUnit(robot, f, capture_us); });
+      recorder->setVideoFigures([hub = video.get()](const std::string& robot) -> std::optional<VideoFigures> {
+        const auto st = hub->stats(robot);
+        if (!st) return std::nullopt;
+        return VideoFigures{static_cast<int64_t>(st->frames), static_cast<int64_t>(st->decoded),
+                            static_cast<int64_t>(st->lost_packets)};
+      });
+    }
     video->start();
     std::cout << "pc_server: video on UDP port " << video->port() << ", SDP files in " << config.video.dir << "/"
               << std::endl;
@@ -126,6 +155,17 @@ int runServer(const CliOptions& options) {
     stop.request();
   });
 
+  // MCAP chunks of quiet recordings reach the disk within a second.
+  asio::steady_timer record_timer(ioc);
+  std::function<void()> record_tick = [&] {
+    if (recorder) recorder->tick();
+    record_timer.expires_after(std::chrono::milliseconds(200));
+    record_timer.async_wait([&](const boost::system::error_code& ec) {
+      if (!ec) record_tick();
+    });
+  };
+  if (recorder) record_tick();
+
   auto work = asio::make_work_guard(ioc);
   IoThreads io{ioc, {}};
   for (int i = 0; i < kIoThreads; ++i) io.threads.emplace_back([&ioc] { ioc.run(); });
@@ -135,6 +175,7 @@ int runServer(const CliOptions& options) {
     Console::Options copt;
     Console console(registry, link, std::cout, stop, copt);
     console.setVideo(video.get());
+    console.setRecorder(recorder.get());
     ConsoleRunner runner(console, stop, config.status_refresh_hz);
     switch (mode) {
       case ConsoleMode::kNone:
@@ -157,12 +198,15 @@ int runServer(const CliOptions& options) {
   log::info(kTag, "stopping: closing robot sessions");
   link.stop();
   if (!link.waitAllClosed(std::chrono::seconds(1))) log::warn(kTag, "some sessions did not close within 1 s");
-  asio::post(ioc, [&signals] {
+  asio::post(ioc, [&signals, &record_timer] {
     boost::system::error_code ignored;
     signals.cancel(ignored);
+    record_timer.cancel();
   });
   if (video) video->stop();
   work.reset();
+  // IoThreads' destructor joins the io threads before the recorder (declared
+  // earlier) ends the runs still open.
   return status;  // io stops and joins the threads
 
 }

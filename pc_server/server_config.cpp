@@ -42,6 +42,16 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   vc.snapshot_period_s = v.number("snapshot_period_s", vc.snapshot_period_s, 0, 3600);
   vc.reorder_window = static_cast<std::size_t>(v.integer("reorder_window", static_cast<long>(vc.reorder_window), 1, 1024));
   vc.keyframe_min_interval_s = v.number("keyframe_min_interval_s", vc.keyframe_min_interval_s, 0.05, 10);
+  const auto r = root.optChild("recording");
+  auto& rc = c.recording;
+  rc.enabled = r.boolean("enabled", rc.enabled);
+  rc.dir = r.string("dir", rc.dir);
+  if (rc.dir.empty()) r.fail("dir", "must not be empty");
+  rc.auto_start = r.boolean("auto_start", rc.auto_start);
+  rc.compression = r.string("compression", rc.compression);
+  if (rc.compression != "zstd" && rc.compression != "none")
+    r.fail("compression", "'" + rc.compression + "' is not one of zstd, none");
+  rc.max_fragment_s = r.number("max_fragment_s", rc.max_fragment_s, 0.1, 60);
   return c;
 }
 

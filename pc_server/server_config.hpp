@@ -21,6 +21,15 @@ struct VideoServerConfig {
   double keyframe_min_interval_s = 0.3;
 };
 
+/// Recording of runs (docs/recording.md).
+struct RecordingServerConfig {
+  bool enabled = true;
+  std::string dir = "runs";
+  bool auto_start = true;
+  std::string compression = "zstd";
+  double max_fragment_s = 0.5;
+};
+
 /// Link and console settings; defaults are those documented in config/server.yaml.
 struct ServerConfig {
   std::string bind_address = "0.0.0.0";  // all interfaces: robots connect from the network
@@ -33,6 +42,7 @@ struct ServerConfig {
   std::size_t max_frame_bytes = 1u << 20;
   double status_refresh_hz = 5.0;
   VideoServerConfig video;
+  RecordingServerConfig recording;
 };
 
 /// True for a numeric IPv4/IPv6 address.

@@ -50,6 +50,8 @@ class VideoHub {
   /// The port the robot's RTP is forwarded to for players (0 = none).
   uint16_t forwardPort(const std::string& robot_id) const;
   bool windowShown() const { return window_running_; }
+  /// Every intact access unit (for recording); set before start().
+  void setAccessUnitHook(video::VideoReceiver::AccessUnitHook f) { receiver_->setAccessUnitHook(std::move(f)); }
 
  private:
   struct Robot {

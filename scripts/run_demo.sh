@@ -56,7 +56,7 @@ PIDS+=("$CLIENT")
 
 # Video on an ephemeral UDP port (5600 may be taken); SDP and snapshots in $OUT/video.
 ARGS=(--config config/server.yaml --bind 127.0.0.1 --port "$PORT" --port-file "$OUT/port"
-      --video-port 0 --video-port-file "$OUT/video_port" --video-dir "$OUT/video"
+      --video-port 0 --video-port-file "$OUT/video_port" --video-dir "$OUT/video" --runs-dir "$OUT/runs"
       --script scripts/demo/square.console)
 echo "demo: camera: $OUT/video/robot1.sdp (play it while the console runs:"
 echo "        ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay $OUT/video/robot1.sdp)"
@@ -82,7 +82,7 @@ awk -F, '$1=="T"{ if(!n){x0=$4;y0=$5;t0=$6;n=1} x=$4;y=$5;t=$6 }
   END{ if(!n) exit; dx=x-x0; dy=y-y0; c=cos(t0); s=sin(t0);
        d=t-t0; while(d>3.14159265)d-=6.2831853; while(d<-3.14159265)d+=6.2831853;
        printf "ground truth, relative to the start pose: x=%.3f m  y=%.3f m  theta=%.3f rad\n", c*dx+s*dy, -s*dx+c*dy, d }' "$OUT/truth.csv"
-LAST=$(grep -E 'x [-+]?[0-9]' "$OUT/pc_server.out" 2>/dev/null | tail -n 1 || true)
+LAST=$(grep -E '^robot1 \| .* x [-+]?[0-9]' "$OUT/pc_server.out" 2>/dev/null | tail -n 1 || true)
 [ -n "$LAST" ] && echo "last telemetry status line:               $LAST"
 ls "$OUT"/video/*.png 2>/dev/null | sed 's/^/camera snapshot:                          /' || true
 if [ "$status" -eq 0 ]; then echo "demo: all console checks passed"; else echo "demo: console checks FAILED (exit $status)"; fi

@@ -11,6 +11,8 @@ PACKAGES=(
   libeigen3-dev
   libgtest-dev libgmock-dev
   nlohmann-json3-dev
+  libsqlite3-dev sqlite3
+  libzstd-dev zlib1g-dev
   fuzzylite libfuzzylite-dev
   gnuplot-nox
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev

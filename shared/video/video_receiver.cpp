@@ -131,6 +131,10 @@ void VideoReceiver::setFrameHook(FrameHook f) {
   std::lock_guard lk(mu_);
   frame_hook_ = std::move(f);
 }
+void VideoReceiver::setAccessUnitHook(AccessUnitHook f) {
+  std::lock_guard lk(mu_);
+  access_unit_hook_ = std::move(f);
+}
 void VideoReceiver::setPacketHook(PacketHook f) {
   std::lock_guard lk(mu_);
   packet_hook_ = std::move(f);
@@ -268,6 +272,14 @@ void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) 
       if (nalType(nal[0]) == kNalPps) s.pps.assign(nal.begin(), nal.end());
     }
   }
+  uint64_t capture_server_us = 0;
+  if (f.capture_us) capture_server_us = static_cast<uint64_t>(static_cast<int64_t>(*f.capture_us) + s.offset_us);
+  AccessUnitHook au_hook;
+  {
+    std::lock_guard lk(mu_);
+    au_hook = access_unit_hook_;
+  }
+  if (au_hook) au_hook(name, f, capture_server_us);
   if (!s.decoder) return;
   // After a loss the picture stays frozen until a keyframe: P frames that
   // reference a lost frame would only smear the damage (as WebRTC does).
@@ -291,9 +303,7 @@ void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) 
   ++s.w_decoded;
   s.st.width = bgr.cols;
   s.st.height = bgr.rows;
-  uint64_t capture_server_us = 0;
   if (f.capture_us) {
-    capture_server_us = static_cast<uint64_t>(static_cast<int64_t>(*f.capture_us) + s.offset_us);
     const double ms = (static_cast<double>(monoNowUs()) - static_cast<double>(capture_server_us)) / 1000.0;
     s.w_latency_sum += ms;
     ++s.w_latency_n;

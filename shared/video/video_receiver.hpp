@@ -73,6 +73,9 @@ class VideoReceiver {
   /// Called on the receiver thread with each decoded picture (BGR) and its
   /// capture time on the server's clock (µs, CLOCK_MONOTONIC).
   using FrameHook = std::function<void(const std::string& stream, const cv::Mat& bgr, uint64_t capture_us)>;
+  /// Called on the receiver thread with each intact access unit (before
+  /// decoding; recorders store these) and its capture time on the server's clock.
+  using AccessUnitHook = std::function<void(const std::string& stream, const Frame& frame, uint64_t capture_us)>;
   /// Called on the receiver thread with each accepted RTP datagram.
   using PacketHook = std::function<void(const std::string& stream, const std::vector<uint8_t>& datagram)>;
 
@@ -98,6 +101,7 @@ class VideoReceiver {
   void setKeyframeRequest(KeyframeRequest f);
   void setFrameHook(FrameHook f);
   void setPacketHook(PacketHook f);
+  void setAccessUnitHook(AccessUnitHook f);
 
   std::optional<StreamStats> stats(const std::string& name) const;
   ReceiverCounters counters() const;
@@ -145,6 +149,7 @@ class VideoReceiver {
   KeyframeRequest keyframe_request_;
   FrameHook frame_hook_;
   PacketHook packet_hook_;
+  AccessUnitHook access_unit_hook_;
 };
 
 }  // namespace inspect::video

@@ -1,5 +1,7 @@
 #include "tests/integration/stack.hpp"
 
+#include <algorithm>
+
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -65,6 +67,11 @@ bool Stack::startServer(const std::string& script, const std::vector<std::string
                                    "--bind",            "127.0.0.1", "--port",
                                    "0",                 "--port-file", dir_ / "port",
                                    "--script",          dir_ / "script.txt"};
+  // Runs are recorded (track/goto start them) into the test's directory.
+  if (std::find(extra.begin(), extra.end(), "--runs-dir") == extra.end()) {
+    argv.push_back("--runs-dir");
+    argv.push_back(dir_ / "runs");
+  }
   if (video_) {
     for (const std::string a : {"--video-port", "0", "--video-port-file"}) argv.push_back(a);
     argv.push_back(dir_ / "video_port");

@@ -606,3 +606,12 @@ TEST_F(ConsoleTest, VideoStatsWithoutAServerStreamSaysSo) {
   EXPECT_HAS(out, "encoded 300");
   EXPECT_HAS(out, "server: video off");
 }
+
+TEST_F(ConsoleTest, RecordingCommandsWithoutARecorderSaySo) {
+  connectRobot();
+  for (const char* line : {"record start x", "runs", "run show 1"}) {
+    const auto [ok, out] = run(line);
+    EXPECT_FALSE(ok) << line;
+    EXPECT_HAS(out, "the server records nothing");
+  }
+}

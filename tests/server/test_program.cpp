@@ -59,6 +59,8 @@ class Program {
     const auto err_path = path("stderr.txt");
     // No UDP video port 5600 (tests run in parallel); the video tests ask for an ephemeral one.
     if (std::find(args.begin(), args.end(), "--video-port") == args.end()) args.push_back("--no-video");
+    // Nor a catalog in the working directory.
+    if (std::find(args.begin(), args.end(), "--runs-dir") == args.end()) args.push_back("--no-record");
     args.insert(args.begin(), kBinary);
     pid_ = ::fork();
     ASSERT_GE(pid_, 0);

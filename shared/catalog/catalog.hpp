@@ -1,0 +1,152 @@
+#pragma once
+// The run catalog: one SQLite file (`catalog.sqlite`, WAL) listing robots,
+// runs, their events and alarms, summary figures and files. Schema and example
+// queries: docs/catalog.md.
+//
+// One connection per Catalog, every call under a mutex: the server may call
+// from several threads. Each write is its own transaction, so what a call has
+// written survives a kill of the process (WAL, synchronous=NORMAL).
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace inspect::catalog {
+
+using Time = std::chrono::system_clock::time_point;
+
+/// Any failure: the message names the catalog file and gives SQLite's reason.
+class CatalogError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// How a run ended. "incomplete": the server stopped without ending it.
+inline constexpr std::string_view kOutcomes[] = {"completed", "stopped", "failed", "incomplete"};
+
+struct RunStart {
+  std::string robot;             // robot id, e.g. "robot1" (added to robots if new)
+  std::string name;              // free text, e.g. "night round B"
+  std::string route;             // route name or file
+  std::string gains_json = "{}"; // controller gains in force
+  std::string software_version;
+  std::string dir;               // where the run's files go
+  std::optional<Time> start;     // default: now
+};
+
+struct RunInfo {
+  int64_t rowid = 0;       // runs.id
+  std::string id;          // runs.run_id, "20261122-083015-robot1"
+  std::string robot, name, route, gains_json, software_version, dir;
+  Time start{};
+  std::optional<Time> end;
+  std::string outcome;     // one of kOutcomes, "" while running
+};
+
+struct GasFigures {
+  std::string channel;  // e.g. "CH4"
+  std::string unit;     // e.g. "ppm", "%LEL"
+  double max = 0, mean = 0;
+};
+
+struct Summary {
+  double duration_s = 0, distance_m = 0;
+  std::optional<double> min_person_m;  // nobody seen: none
+  // Trajectory tracking (none when no path was followed).
+  std::optional<double> track_max_pos_err_m, track_rms_pos_err_m, track_max_angle_err_rad;
+  int64_t video_frames_received = 0, video_frames_decoded = 0, video_packets_lost = 0;
+  std::vector<GasFigures> gas;  // one per channel
+};
+
+struct FileEntry {
+  std::string kind;  // e.g. "log", "telemetry", "video", "plot"
+  std::string path;
+  int64_t bytes = 0;
+};
+
+struct RunDetail {
+  RunInfo info;
+  std::optional<Summary> summary;
+  std::vector<FileEntry> files;
+  int64_t event_count = 0, alarm_count = 0;
+};
+
+/// listRuns: every field empty/unset matches all runs.
+struct RunFilter {
+  std::string robot;          // exact robot id
+  std::string name_contains;  // substring of the name, case-insensitive (ASCII)
+  std::string outcome;        // one of kOutcomes, or "running"
+  std::optional<Time> since;  // runs started at or after
+  int limit = 100;            // newest first; <= 0: no limit
+};
+
+/// The built-in schema migrations, oldest first. PRAGMA user_version is the
+/// number applied. Append only: a released migration is never edited.
+std::span<const std::string_view> schemaMigrations();
+
+/// "2026-11-22T08:30:15.123Z" (UTC, milliseconds).
+std::string formatIsoUtc(Time t);
+/// Reads "YYYY-MM-DD", "YYYY-MM-DD[T ]HH:MM[:SS[.fff]][Z]" as UTC; none if malformed.
+std::optional<Time> parseIsoUtc(std::string_view text);
+
+class Catalog {
+ public:
+  /// Opens or creates the file, sets WAL, synchronous=NORMAL, foreign keys and
+  /// a busy timeout, and applies the pending migrations in one transaction.
+  /// Throws CatalogError (file missing directory, not a database, not a
+  /// catalog, written by a newer program, ...).
+  static Catalog open(const std::string& path);
+  /// The same with another migration list (tests: an older schema).
+  static Catalog open(const std::string& path, std::span<const std::string_view> migrations);
+
+  Catalog(Catalog&&) noexcept;
+  Catalog& operator=(Catalog&&) noexcept;
+  ~Catalog();
+
+  const std::string& path() const;
+  int schemaVersion();
+
+  /// Adds the robot or updates its software version and last_seen.
+  void upsertRobot(const std::string& robot, const std::string& software_version, Time now);
+
+  /// A new run, id "<UTC start yyyymmdd-hhmmss>-<robot>" with "-2", "-3"...
+  /// when taken (characters of the robot id outside [A-Za-z0-9_.-] become '_').
+  RunInfo startRun(const RunStart& r);
+  /// Ends a running run. False if it had already ended (unchanged); throws for
+  /// an unknown run or outcome.
+  bool endRun(const std::string& run_id, const std::string& outcome, Time end);
+  /// The robot's run that has not ended (the newest), e.g. to carry on after a reconnect.
+  std::optional<RunInfo> activeRun(const std::string& robot);
+  /// At start-up: every run without an end becomes 'incomplete', its end time
+  /// the last event or alarm recorded (else its start). Returns their ids.
+  std::vector<std::string> markIncompleteRuns();
+
+  /// run_id "" = not during a run.
+  void addEvent(const std::string& run_id, const std::string& robot, Time t, const std::string& kind,
+                const std::string& text);
+  void addAlarm(const std::string& run_id, const std::string& robot, Time t, const std::string& channel,
+                const std::string& level, const std::string& state, double value, double x_m, double y_m);
+  /// Replaces the run's summary and gas figures.
+  void setSummary(const std::string& run_id, const Summary& s);
+  /// Adds the file, or updates its kind and size if the run already lists that path.
+  void addFile(const std::string& run_id, const std::string& kind, const std::string& path, int64_t bytes);
+
+  std::vector<RunInfo> listRuns(const RunFilter& f = {});
+  /// By run id, or by rowid when `run_id` is all digits.
+  std::optional<RunDetail> run(const std::string& run_id);
+
+  /// "ok", or SQLite's messages one per line.
+  std::string integrityCheck();
+
+ private:
+  struct Impl;
+  explicit Catalog(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace inspect::catalog

@@ -1,0 +1,464 @@
+// Run catalog (SQLite) on real files in a temporary directory: creation and
+// migrations (v1 -> latest, refusing a newer schema), runs, events, alarms,
+// summaries, files, filters, a SIGKILL during a run, the sqlite3 shell, bad
+// files, concurrent writers, and the time format.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "shared/catalog/catalog.hpp"
+
+using namespace inspect::catalog;
+namespace fs = std::filesystem;
+using std::chrono::milliseconds;
+
+namespace {
+
+Time at(const char* iso) { return parseIsoUtc(iso).value(); }
+
+RunStart runOf(const std::string& robot, const std::string& name, Time start) {
+  RunStart r;
+  r.robot = robot;
+  r.name = name;
+  r.route = "routes/corridor.yaml";
+  r.gains_json = R"({"kp":1.5})";
+  r.software_version = "0.1.0";
+  r.dir = "runs/" + name;
+  r.start = start;
+  return r;
+}
+
+// First column of every row of `sql`, through SQLite directly (not the Catalog).
+std::vector<std::string> rawQuery(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  std::vector<std::string> rows;
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr) == SQLITE_OK) {
+    sqlite3_stmt* s = nullptr;
+    if (sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) == SQLITE_OK) {
+      while (sqlite3_step(s) == SQLITE_ROW) {
+        const auto* t = reinterpret_cast<const char*>(sqlite3_column_text(s, 0));
+        rows.emplace_back(t ? t : "");
+      }
+    } else {
+      rows.push_back(std::string("error: ") + sqlite3_errmsg(db));
+    }
+    sqlite3_finalize(s);
+  }
+  sqlite3_close(db);
+  return rows;
+}
+
+// The CatalogError message of `f`, "" if it does not throw one.
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const CatalogError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+class CatalogTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("catalog_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    path_ = (dir_ / "catalog.sqlite").string();
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path dir_;
+  std::string path_;
+  const Time t0_ = at("2026-11-22T08:30:15.250Z");
+};
+
+TEST_F(CatalogTest, CreatesWalDatabaseAtLatestVersion) {
+  auto cat = Catalog::open(path_);
+  EXPECT_TRUE(fs::exists(path_));
+  EXPECT_EQ(cat.schemaVersion(), static_cast<int>(schemaMigrations().size()));
+  EXPECT_EQ(cat.integrityCheck(), "ok");
+  EXPECT_EQ(rawQuery(path_, "PRAGMA journal_mode"), std::vector<std::string>{"wal"});
+  EXPECT_EQ(rawQuery(path_, "SELECT name FROM sqlite_master WHERE type IN ('table', 'view') ORDER BY name"),
+            (std::vector<std::string>{"alarms", "events", "robots", "run_files", "run_gas", "run_overview",
+                                      "run_summary", "runs"}));
+}
+
+TEST_F(CatalogTest, ReopeningKeepsDataAndVersion) {
+  std::string id;
+  {
+    auto cat = Catalog::open(path_);
+    id = cat.startRun(runOf("robot1", "a", t0_)).id;
+  }
+  auto cat = Catalog::open(path_);
+  EXPECT_EQ(cat.schemaVersion(), static_cast<int>(schemaMigrations().size()));
+  const auto runs = cat.listRuns();
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].id, id);
+}
+
+TEST_F(CatalogTest, UpgradesVersion1ToLatest) {
+  std::string id;
+  {
+    auto v1 = Catalog::open(path_, schemaMigrations().first(1));
+    EXPECT_EQ(v1.schemaVersion(), 1);
+    id = v1.startRun(runOf("robot1", "old", t0_)).id;
+    v1.addEvent(id, "robot1", t0_ + milliseconds(10), "note", "before the upgrade");
+    ASSERT_TRUE(v1.endRun(id, "completed", t0_ + milliseconds(5000)));
+  }
+  EXPECT_EQ(rawQuery(path_, "SELECT count(*) FROM sqlite_master WHERE name = 'run_summary'"),
+            std::vector<std::string>{"0"});
+
+  auto cat = Catalog::open(path_);
+  EXPECT_EQ(cat.schemaVersion(), static_cast<int>(schemaMigrations().size()));
+  Summary s;
+  s.duration_s = 5;
+  s.gas = {{"CH4", "ppm", 12, 3}};
+  cat.setSummary(id, s);
+  const auto d = cat.run(id);
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->info.name, "old");
+  EXPECT_EQ(d->info.outcome, "completed");
+  EXPECT_EQ(d->event_count, 1);
+  ASSERT_TRUE(d->summary);
+  ASSERT_EQ(d->summary->gas.size(), 1u);
+  EXPECT_EQ(cat.integrityCheck(), "ok");
+}
+
+TEST_F(CatalogTest, RefusesANewerSchema) {
+  { auto cat = Catalog::open(path_); }
+  // A program that knows only version 1 must not touch a later catalog.
+  const std::string older = errorOf([&] { Catalog::open(path_, schemaMigrations().first(1)); });
+  EXPECT_NE(older.find(path_), std::string::npos) << older;
+  EXPECT_NE(older.find("newer program"), std::string::npos) << older;
+
+  const int future = static_cast<int>(schemaMigrations().size()) + 1;
+  rawQuery(path_, "PRAGMA user_version = " + std::to_string(future));
+  const std::string err = errorOf([&] { Catalog::open(path_); });
+  EXPECT_NE(err.find("schema version " + std::to_string(future)), std::string::npos) << err;
+  // Refusing did not change the file.
+  EXPECT_EQ(rawQuery(path_, "PRAGMA user_version"), std::vector<std::string>{std::to_string(future)});
+}
+
+TEST_F(CatalogTest, RunIdsAreUniqueWithinASecond) {
+  auto cat = Catalog::open(path_);
+  const auto a = cat.startRun(runOf("robot1", "a", t0_));
+  const auto b = cat.startRun(runOf("robot1", "b", t0_ + milliseconds(300)));
+  const auto c = cat.startRun(runOf("robot1", "c", t0_));
+  const auto other = cat.startRun(runOf("robot 2/x", "d", t0_));
+  EXPECT_EQ(a.id, "20261122-083015-robot1");
+  EXPECT_EQ(b.id, "20261122-083015-robot1-2");
+  EXPECT_EQ(c.id, "20261122-083015-robot1-3");
+  EXPECT_EQ(other.id, "20261122-083015-robot_2_x");
+  EXPECT_EQ(other.robot, "robot 2/x");
+  EXPECT_LT(a.rowid, b.rowid);
+  EXPECT_LT(b.rowid, c.rowid);
+  EXPECT_FALSE(errorOf([&] { cat.startRun(runOf("", "x", t0_)); }).empty());
+}
+
+TEST_F(CatalogTest, StartAndEndRuns) {
+  auto cat = Catalog::open(path_);
+  cat.upsertRobot("robot1", "0.1.0", t0_ - milliseconds(60000));
+  const auto r = cat.startRun(runOf("robot1", "night", t0_));
+  EXPECT_EQ(cat.activeRun("robot1").value().id, r.id);
+  EXPECT_FALSE(cat.activeRun("robot9"));
+
+  EXPECT_NE(errorOf([&] { cat.endRun(r.id, "exploded", t0_); }).find("unknown outcome"), std::string::npos);
+  EXPECT_NE(errorOf([&] { cat.endRun("nope", "completed", t0_); }).find("no run 'nope'"), std::string::npos);
+  EXPECT_TRUE(cat.endRun(r.id, "stopped", t0_ + milliseconds(90500)));
+  EXPECT_FALSE(cat.endRun(r.id, "completed", t0_ + milliseconds(99000)));  // already ended: unchanged
+  EXPECT_FALSE(cat.activeRun("robot1"));
+
+  const auto d = cat.run(r.id).value();
+  EXPECT_EQ(d.info.outcome, "stopped");
+  EXPECT_EQ(d.info.end.value(), t0_ + milliseconds(90500));
+  EXPECT_EQ(d.info.start, t0_);
+  EXPECT_EQ(d.info.gains_json, R"({"kp":1.5})");
+  EXPECT_EQ(d.info.route, "routes/corridor.yaml");
+  EXPECT_EQ(d.info.dir, "runs/night");
+  EXPECT_EQ(cat.run(std::to_string(r.rowid)).value().info.id, r.id);  // by rowid too
+  EXPECT_FALSE(cat.run("20990101-000000-none"));
+
+  // Robots: the first sighting stays, the version and last sighting follow upserts.
+  cat.upsertRobot("robot1", "0.2.0", t0_ + milliseconds(100000));
+  EXPECT_EQ(rawQuery(path_, "SELECT first_seen || ' ' || last_seen || ' ' || software_version FROM robots"),
+            std::vector<std::string>{"2026-11-22T08:29:15.250Z 2026-11-22T08:31:55.250Z 0.2.0"});
+  EXPECT_EQ(rawQuery(path_, "SELECT start_time || ' ' || end_time FROM runs"),
+            std::vector<std::string>{"2026-11-22T08:30:15.250Z 2026-11-22T08:31:45.750Z"});
+}
+
+TEST_F(CatalogTest, EventsAlarmsSummaryAndFilesRoundTrip) {
+  auto cat = Catalog::open(path_);
+  const auto r = cat.startRun(runOf("robot1", "gas round", t0_));
+  cat.addEvent(r.id, "robot1", t0_ + milliseconds(100), "connected", "");
+  cat.addEvent(r.id, "robot1", t0_ + milliseconds(200), "disconnected", "link lost");
+  cat.addEvent("", "robot1", t0_ + milliseconds(250), "note", "between runs");
+  cat.addAlarm(r.id, "robot1", t0_ + milliseconds(300), "CH4", "alarm", "raised", 812.5, 3.25, -1.5);
+  EXPECT_NE(errorOf([&] { cat.addEvent("nope", "robot1", t0_, "x", ""); }).find("FOREIGN KEY"), std::string::npos);
+
+  Summary s;
+  s.duration_s = 95.5;
+  s.distance_m = 42.25;
+  s.min_person_m = 0.85;
+  s.track_max_pos_err_m = 0.12;
+  s.track_rms_pos_err_m = 0.04;
+  s.track_max_angle_err_rad = 0.2;
+  s.video_frames_received = 2850;
+  s.video_frames_decoded = 2840;
+  s.video_packets_lost = 7;
+  s.gas = {{"CO", "ppm", 5, 1}, {"CH4", "ppm", 812.5, 120.25}};
+  cat.setSummary(r.id, s);
+  s.gas.pop_back();  // a second summary replaces the first, gas rows included
+  s.gas[0].max = 6;
+  s.min_person_m.reset();
+  cat.setSummary(r.id, s);
+
+  cat.addFile(r.id, "telemetry", "runs/gas/telemetry.csv", 100);
+  cat.addFile(r.id, "video", "runs/gas/camera.mkv", 5000000);
+  cat.addFile(r.id, "telemetry", "runs/gas/telemetry.csv", 2048);  // final size
+
+  const auto d = cat.run(r.id).value();
+  EXPECT_EQ(d.event_count, 2);
+  EXPECT_EQ(d.alarm_count, 1);
+  ASSERT_TRUE(d.summary);
+  EXPECT_DOUBLE_EQ(d.summary->duration_s, 95.5);
+  EXPECT_DOUBLE_EQ(d.summary->distance_m, 42.25);
+  EXPECT_FALSE(d.summary->min_person_m);
+  EXPECT_DOUBLE_EQ(d.summary->track_max_pos_err_m.value(), 0.12);
+  EXPECT_DOUBLE_EQ(d.summary->track_rms_pos_err_m.value(), 0.04);
+  EXPECT_DOUBLE_EQ(d.summary->track_max_angle_err_rad.value(), 0.2);
+  EXPECT_EQ(d.summary->video_frames_received, 2850);
+  EXPECT_EQ(d.summary->video_frames_decoded, 2840);
+  EXPECT_EQ(d.summary->video_packets_lost, 7);
+  ASSERT_EQ(d.summary->gas.size(), 1u);
+  EXPECT_EQ(d.summary->gas[0].channel, "CO");
+  EXPECT_EQ(d.summary->gas[0].unit, "ppm");
+  EXPECT_DOUBLE_EQ(d.summary->gas[0].max, 6);
+  EXPECT_DOUBLE_EQ(d.summary->gas[0].mean, 1);
+  ASSERT_EQ(d.files.size(), 2u);
+  EXPECT_EQ(d.files[0].path, "runs/gas/telemetry.csv");
+  EXPECT_EQ(d.files[0].bytes, 2048);
+  EXPECT_EQ(d.files[1].kind, "video");
+  EXPECT_EQ(d.files[1].bytes, 5000000);
+
+  EXPECT_EQ(rawQuery(path_, "SELECT channel || ' ' || level || ' ' || state || ' ' || value || ' ' || x_m || ' ' || "
+                            "y_m || ' ' || time FROM alarms"),
+            std::vector<std::string>{"CH4 alarm raised 812.5 3.25 -1.5 2026-11-22T08:30:15.550Z"});
+  EXPECT_EQ(rawQuery(path_, "SELECT count(*) FROM events WHERE run_id IS NULL"), std::vector<std::string>{"1"});
+
+  // A run without a summary.
+  const auto bare = cat.run(cat.startRun(runOf("robot1", "bare", t0_)).id).value();
+  EXPECT_FALSE(bare.summary);
+  EXPECT_TRUE(bare.files.empty());
+}
+
+TEST_F(CatalogTest, ListRunsFilters) {
+  auto cat = Catalog::open(path_);
+  const auto a = cat.startRun(runOf("robot1", "Night round A", at("2026-11-20T22:00:00Z")));
+  const auto b = cat.startRun(runOf("robot2", "night round B", at("2026-11-21T22:00:00Z")));
+  const auto c = cat.startRun(runOf("robot1", "calibration", at("2026-11-22T08:00:00Z")));
+  cat.endRun(a.id, "completed", at("2026-11-20T23:00:00Z"));
+  cat.endRun(b.id, "failed", at("2026-11-21T22:10:00Z"));
+
+  auto ids = [&](const RunFilter& f) {
+    std::vector<std::string> out;
+    for (const auto& r : cat.listRuns(f)) out.push_back(r.id);
+    return out;
+  };
+  EXPECT_EQ(ids({}), (std::vector<std::string>{c.id, b.id, a.id}));  // newest first
+  RunFilter f;
+  f.robot = "robot1";
+  EXPECT_EQ(ids(f), (std::vector<std::string>{c.id, a.id}));
+  f = {};
+  f.name_contains = "NIGHT";
+  EXPECT_EQ(ids(f), (std::vector<std::string>{b.id, a.id}));
+  f.outcome = "failed";
+  EXPECT_EQ(ids(f), std::vector<std::string>{b.id});
+  f = {};
+  f.outcome = "running";
+  EXPECT_EQ(ids(f), std::vector<std::string>{c.id});
+  f = {};
+  f.since = at("2026-11-21");
+  EXPECT_EQ(ids(f), (std::vector<std::string>{c.id, b.id}));
+  f.limit = 1;
+  EXPECT_EQ(ids(f), std::vector<std::string>{c.id});
+  f = {};
+  f.outcome = "bogus";
+  EXPECT_NE(errorOf([&] { cat.listRuns(f); }).find("unknown outcome 'bogus'"), std::string::npos);
+}
+
+TEST_F(CatalogTest, MarkIncompleteRunsEndsThemAtTheirLastRecord) {
+  auto cat = Catalog::open(path_);
+  const auto a = cat.startRun(runOf("robot1", "a", t0_));
+  const auto b = cat.startRun(runOf("robot2", "b", t0_));
+  const auto c = cat.startRun(runOf("robot3", "c", t0_));
+  cat.endRun(c.id, "completed", t0_ + milliseconds(1000));
+  cat.addEvent(a.id, "robot1", t0_ + milliseconds(4000), "tick", "");
+  cat.addAlarm(a.id, "robot1", t0_ + milliseconds(7000), "CO", "warning", "raised", 30, 0, 0);
+
+  EXPECT_EQ(cat.markIncompleteRuns(), (std::vector<std::string>{a.id, b.id}));
+  EXPECT_TRUE(cat.markIncompleteRuns().empty());
+  const auto da = cat.run(a.id).value().info;
+  EXPECT_EQ(da.outcome, "incomplete");
+  EXPECT_EQ(da.end.value(), t0_ + milliseconds(7000));
+  EXPECT_EQ(cat.run(b.id).value().info.end.value(), t0_);
+  EXPECT_EQ(cat.run(c.id).value().info.outcome, "completed");
+}
+
+// A server killed with SIGKILL in the middle of a run: every committed write is
+// there, the file is sound, and the run is marked incomplete at the next start.
+TEST_F(CatalogTest, SurvivesSigkillDuringARun) {
+  constexpr int kAcksBeforeKill = 300;
+  constexpr int kMaxEvents = 100000;  // bound if the kill never came
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {  // the "server": no gtest here, only _exit
+    ::close(fds[0]);
+    int code = 0;
+    try {
+      auto cat = Catalog::open(path_);
+      const auto run = cat.startRun(runOf("robot1", "doomed", t0_));
+      char id[64] = {};
+      run.id.copy(id, sizeof id - 1);
+      if (::write(fds[1], id, sizeof id) != sizeof id) ::_exit(3);
+      for (int32_t i = 0; i < kMaxEvents; ++i) {
+        cat.addEvent(run.id, "robot1", t0_ + milliseconds(i), "tick", std::to_string(i));
+        if (::write(fds[1], &i, sizeof i) != sizeof i) ::_exit(3);  // acknowledged = committed
+      }
+    } catch (...) {
+      code = 2;
+    }
+    ::_exit(code);
+  }
+  ::close(fds[1]);
+  auto readAll = [&](void* buf, std::size_t n) {
+    auto* p = static_cast<char*>(buf);
+    while (n > 0) {
+      const ssize_t got = ::read(fds[0], p, n);
+      if (got <= 0) return false;
+      p += got;
+      n -= static_cast<std::size_t>(got);
+    }
+    return true;
+  };
+  char id[64] = {};
+  const bool started = readAll(id, sizeof id);
+  int32_t last_ack = -1, ack = 0;
+  while (started && last_ack + 1 < kAcksBeforeKill && readAll(&ack, sizeof ack)) last_ack = ack;
+  ::kill(pid, SIGKILL);
+  while (readAll(&ack, sizeof ack)) last_ack = ack;  // acknowledged before the kill landed
+  ::close(fds[0]);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(started);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "child status " << status;
+  ASSERT_GE(last_ack + 1, kAcksBeforeKill);
+  EXPECT_TRUE(fs::exists(path_ + "-wal"));  // killed with its WAL not checkpointed
+
+  auto cat = Catalog::open(path_);
+  EXPECT_EQ(cat.integrityCheck(), "ok");
+  EXPECT_EQ(cat.markIncompleteRuns(), std::vector<std::string>{id});
+  const auto d = cat.run(id).value();
+  EXPECT_EQ(d.info.outcome, "incomplete");
+  // Every acknowledged event, and at most the one in flight.
+  EXPECT_GE(d.event_count, last_ack + 1);
+  EXPECT_LE(d.event_count, last_ack + 2);
+  EXPECT_EQ(rawQuery(path_, "SELECT count(DISTINCT text) = count(*) AND min(CAST(text AS INTEGER)) = 0 AND "
+                            "max(CAST(text AS INTEGER)) = count(*) - 1 FROM events"),
+            std::vector<std::string>{"1"});
+  EXPECT_GE(d.info.end.value(), t0_ + milliseconds(last_ack));
+}
+
+TEST_F(CatalogTest, ReadableWithTheSqlite3Shell) {
+  if (!fs::exists("/usr/bin/sqlite3")) GTEST_SKIP() << "no /usr/bin/sqlite3 (Debian sqlite3)";
+  {
+    auto cat = Catalog::open(path_);
+    const auto r = cat.startRun(runOf("robot1", "a", t0_));
+    cat.startRun(runOf("robot1", "b", t0_));
+    Summary s;
+    s.gas = {{"CH4", "ppm", 812.5, 120.25}};
+    cat.setSummary(r.id, s);
+  }
+  const std::string cmd = "/usr/bin/sqlite3 '" + path_ +
+                          "' 'PRAGMA integrity_check; SELECT count(*) FROM runs;"
+                          " SELECT channel, max, mean FROM run_gas; SELECT outcome FROM run_overview LIMIT 1;' 2>&1";
+  std::FILE* p = ::popen(cmd.c_str(), "r");
+  ASSERT_TRUE(p);
+  std::string out;
+  char buf[256];
+  while (std::fgets(buf, sizeof buf, p)) out += buf;
+  EXPECT_EQ(::pclose(p), 0) << out;
+  EXPECT_EQ(out, "ok\n2\nCH4|812.5|120.25\nrunning\n");
+}
+
+TEST_F(CatalogTest, BadFilesGiveErrorsNamingThePath) {
+  const std::string missing = (dir_ / "no_such_dir" / "catalog.sqlite").string();
+  const std::string e1 = errorOf([&] { Catalog::open(missing); });
+  EXPECT_NE(e1.find(missing), std::string::npos) << e1;
+  EXPECT_NE(e1.find("unable to open"), std::string::npos) << e1;
+
+  const std::string text = (dir_ / "notes.txt").string();
+  std::ofstream(text) << std::string(2000, 'x');
+  const std::string e2 = errorOf([&] { Catalog::open(text); });
+  EXPECT_NE(e2.find(text), std::string::npos) << e2;
+  EXPECT_NE(e2.find("not a database"), std::string::npos) << e2;
+
+  const std::string foreign = (dir_ / "other.sqlite").string();
+  {
+    sqlite3* db = nullptr;
+    sqlite3_open(foreign.c_str(), &db);
+    sqlite3_exec(db, "CREATE TABLE t (x)", nullptr, nullptr, nullptr);
+    sqlite3_close(db);
+  }
+  const std::string e3 = errorOf([&] { Catalog::open(foreign); });
+  EXPECT_NE(e3.find(foreign), std::string::npos) << e3;
+  EXPECT_NE(e3.find("not a run catalog"), std::string::npos) << e3;
+  EXPECT_EQ(rawQuery(foreign, "SELECT count(*) FROM sqlite_master"), std::vector<std::string>{"1"});  // untouched
+  EXPECT_EQ(rawQuery(foreign, "PRAGMA journal_mode"), std::vector<std::string>{"delete"});
+}
+
+TEST_F(CatalogTest, ConcurrentWritersShareOneCatalog) {
+  auto cat = Catalog::open(path_);
+  const auto r = cat.startRun(runOf("robot1", "busy", t0_));
+  constexpr int kThreads = 4, kEach = 100;
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < kEach; ++i) {
+        if (i % 2)
+          cat.addEvent(r.id, "robot1", t0_ + milliseconds(i), "tick", std::to_string(t));
+        else
+          cat.addAlarm(r.id, "robot1", t0_ + milliseconds(i), "CO", "warning", "raised", i, 0, 0);
+        if (i % 25 == 0) cat.listRuns();
+      }
+    });
+  for (auto& th : threads) th.join();
+  const auto d = cat.run(r.id).value();
+  EXPECT_EQ(d.event_count + d.alarm_count, kThreads * kEach);
+  EXPECT_EQ(cat.integrityCheck(), "ok");
+}
+
+TEST(CatalogTime, FormatsAndParsesIsoUtc) {
+  const Time t = parseIsoUtc("2026-11-22T08:30:15.123Z").value();
+  EXPECT_EQ(formatIsoUtc(t), "2026-11-22T08:30:15.123Z");
+  EXPECT_EQ(std::chrono::system_clock::to_time_t(t), 1795336215);
+  EXPECT_EQ(parseIsoUtc("2026-11-22").value(), parseIsoUtc("2026-11-22T00:00:00Z").value());
+  EXPECT_EQ(parseIsoUtc("2026-11-22 08:30").value(), parseIsoUtc("2026-11-22T08:30:00.000").value());
+  for (const char* bad : {"", "2026-11", "2026-13-01", "2026-02-30", "2026-11-22T25:00", "2026-11-22T08:30:15.",
+                          "2026-11-22x", "20261122"})
+    EXPECT_FALSE(parseIsoUtc(bad)) << bad;
+}
+
+}  // namespace

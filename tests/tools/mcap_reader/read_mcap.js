@@ -1,0 +1,164 @@
+#!/usr/bin/env node
+// Independent MCAP reader for the tests (@mcap/core from npm, the library
+// Foxglove itself uses). Prints {"<topic>": messages, ..., "schemas": n}.
+//
+//   node read_mcap.js [--stream] [--expect expected.json] file.mcap
+//
+// A file that ends with the MCAP magic is opened with McapIndexedReader (footer,
+// summary, chunk indexes, every chunk's CRC) and then read again from start to
+// end with McapStreamReader, which must agree; the data-section CRC in DataEnd
+// and the Statistics record are checked too. A file without the magic at its
+// end (a cut-off recording), or any file with --stream, is read with
+// McapStreamReader only: every complete record before the cut counts.
+// Exit status 1 on any error or disagreement, or when the counts differ from
+// --expect.
+"use strict";
+
+const fs = require("node:fs");
+const zlib = require("node:zlib");
+const { McapIndexedReader, McapStreamReader } = require("@mcap/core");
+const fzstd = require("fzstd");
+
+const MAGIC = Buffer.from([0x89, 0x4d, 0x43, 0x41, 0x50, 0x30, 0x0d, 0x0a]);
+const decompressHandlers = {
+  zstd: (buffer, decompressedSize) => {
+    const out = fzstd.decompress(buffer);
+    if (BigInt(out.byteLength) !== decompressedSize) {
+      throw new Error(`zstd chunk: ${out.byteLength} bytes, expected ${decompressedSize}`);
+    }
+    return out;
+  },
+};
+
+function addCount(counts, topic) {
+  counts[topic] = (counts[topic] ?? 0) + 1;
+}
+
+async function readIndexed(path) {
+  const handle = await fs.promises.open(path, "r");
+  try {
+    const readable = {
+      size: async () => BigInt((await handle.stat()).size),
+      read: async (offset, size) => {
+        const buffer = Buffer.alloc(Number(size));
+        const { bytesRead } = await handle.read(buffer, 0, buffer.length, Number(offset));
+        if (bytesRead !== buffer.length) throw new Error(`short read at ${offset}`);
+        return buffer;
+      },
+    };
+    const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+    const counts = {};
+    for await (const message of reader.readMessages({ validateCrcs: true })) {
+      addCount(counts, reader.channelsById.get(message.channelId).topic);
+    }
+    const total = Object.values(counts).reduce((a, b) => a + b, 0);
+    const stats = reader.statistics;
+    if (!stats) throw new Error("no Statistics record");
+    if (stats.messageCount !== BigInt(total)) {
+      throw new Error(`Statistics.message_count ${stats.messageCount}, read ${total}`);
+    }
+    for (const [id, n] of stats.channelMessageCounts) {
+      const topic = reader.channelsById.get(id).topic;
+      if (n !== BigInt(counts[topic] ?? 0)) throw new Error(`Statistics says ${n} on ${topic}, read ${counts[topic]}`);
+    }
+    if (reader.dataSectionCrc === undefined) throw new Error("DataEnd has no data section CRC");
+    if (typeof zlib.crc32 === "function") {
+      const data = fs.readFileSync(path).subarray(0, Number(reader.dataEndOffset));
+      const crc = zlib.crc32(data) >>> 0;
+      if (crc !== reader.dataSectionCrc) {
+        throw new Error(`data section CRC ${crc}, DataEnd says ${reader.dataSectionCrc}`);
+      }
+    } else {
+      process.stderr.write("read_mcap: this node has no zlib.crc32, data section CRC not checked\n");
+    }
+    return { counts, schemas: reader.schemasById.size, chunks: reader.chunkIndexes.length };
+  } finally {
+    await handle.close();
+  }
+}
+
+function readStream(path, requireComplete) {
+  const reader = new McapStreamReader({ includeChunks: true, decompressHandlers, validateCrcs: true });
+  const topics = new Map();
+  const schemas = new Set();
+  const counts = {};
+  let chunks = 0;
+  const fd = fs.openSync(path, "r");
+  try {
+    const buffer = Buffer.alloc(1 << 20);
+    for (;;) {
+      const n = fs.readSync(fd, buffer, 0, buffer.length, null);
+      if (n === 0) break;
+      reader.append(buffer.subarray(0, n));
+      for (let record; (record = reader.nextRecord()); ) {
+        if (record.type === "Schema") schemas.add(record.id);
+        if (record.type === "Channel") topics.set(record.id, record.topic);
+        if (record.type === "Chunk") chunks += 1;
+        if (record.type === "Message") {
+          if (!topics.has(record.channelId)) throw new Error(`message on unknown channel ${record.channelId}`);
+          addCount(counts, topics.get(record.channelId));
+        }
+      }
+    }
+  } finally {
+    fs.closeSync(fd);
+  }
+  if (requireComplete && !reader.done()) throw new Error("stream reader did not reach the footer");
+  return { counts, schemas: schemas.size, chunks, complete: reader.done() };
+}
+
+function endsWithMagic(path) {
+  const size = fs.statSync(path).size;
+  if (size < 2 * MAGIC.length) return false;
+  const fd = fs.openSync(path, "r");
+  try {
+    const tail = Buffer.alloc(MAGIC.length);
+    fs.readSync(fd, tail, 0, MAGIC.length, size - MAGIC.length);
+    return tail.equals(MAGIC);
+  } finally {
+    fs.closeSync(fd);
+  }
+}
+
+function sameJson(a, b) {
+  const keys = new Set([...Object.keys(a), ...Object.keys(b)]);
+  return [...keys].every((k) => a[k] === b[k]);
+}
+
+async function main() {
+  const args = process.argv.slice(2);
+  let stream = false;
+  let expectPath;
+  let path;
+  for (let i = 0; i < args.length; i++) {
+    if (args[i] === "--stream") stream = true;
+    else if (args[i] === "--expect") expectPath = args[++i];
+    else if (!path) path = args[i];
+    else throw new Error(`unexpected argument ${args[i]}`);
+  }
+  if (!path) throw new Error("usage: node read_mcap.js [--stream] [--expect expected.json] file.mcap");
+
+  let result;
+  if (!stream && endsWithMagic(path)) {
+    result = await readIndexed(path);
+    const linear = readStream(path, true);
+    if (!sameJson(result.counts, linear.counts) || linear.schemas !== result.schemas || linear.chunks !== result.chunks) {
+      throw new Error(`indexed and stream readers disagree: ${JSON.stringify(result)} vs ${JSON.stringify(linear)}`);
+    }
+  } else {
+    result = readStream(path, false);
+  }
+  const out = { ...result.counts, schemas: result.schemas };
+  process.stdout.write(JSON.stringify(out) + "\n");
+  if (expectPath) {
+    const expected = JSON.parse(fs.readFileSync(expectPath, "utf8"));
+    if (!sameJson(out, expected)) {
+      throw new Error(`counts differ from ${expectPath}: expected ${JSON.stringify(expected)}`);
+    }
+  }
+}
+
+main().catch((err) => {
+  process.stderr.write(`read_mcap: ${err.message ?? err}\n`);
+  process.exit(1);
+});
