@@ -149,6 +149,18 @@ const std::vector<Console::CommandDef>& Console::commands() {
        &Console::cmdRuns},
       {"run", "run show <run-id>", "a recorded run's summary, files and counts",
        "  example: run show 20261122-083015-robot1\n", &Console::cmdRun},
+      {"report", "report <run-id>", "write a run's report: PNG plots and summary.md in <run>/report/",
+       "  Plots: trajectory (with the tracking reference), speed and nearest person with the proxemic\n"
+       "  zones, tracking errors, gas concentrations; summary.md links them and the run's files.\n"
+       "  example: report 20261122-083015-robot1\n",
+       &Console::cmdReport},
+      {"export", "export <run-id> csv [dir]", "one CSV per channel of a run's MCAP file (default <run>/csv/)",
+       "  Columns: log_time_s, publish_time_s, then every field, nested ones dotted (pose.x_m).\n",
+       &Console::cmdExport},
+      {"replay", "replay <run-id> [speed]", "play a run's telemetry back as status lines (speed 0.1-100, default 1)",
+       "  One status line per second of run time, and the run's events as they came.\n"
+       "  example: replay 1 10\n",
+       &Console::cmdReplay},
       {"wait", "wait <seconds>", "pause the console (events still print)",
        "  example: wait 2.5\n", &Console::cmdWait},
       {"expect", "expect <field> <op> <value> [<tol>] [within <seconds>]", "check a value (scripts, tests)",

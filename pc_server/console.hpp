@@ -13,6 +13,7 @@
 #include "pc_server/keyboard_teleop.hpp"
 #include "pc_server/robot_registry.hpp"
 #include "pc_server/stop_flag.hpp"
+#include "shared/catalog/catalog.hpp"
 
 namespace inspect::server {
 
@@ -106,6 +107,11 @@ class Console {
   bool cmdRecord(const Args& args, const std::string& rest, int line_no);
   bool cmdRuns(const Args& args, const std::string& rest, int line_no);
   bool cmdRun(const Args& args, const std::string& rest, int line_no);
+  bool cmdReport(const Args& args, const std::string& rest, int line_no);
+  bool cmdExport(const Args& args, const std::string& rest, int line_no);
+  bool cmdReplay(const Args& args, const std::string& rest, int line_no);
+  /// A run of the catalog and its directory; prints why not (as `cmd`) when there is none.
+  std::optional<std::pair<catalog::RunDetail, std::string>> findRun(const std::string& cmd, const std::string& id);
   bool cmdWait(const Args& args, const std::string& rest, int line_no);
   bool cmdExpect(const Args& args, const std::string& rest, int line_no);
   bool cmdEcho(const Args& args, const std::string& rest, int line_no);

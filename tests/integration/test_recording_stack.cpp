@@ -115,7 +115,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
     EXPECT_TRUE(cat.activeRun("robot1").has_value());
   }
   const std::string second = runDir(runs, ids[1]);
-  writeFile(s.dir() / "restart.txt", "runs\nrun show 2\n");
+  writeFile(s.dir() / "restart.txt", "runs\nrun show 2\nreport 1\nexport 1 csv\nreplay 1 20\n");
   auto restarted = Process::spawn({binPath("pc_server"), "--config", srcPath("config/server.yaml"), "--bind",
                                    "127.0.0.1", "--port", "0", "--no-video", "--runs-dir", runs, "--script",
                                    s.dir() / "restart.txt"},
@@ -124,6 +124,15 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   const std::string rout = readFile(s.dir() / "restart.out");
   EXPECT_NE(rout.find(ids[1] + ": marked incomplete, MCAP repaired"), std::string::npos) << rout;
   EXPECT_NE(rout.find("incomplete"), std::string::npos) << rout;
+  // report, export and replay read the first run back.
+  EXPECT_NE(rout.find(ids[0] + ": report "), std::string::npos) << rout;
+  for (const char* png : {"trajectory.png", "speed_people.png"})
+    EXPECT_TRUE(exists(first + "/report/" + png)) << png << "\n" << rout;
+  EXPECT_TRUE(exists(first + "/report/summary.md"));
+  EXPECT_NE(rout.find(ids[0] + ": exported 6 CSV files"), std::string::npos) << rout;
+  EXPECT_NE(readFile(first + "/csv/telemetry.csv").find("pose.x_m"), std::string::npos);
+  EXPECT_NE(rout.find("replay of " + ids[0] + " done"), std::string::npos) << rout;
+  EXPECT_NE(rout.find("| TELEOP |"), std::string::npos) << rout;
   {
     auto cat = inspect::catalog::Catalog::open(runs + "/catalog.sqlite");
     EXPECT_EQ(cat.integrityCheck(), "ok");
