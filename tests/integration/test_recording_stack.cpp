@@ -104,6 +104,17 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   EXPECT_GT(topicCount(counts, "/ack"), 20) << counts;
   EXPECT_GE(topicCount(counts, "/server_event"), 2) << counts;
   EXPECT_GT(ffprobeFrames(first + "/video.mp4"), 90);
+  // ...and finds exactly the messages the server wrote ("run <id> ended (stopped): N messages" in its log).
+  {
+    const std::string err = readFile(s.dir() / "server.err");
+    const std::regex re_end("run " + ids[0] + " ended \\(stopped\\): ([0-9]+) messages");
+    std::smatch me;
+    ASSERT_TRUE(std::regex_search(err, me, re_end)) << err;
+    int read_total = 0;
+    for (const char* t : {"/telemetry", "/camera", "/command", "/ack", "/event", "/server_event"})
+      read_total += std::max(topicCount(counts, t), 0);
+    EXPECT_EQ(read_total, std::stoi(me[1])) << counts;
+  }
   EXPECT_NE(out.find("distance "), std::string::npos) << out;  // run show
   EXPECT_NE(out.find("stopped"), std::string::npos) << out;
 
