@@ -1,5 +1,6 @@
 #include "pc_server/recorder.hpp"
 
+#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 
@@ -36,6 +37,14 @@ int64_t fileBytes(const std::string& path) {
 }
 }  // namespace
 
+std::string gainsJson(const v1::Telemetry& t) {
+  if (t.track_controller().empty()) return "{}";
+  char json[256];
+  std::snprintf(json, sizeof json, R"({"controller":"%s","kp":%.6g,"ki":%.6g,"kd":%.6g})",
+                t.track_controller().c_str(), t.kp(), t.ki(), t.kd());
+  return json;
+}
+
 struct Recorder::Run {
   catalog::RunInfo info;
   record::McapWriter mcap;
@@ -46,6 +55,7 @@ struct Recorder::Run {
   uint64_t command_id = 0;   // the track/goto command that started it (ends it on COMPLETED/FAILED)
   std::string address;       // robot's link address, to notice reconnects
   uint64_t video_frames = 0;
+  bool gains_known = false;  // gains_json holds a tracking controller's gains
 
   explicit Run(record::McapWriterOptions o) : mcap(std::move(o)) {}
 };
@@ -95,6 +105,11 @@ Recorder::~Recorder() {
   }
 }
 
+void Recorder::setGainsSource(std::function<std::string(const std::string&)> f) {
+  std::lock_guard lk(mu_);
+  gains_source_ = std::move(f);
+}
+
 void Recorder::setVideoFigures(std::function<std::optional<VideoFigures>(const std::string&)> f) {
   std::lock_guard lk(mu_);
   video_figures_ = std::move(f);
@@ -121,6 +136,8 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
   rs.name = name;
   rs.route = route;
   rs.software_version = software_version_;
+  if (gains_source_) rs.gains_json = gains_source_(robot);
+  const bool gains_known = rs.gains_json != "{}";
   rs.dir = config_.dir;  // the runs directory: the run's files are in <dir>/<run id>/
   record::McapWriterOptions mo;
   mo.compression = config_.compression == "none" ? "" : config_.compression;
@@ -146,6 +163,7 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
     throw std::runtime_error("run " + run->info.id + ": " + e.what());
   }
   run->command_id = command_id;
+  run->gains_known = gains_known;
   const std::string id = run->info.id;
   noteLocked(*run, robot, "run " + id + " started" + (name.empty() ? "" : " (" + name + ")"));
   catalog_->addFile(id, "mcap", run->info.dir + "/run.mcap", 0);
@@ -235,6 +253,12 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
     switch (env.body_case()) {
       case v1::Envelope::kTelemetry:
         r.stats.add(env.telemetry());
+        // The gains in force, as soon as the robot tracks with them.
+        if (!r.gains_known && env.telemetry().mode() == v1::TRACKING && !env.telemetry().track_controller().empty()) {
+          const auto& t = env.telemetry();
+          catalog_->setGains(r.info.id, gainsJson(t));
+          r.gains_known = true;
+        }
         r.mcap.write(r.ch_telemetry, log_ns, publish_ns, env.telemetry());
         break;
       case v1::Envelope::kCommand: r.mcap.write(r.ch_command, log_ns, publish_ns, env.command()); break;

@@ -32,6 +32,10 @@ struct VideoFigures {
   int64_t frames_received = 0, frames_decoded = 0, packets_lost = 0;
 };
 
+/// The wheel PID gains a telemetry message reports while tracking, as JSON
+/// ({"controller":"fuzzy_pid","kp":..,"ki":..,"kd":..}); "{}" when not tracking.
+std::string gainsJson(const v1::Telemetry& t);
+
 class Recorder {
  public:
   /// Opens (creates) <dir>/catalog.sqlite, marks runs left open as
@@ -53,6 +57,8 @@ class Recorder {
   void onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us);
   /// Closes MCAP chunks of quiet recordings; call every 100-200 ms.
   void tick();
+  /// Where a new run gets the robot's controller gains in force (JSON; "{}" when unknown).
+  void setGainsSource(std::function<std::string(const std::string& robot)> f);
   /// Where run summaries get the robot's video figures.
   void setVideoFigures(std::function<std::optional<VideoFigures>(const std::string& robot)> f);
 
@@ -73,6 +79,7 @@ class Recorder {
   std::unique_ptr<catalog::Catalog> catalog_;
   std::string startup_report_;
   std::function<std::optional<VideoFigures>(const std::string&)> video_figures_;
+  std::function<std::string(const std::string&)> gains_source_;
   mutable std::mutex mu_;
   std::map<std::string, std::unique_ptr<Run>> runs_;  // robot -> its run
 };

@@ -24,6 +24,7 @@
 #include "pc_server/stop_flag.hpp"
 #include "pc_server/recorder.hpp"
 #include "pc_server/video_hub.hpp"
+#include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
 
 namespace inspect::server {
@@ -118,6 +119,12 @@ int runServer(const CliOptions& options) {
     link.addEnvelopeObserver([rec = recorder.get()](const std::string& id, const std::string& address,
                                                     const v1::Envelope& env, bool inbound, uint64_t time_us) {
       rec->onEnvelope(id, address, env, inbound, time_us);
+    });
+    // The gains the robot reports in its latest telemetry, when it is tracking
+    // (otherwise the recorder fills them in at the run's first tracking telemetry).
+    recorder->setGainsSource([&registry](const std::string& robot) {
+      const auto snap = registry.snapshot(robot, monoNowNs());
+      return snap && snap->has_telemetry ? gainsJson(snap->telemetry) : std::string("{}");
     });
     std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog.sqlite)";
     if (!recorder->startupReport().empty()) std::cout << "; " << recorder->startupReport();

@@ -535,6 +535,12 @@ bool Catalog::endRun(const std::string& run_id, const std::string& outcome, Time
   return false;
 }
 
+void Catalog::setGains(const std::string& run_id, const std::string& gains_json) {
+  std::lock_guard lk(impl_->mu);
+  impl_->query("UPDATE runs SET gains_json = ? WHERE run_id = ?").bind(gains_json, run_id).run();
+  if (sqlite3_changes(impl_->db.get()) != 1) impl_->failPlain("no run '" + run_id + "'");
+}
+
 std::optional<RunInfo> Catalog::activeRun(const std::string& robot) {
   std::lock_guard lk(impl_->mu);
   auto q = impl_->query("SELECT " RUN_COLUMNS

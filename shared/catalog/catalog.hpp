@@ -120,6 +120,8 @@ class Catalog {
   /// Ends a running run. False if it had already ended (unchanged); throws for
   /// an unknown run or outcome.
   bool endRun(const std::string& run_id, const std::string& outcome, Time end);
+  /// Replaces the run's gains in force (JSON); throws for an unknown run.
+  void setGains(const std::string& run_id, const std::string& gains_json);
   /// The robot's run that has not ended (the newest), e.g. to carry on after a reconnect.
   std::optional<RunInfo> activeRun(const std::string& robot);
   /// At start-up: every run without an end becomes 'incomplete', its end time

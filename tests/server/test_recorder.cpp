@@ -90,7 +90,10 @@ TEST(Recorder, ConsoleRunAndTrackRunAreRecordedAndListed) {
     const auto active = rec.activeRun("robot1");
     ASSERT_TRUE(active.has_value());
     second = *active;
-    rec.onEnvelope("robot1", "127.0.0.1:2", telemetry(0.5, -1, 1, v1::TRACKING, 0.02), true, monoNowUs());
+    auto tracking = telemetry(0.5, -1, 1, v1::TRACKING, 0.02);
+    tracking.mutable_telemetry()->set_track_controller("fuzzy_pid");
+    tracking.mutable_telemetry()->set_kp(9.5);
+    rec.onEnvelope("robot1", "127.0.0.1:2", tracking, true, monoNowUs());
     v1::Envelope ack;
     ack.mutable_ack()->set_command_id(77);
     ack.mutable_ack()->set_status(v1::Ack::COMPLETED);
@@ -107,6 +110,8 @@ TEST(Recorder, ConsoleRunAndTrackRunAreRecordedAndListed) {
     ASSERT_TRUE(d2 && d2->summary);
     EXPECT_EQ(d2->info.outcome, "completed");
     EXPECT_EQ(d2->info.name, "track");
+    EXPECT_NE(d2->info.gains_json.find(R"("controller":"fuzzy_pid","kp":9.5)"), std::string::npos) << d2->info.gains_json;
+    EXPECT_EQ(d1->info.gains_json, "{}");  // never tracked
     EXPECT_DOUBLE_EQ(d2->summary->track_max_pos_err_m.value_or(-1), 0.02);
 
     // The console lists and shows them.
