@@ -25,6 +25,7 @@
 #include "pc_server/recorder.hpp"
 #include "pc_server/video_hub.hpp"
 #include "shared/util/clock.hpp"
+#include "shared/util/file_util.hpp"
 #include "shared/util/log.hpp"
 
 namespace inspect::server {
@@ -69,20 +70,9 @@ ServerConfig resolveConfig(const CliOptions& options) {
   return c;
 }
 
-void writePortFile(const std::string& path, uint16_t port) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) throw StartupError("--port-file: cannot write '" + tmp + "': " + std::strerror(errno));
-  const bool ok = std::fprintf(f, "%u\n", static_cast<unsigned>(port)) > 0;
-  if (std::fclose(f) != 0 || !ok) {
-    std::remove(tmp.c_str());
-    throw StartupError("--port-file: cannot write '" + tmp + "'");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw StartupError("--port-file: cannot rename to '" + path + "': " + why);
-  }
+void writePortFile(const std::string& path, uint16_t port, const std::string& flag) {
+  if (const auto why = writeFileAtomically(path, std::to_string(port) + "\n"); !why.empty())
+    throw StartupError(flag + ": " + why);
 }
 
 int runServer(const CliOptions& options) {
@@ -107,7 +97,7 @@ int runServer(const CliOptions& options) {
   const auto endpoint = link.listen();
   log::warn(kTag, "robot link is plaintext TCP (TLS is not implemented yet): use it only on a trusted network");
   std::cout << "pc_server: listening on " << endpoint.address().to_string() << ":" << endpoint.port() << std::endl;
-  if (options.port_file) writePortFile(*options.port_file, endpoint.port());
+  if (options.port_file) writePortFile(*options.port_file, endpoint.port(), "--port-file");
 
   std::unique_ptr<Recorder> recorder;
   if (config.recording.enabled) {
@@ -151,7 +141,7 @@ int runServer(const CliOptions& options) {
     video->start();
     std::cout << "pc_server: video on UDP port " << video->port() << ", SDP files in " << config.video.dir << "/"
               << std::endl;
-    if (options.video_port_file) writePortFile(*options.video_port_file, video->port());
+    if (options.video_port_file) writePortFile(*options.video_port_file, video->port(), "--video-port-file");
   }
 
   StopFlag stop;

@@ -11,7 +11,7 @@ namespace inspect::server {
 ServerConfig resolveConfig(const CliOptions& options);
 
 /// Writes `port` to `path` through a temporary file and a rename. Throws StartupError.
-void writePortFile(const std::string& path, uint16_t port);
+void writePortFile(const std::string& path, uint16_t port, const std::string& flag = "--port-file");
 
 /// Runs the server until the console ends or SIGINT/SIGTERM; returns the exit status.
 /// Throws config::ConfigError / StartupError for startup failures.

@@ -11,6 +11,7 @@
 
 #include "pc_server/startup_error.hpp"
 #include "shared/util/clock.hpp"
+#include "shared/util/file_util.hpp"
 #include "shared/util/log.hpp"
 #include "shared/video/sdp.hpp"
 
@@ -129,7 +130,7 @@ void VideoHub::writeSdp(const std::string& robot_id, Robot& r, bool with_params)
   p.address = "127.0.0.1";
   p.port = r.forward_port;
   if (with_params && receiver_->parameterSets(robot_id, p.sps, p.pps)) r.sdp_has_params = true;
-  if (const auto why = video::writeFileAtomically(r.sdp_path, video::makeSdp(p)); !why.empty())
+  if (const auto why = writeFileAtomically(r.sdp_path, video::makeSdp(p)); !why.empty())
     log::warn(kTag, robot_id, ": SDP: ", why);
 }
 

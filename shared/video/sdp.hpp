@@ -18,10 +18,6 @@ struct SdpParams {
 /// profile-level-id / sprop-parameter-sets when SPS/PPS are known.
 std::string makeSdp(const SdpParams& p);
 
-/// Writes `text` to `path` atomically (temporary file + rename). Returns "" or
-/// the reason it failed.
-std::string writeFileAtomically(const std::string& path, const std::string& text);
-
 std::string base64(const std::vector<uint8_t>& bytes);
 
 }  // namespace inspect::video

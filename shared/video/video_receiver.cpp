@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 
 #include <boost/asio/post.hpp>
 
@@ -123,20 +124,24 @@ void VideoReceiver::removeStream(const std::string& name) {
   });
 }
 
+void VideoReceiver::checkNotStarted() const {
+  // The receiver thread reads the hooks without a lock.
+  if (started_) throw std::logic_error("VideoReceiver: hooks are set before start()");
+}
 void VideoReceiver::setKeyframeRequest(KeyframeRequest f) {
-  std::lock_guard lk(mu_);
+  checkNotStarted();
   keyframe_request_ = std::move(f);
 }
 void VideoReceiver::setFrameHook(FrameHook f) {
-  std::lock_guard lk(mu_);
+  checkNotStarted();
   frame_hook_ = std::move(f);
 }
 void VideoReceiver::setAccessUnitHook(AccessUnitHook f) {
-  std::lock_guard lk(mu_);
+  checkNotStarted();
   access_unit_hook_ = std::move(f);
 }
 void VideoReceiver::setPacketHook(PacketHook f) {
-  std::lock_guard lk(mu_);
+  checkNotStarted();
   packet_hook_ = std::move(f);
 }
 
@@ -200,28 +205,21 @@ void VideoReceiver::onDatagram(std::size_t n) {
       std::lock_guard lk(mu_);
       ++counters_.datagrams;
     }
-    handlePacket(*s, name, std::vector<uint8_t>(data.begin(), data.end()));
+    handlePacket(*s, name, p.seq, std::vector<uint8_t>(data.begin(), data.end()));
     return;
   }
   reject(&ReceiverCounters::unknown_ssrc, "unknown SSRC " + std::to_string(p.ssrc));
 }
 
-void VideoReceiver::handlePacket(Stream& s, const std::string& name, std::vector<uint8_t> datagram) {
+void VideoReceiver::handlePacket(Stream& s, const std::string& name, uint16_t seq, std::vector<uint8_t> datagram) {
   const auto now = Clock::now();
   s.last_packet = now;
   ++s.st.packets;
   ++s.w_packets;
   s.st.bytes += datagram.size();
   s.w_bytes += datagram.size();
-  PacketHook packet_hook;
-  {
-    std::lock_guard lk(mu_);
-    packet_hook = packet_hook_;
-  }
-  if (packet_hook) packet_hook(name, datagram);
-  RtpPacket probe;
-  parseRtp(datagram, probe);
-  s.reorder.push(probe.seq, std::move(datagram));
+  if (packet_hook_) packet_hook_(name, datagram);
+  s.reorder.push(seq, std::move(datagram));
   s.ready.clear();
   s.reorder.pop(s.ready);
   // A gap is given up after reorder_timeout_s even when fewer than `window`
@@ -256,12 +254,7 @@ void VideoReceiver::maybeRequestKeyframe(Stream& s, const std::string& name) {
   if (!s.damaged || now - s.last_request < std::chrono::duration<double>(settings_.keyframe_min_interval_s)) return;
   s.last_request = now;
   ++s.st.keyframe_requests;
-  KeyframeRequest request;
-  {
-    std::lock_guard lk(mu_);
-    request = keyframe_request_;
-  }
-  if (request) request(name);
+  if (keyframe_request_) keyframe_request_(name);
 }
 
 void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) {
@@ -274,12 +267,7 @@ void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) 
   }
   uint64_t capture_server_us = 0;
   if (f.capture_us) capture_server_us = static_cast<uint64_t>(static_cast<int64_t>(*f.capture_us) + s.offset_us);
-  AccessUnitHook au_hook;
-  {
-    std::lock_guard lk(mu_);
-    au_hook = access_unit_hook_;
-  }
-  if (au_hook) au_hook(name, f, capture_server_us);
+  if (access_unit_hook_) access_unit_hook_(name, f, capture_server_us);
   if (!s.decoder) return;
   // After a loss the picture stays frozen until a keyframe: P frames that
   // reference a lost frame would only smear the damage (as WebRTC does).
@@ -310,15 +298,13 @@ void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) 
     s.latencies.push_back(ms);
     if (s.latencies.size() > kLatencyHistory) s.latencies.pop_front();
   }
-  FrameHook hook;
   {
     std::lock_guard lk(mu_);
     auto& pub = published_[name];
     pub.latest = bgr;
     pub.latest_capture_us = capture_server_us;
-    hook = frame_hook_;
   }
-  if (hook) hook(name, bgr, capture_server_us);
+  if (frame_hook_) frame_hook_(name, bgr, capture_server_us);
 }
 
 void VideoReceiver::tick() {

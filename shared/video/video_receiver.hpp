@@ -98,6 +98,8 @@ class VideoReceiver {
   void setClockOffset(const std::string& name, int64_t clock_offset_us);
   void removeStream(const std::string& name);
 
+  /// Hooks are set before start() (std::logic_error after): the receiver
+  /// thread calls them without taking a lock.
   void setKeyframeRequest(KeyframeRequest f);
   void setFrameHook(FrameHook f);
   void setPacketHook(PacketHook f);
@@ -115,7 +117,8 @@ class VideoReceiver {
   struct Stream;
   void doReceive();
   void onDatagram(std::size_t n);
-  void handlePacket(Stream& s, const std::string& name, std::vector<uint8_t> datagram);
+  void handlePacket(Stream& s, const std::string& name, uint16_t seq, std::vector<uint8_t> datagram);
+  void checkNotStarted() const;
   /// Feeds the reorder buffer's released packets (s.ready) to the depacketizer.
   void depacketizeReady(Stream& s, const std::string& name);
   void maybeRequestKeyframe(Stream& s, const std::string& name);
@@ -132,6 +135,12 @@ class VideoReceiver {
   std::thread thread_;
   bool started_ = false;
 
+  // Set before start(), then only read (on the receiver thread).
+  KeyframeRequest keyframe_request_;
+  FrameHook frame_hook_;
+  PacketHook packet_hook_;
+  AccessUnitHook access_unit_hook_;
+
   // Touched only on the receiver thread (setStream/removeStream post to it).
   std::map<std::string, std::unique_ptr<Stream>> streams_;
   int tick_count_ = 0;
@@ -146,10 +155,6 @@ class VideoReceiver {
   mutable std::mutex mu_;
   std::map<std::string, Published> published_;
   ReceiverCounters counters_;
-  KeyframeRequest keyframe_request_;
-  FrameHook frame_hook_;
-  PacketHook packet_hook_;
-  AccessUnitHook access_unit_hook_;
 };
 
 }  // namespace inspect::video
