@@ -1,5 +1,7 @@
 #include "shared/config/robot_config.hpp"
 
+#include <cctype>
+
 namespace inspect::config {
 
 RobotConfig loadRobotConfig(const ConfigNode& root) {
@@ -40,6 +42,7 @@ RobotConfig loadRobotConfig(const ConfigNode& root) {
       (void)mounts[i].string("name", "");
     }
   }
+  c.gas = loadGasConfig(root.optChild("gas"), root.has("gas"));
   return c;
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "shared/config/config_node.hpp"
+#include "shared/config/gas_config.hpp"
 #include "shared/control/diff_drive.hpp"
 
 namespace inspect::config {
@@ -63,6 +64,7 @@ struct RobotConfig {
   RobotLimits limits;
   MotorModel motor;
   UltrasonicConfig ultrasonic;
+  GasConfig gas;  // the `gas` section (none when absent; defaultGasConfig() = config/robot.yaml's)
 };
 
 /// Reads a robot config; missing keys take the defaults above. Throws ConfigError.

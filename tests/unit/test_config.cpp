@@ -58,3 +58,62 @@ TEST(Config, WrongMountCount) {
   const auto e = errorOf("ultrasonic:\n  mounts:\n    - {x_m: 0, y_m: 0, yaw_rad: 0}\n");
   EXPECT_NE(e.find("exactly 4"), std::string::npos) << e;
 }
+
+TEST(GasConfig, ShippedChannelsAreTheDefaults) {
+  const auto c = loadRobotConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/robot.yaml");
+  const auto d = defaultGasConfig();
+  ASSERT_EQ(c.gas.channels.size(), d.channels.size());
+  for (std::size_t i = 0; i < d.channels.size(); ++i) {
+    const auto &a = c.gas.channels[i], &b = d.channels[i];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.unit, b.unit);
+    EXPECT_EQ(a.sensor, b.sensor);
+    EXPECT_DOUBLE_EQ(a.scale, b.scale);
+    EXPECT_DOUBLE_EQ(a.range_max, b.range_max);
+    EXPECT_DOUBLE_EQ(a.t90_s, b.t90_s);
+    EXPECT_DOUBLE_EQ(a.noise, b.noise);
+    EXPECT_DOUBLE_EQ(a.background, b.background);
+    EXPECT_EQ(a.direction, b.direction);
+    EXPECT_DOUBLE_EQ(a.alarm_low, b.alarm_low);
+    EXPECT_DOUBLE_EQ(a.alarm_high, b.alarm_high);
+    EXPECT_DOUBLE_EQ(a.hysteresis, b.hysteresis);
+    EXPECT_DOUBLE_EQ(a.min_duration_s, b.min_duration_s);
+    ASSERT_EQ(a.cross.size(), b.cross.size());
+    for (std::size_t k = 0; k < a.cross.size(); ++k) {
+      EXPECT_EQ(a.cross[k].gas, b.cross[k].gas);
+      EXPECT_DOUBLE_EQ(a.cross[k].factor, b.cross[k].factor);
+    }
+  }
+  EXPECT_NEAR(d.channels[0].tau_s(), 6.0 / std::log(10.0), 1e-12);
+  EXPECT_TRUE(loadRobotConfig(ConfigNode::loadString("{}", "r.yaml")).gas.channels.empty()) << "absent = none";
+}
+
+TEST(GasConfig, BadChannelsNameTheKey) {
+  auto err = [](const std::string& channel) {
+    try {
+      loadRobotConfig(ConfigNode::loadString("gas:\n  channels:\n    - " + channel + "\n", "r.yaml"));
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(err("{name: CH4, unit: x, range_max: 100, alarm_low: 20, alarm_high: 10}").find("alarm_high"),
+            std::string::npos);
+  EXPECT_NE(err("{name: O2, unit: x, range_max: 30, direction: falling, alarm_low: 18, alarm_high: 19.5}")
+                .find("falling"),
+            std::string::npos);
+  EXPECT_NE(err("{name: 'C H4', unit: x, range_max: 100, alarm_low: 10, alarm_high: 20}").find("name"),
+            std::string::npos);
+  EXPECT_NE(err("{name: CH4, unit: x, range_max: 1000, alarm_low: 10, alarm_high: 20}").find("raw counts"),
+            std::string::npos);
+  EXPECT_NE(err("{name: CH4, unit: x, range_max: 100, alarm_low: 10, alarm_high: 20, t90_s: 0}").find("t90_s"),
+            std::string::npos);
+  EXPECT_NE(err("{name: CH4, unit: x, range_max: 100, alarm_low: 10, alarm_high: 20, "
+                "cross_sensitivity: [{gas: NO2, factor: 1}]}")
+                .find("NO2"),
+            std::string::npos);
+  EXPECT_NE(errorOf("gas:\n  channels:\n    - {name: CH4, unit: x, range_max: 100, alarm_low: 10, alarm_high: 20, "
+                    "colour: red}\n")
+                .find("colour"),
+            std::string::npos);
+}
