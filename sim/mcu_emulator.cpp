@@ -22,6 +22,7 @@ double simSeconds(uint64_t ms) { return static_cast<double>(ms) / 1000.0; }
 
 McuEmulator::McuEmulator(const config::RobotConfig& robot, uint64_t seed, SimObserver* observer)
     : max_wheel_rad_s_(robot.limits.max_wheel_speed_rad_s),
+      gas_channels_(std::min<std::size_t>(robot.gas.channels.size(), serial::kGasChannels)),
       speed_noise_rad_s_(robot.motor.speed_noise_m_s / robot.geometry.wheel_radius_m),
       heading_noise_rad_(robot.motor.heading_noise_rad),
       observer_(observer),
@@ -92,6 +93,7 @@ uint16_t McuEmulator::faults() const {
   if (watchdog_tripped_) f |= serial::kFaultWatchdog;
   if (host_silent_) f |= serial::kFaultHostSilent;
   if (battery_mv_ < kBatteryLow_mv) f |= serial::kFaultBatteryLow;
+  if (gas_fault_) f |= serial::kFaultGasSensor;
   return f;
 }
 
@@ -108,6 +110,8 @@ serial::SensorFrame McuEmulator::sendSensorFrame(uint64_t now_ms, const McuInput
   f.ultrasonic_mm = in.ultrasonic_mm;
   f.grayscale = in.grayscale;
   f.gas_raw = in.gas_raw;
+  gas_fault_ = false;
+  for (std::size_t i = 0; i < gas_channels_; ++i) gas_fault_ = gas_fault_ || in.gas_raw[i] == config::kGasNoData;
   f.battery_mv = battery_mv_;
   f.faults = faults();
   f.cmd_seq_echo = cmd_seq_echo_;

@@ -45,7 +45,7 @@ class McuEmulator {
 
   /// Wheel set-points in force (zero when disabled or after the watchdog).
   control::WheelSpeeds setpoints() const { return setpoint_; }
-  /// McuFault bits at the current state.
+  /// McuFault bits at the current state (GAS_SENSOR: the last frame had a configured channel with no data).
   uint16_t faults() const;
   bool watchdogTripped() const { return watchdog_tripped_; }
   /// Counters of the host -> MCU decoder (corrupt frames, sequence gaps ...).
@@ -61,6 +61,8 @@ class McuEmulator {
   void event(uint64_t now_ms, std::string_view name, std::string_view detail);
 
   double max_wheel_rad_s_;
+  std::size_t gas_channels_;  // configured gas channels (frame slots in use)
+  bool gas_fault_ = false;
   double speed_noise_rad_s_;
   double heading_noise_rad_;
   SimObserver* observer_;

@@ -1,6 +1,7 @@
 #pragma once
 // What the simulation reports for the ground-truth log (and for tests).
 #include <cstdint>
+#include <span>
 #include <string_view>
 
 #include "shared/control/diff_drive.hpp"
@@ -28,6 +29,15 @@ struct PedestrianSample {
   double robot_distance_m = 0.0;  // centre of the person to the centre of the robot's body circle
 };
 
+/// Gas at the robot's sampling inlet (10 Hz of sim time), one value per configured channel in slot order.
+struct GasSample {
+  double sim_t_s = 0.0;
+  double inlet_x_m = 0.0;             // inlet position, world frame
+  double inlet_y_m = 0.0;
+  std::span<const double> true_value;  // background + gas + cross-sensitivities, before the sensor's response
+  std::span<const double> reading;     // what the frame carries: raw x scale; NaN = no data (dropout)
+};
+
 /// Receives the simulation's ground truth, commands and events. Default: ignore.
 class SimObserver {
  public:
@@ -37,10 +47,12 @@ class SimObserver {
   /// Every wheel command the MCU accepted (exact wire integers).
   virtual void onCommand(double /*sim_t_s*/, uint8_t /*seq*/, const serial::WheelCommand& /*cmd*/) {}
   /// A named event (start, watchdog_trip, watchdog_clear, host_silent, collision, collision_person,
-  /// pedestrian_start, pedestrian_end, ptz, stop).
+  /// pedestrian_start, pedestrian_end, gas_channels, gas_source, gas_fault_start, gas_fault_end, ptz, stop).
   virtual void onEvent(double /*sim_t_s*/, std::string_view /*event*/, std::string_view /*detail*/) {}
   /// Each present pedestrian, every 100 ms of sim time.
   virtual void onPedestrian(const PedestrianSample& /*sample*/) {}
+  /// The gas channels at the inlet, every 100 ms of sim time (when any channel is configured).
+  virtual void onGas(const GasSample& /*sample*/) {}
 };
 
 }  // namespace inspect::sim

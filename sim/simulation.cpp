@@ -1,12 +1,53 @@
 #include "sim/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 
 namespace inspect::sim {
 namespace {
 // Independent noise streams per sensor from one --seed.
 uint64_t subSeed(uint64_t seed, uint64_t stream) { return seed * 0x9E3779B97F4A7C15ull + stream; }
+
+std::string channelList(const config::GasConfig& cfg) {
+  std::string s;
+  for (const auto& c : cfg.channels) s += (s.empty() ? "" : ", ") + c.name;
+  return s.empty() ? "none" : s;
+}
+
+[[noreturn]] void gasNameError(const World& w, const std::string& key, const std::string& name,
+                               const config::GasConfig& cfg) {
+  throw config::ConfigError(w.source_file + ": " + key + ": '" + name +
+                            "' is not a gas channel of the robot (robot config gas.channels: " + channelList(cfg) +
+                            ")");
+}
+
+// Leaks must name the robot's channels (checked before the grid is built).
+const World& checkGasNames(const config::GasConfig& cfg, const World& w) {
+  for (std::size_t i = 0; i < w.gas.sources.size(); ++i)
+    if (cfg.find(w.gas.sources[i].gas) < 0)
+      gasNameError(w, "gas.sources[" + std::to_string(i) + "].gas", w.gas.sources[i].gas, cfg);
+  return w;
+}
+
+std::vector<GasSensorFault> resolveGasFaults(const config::GasConfig& cfg, const World& w) {
+  std::vector<GasSensorFault> out;
+  for (std::size_t i = 0; i < w.gas.faults.size(); ++i) {
+    const auto& f = w.gas.faults[i];
+    const int ch = cfg.find(f.channel);
+    if (ch < 0) gasNameError(w, "gas.faults[" + std::to_string(i) + "].channel", f.channel, cfg);
+    out.push_back({static_cast<std::size_t>(ch), f.kind, f.start_s, f.end_s});
+  }
+  return out;
+}
+
+std::string fmtSeconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", s);
+  return buf;
+}
 }  // namespace
 
 Simulation::Simulation(const config::RobotConfig& robot, World world, uint64_t seed, SimObserver* observer)
@@ -19,9 +60,94 @@ Simulation::Simulation(const config::RobotConfig& robot, World world, uint64_t s
       body_radius_m_(robot.geometry.body_radius_m),
       wheel_radius_m_(robot.geometry.wheel_radius_m),
       track_m_(robot.geometry.track_m),
-      person_contact_(world_.pedestrians.size(), false) {
+      person_contact_(world_.pedestrians.size(), false),
+      gas_cfg_(robot.gas),
+      gas_(checkGasNames(robot.gas, world_)),
+      gas_sensors_(robot.gas, resolveGasFaults(robot.gas, world_), subSeed(seed, 3)),
+      gas_fault_on_(world_.gas.faults.size(), false) {
   checkStartPose(world_, body_radius_m_);
   state_.pose = world_.start;
+  for (const auto& ch : gas_cfg_.channels) {
+    GasChannelMap m;
+    m.background = ch.background;
+    m.field = gas_.field(ch.name);
+    for (const auto& x : ch.cross)
+      if (const int f = gas_.field(x.gas); f >= 0) m.cross.emplace_back(f, x.factor);
+    gas_map_.push_back(std::move(m));
+  }
+  // The sensors have been standing at the start pose: no start-up transient.
+  const GasValues truth = trueGas(gasInlet());
+  gas_sensors_.settle(truth);
+}
+
+Vec2 Simulation::gasInlet() const {
+  const auto& p = state_.pose;
+  const double c = std::cos(p.theta_rad), s = std::sin(p.theta_rad);
+  return {p.x_m + c * gas_cfg_.inlet_x_m - s * gas_cfg_.inlet_y_m,
+          p.y_m + s * gas_cfg_.inlet_x_m + c * gas_cfg_.inlet_y_m};
+}
+
+Simulation::GasValues Simulation::trueGas(Vec2 p) const {
+  GasValues fields{}, out{};
+  gas_.concentrations(p, fields);
+  for (std::size_t i = 0; i < gas_map_.size() && i < out.size(); ++i) {
+    const auto& m = gas_map_[i];
+    double v = m.background + (m.field >= 0 ? fields[static_cast<std::size_t>(m.field)] : 0.0);
+    for (const auto& [f, factor] : m.cross) v += factor * fields[static_cast<std::size_t>(f)];
+    out[i] = v;
+  }
+  return out;
+}
+
+double Simulation::trueConcentration(int channel, Vec2 p) const {
+  if (channel < 0 || static_cast<std::size_t>(channel) >= std::min(gas_map_.size(), GasValues{}.size()))
+    return std::numeric_limits<double>::quiet_NaN();
+  return trueGas(p)[static_cast<std::size_t>(channel)];
+}
+
+void Simulation::reportGasStart() {
+  if (gas_reported_) return;
+  gas_reported_ = true;
+  if (!observer_) return;
+  if (!gas_cfg_.channels.empty()) {
+    std::string d;
+    for (const auto& c : gas_cfg_.channels) d += (d.empty() ? "" : " ") + c.name + "=" + c.unit;
+    observer_->onEvent(timeS(), "gas_channels", d);
+  }
+  for (const auto& s : world_.gas.sources) {
+    char detail[256];
+    std::snprintf(detail, sizeof detail, "name=%s gas=%s x=%.3f y=%.3f rate=%g start_s=%s end_s=%s", s.name.c_str(),
+                  s.gas.c_str(), s.position.x_m, s.position.y_m, s.rate, fmtSeconds(s.start_s).c_str(),
+                  fmtSeconds(s.end_s).c_str());
+    observer_->onEvent(timeS(), "gas_source", detail);
+  }
+}
+
+void Simulation::sampleGas(McuInputs& in) {
+  const std::size_t n = std::min(gas_map_.size(), GasValues{}.size());
+  if (n == 0) return;
+  const auto& faults = gas_sensors_.faults();
+  for (std::size_t i = 0; i < faults.size(); ++i) {
+    const bool on = timeS() >= faults[i].start_s && timeS() < faults[i].end_s;
+    if (on == gas_fault_on_[i]) continue;
+    gas_fault_on_[i] = on;
+    if (observer_) {
+      const auto& f = world_.gas.faults[i];
+      observer_->onEvent(timeS(), on ? "gas_fault_start" : "gas_fault_end",
+                         "channel=" + f.channel + (f.kind == GasFaultKind::Stuck ? " kind=stuck" : " kind=dropout"));
+    }
+  }
+  const Vec2 inlet = gasInlet();
+  const GasValues truth = trueGas(inlet);
+  const double dt_s =
+      last_gas_sample_ms_ < 0 ? 0.0 : static_cast<double>(static_cast<int64_t>(t_ms_) - last_gas_sample_ms_) / 1000.0;
+  last_gas_sample_ms_ = static_cast<int64_t>(t_ms_);
+  in.gas_raw = gas_sensors_.sample(timeS(), dt_s, {truth.data(), n});
+  if (observer_ && t_ms_ % kGasLogPeriod_ms == 0) {
+    GasValues reading{};
+    for (std::size_t i = 0; i < n; ++i) reading[i] = gas_sensors_.reading(i);
+    observer_->onGas({timeS(), inlet.x_m, inlet.y_m, {truth.data(), n}, {reading.data(), n}});
+  }
 }
 
 behavior::Agent Simulation::robotBody() const {
@@ -40,6 +166,7 @@ void Simulation::emitFrame() {
   in.truth = state_;
   in.ultrasonic_mm = ultrasonic_.measureAllMm(world_, state_.pose, crowd_.circles());
   in.grayscale = GrayscaleModel::read(world_, state_.pose);
+  sampleGas(in);
   const auto frame = mcu_.sendSensorFrame(t_ms_, in, tx_);
   if (observer_) observer_->onSample({timeS(), state_.pose, state_.wheel, mcu_.setpoints(), frame.faults});
   if (t_ms_ % kPedestrianPeriod_ms == 0) emitPedestrians();
@@ -81,6 +208,8 @@ void Simulation::checkPersonContacts() {
 void Simulation::step() {
   mcu_.tick(t_ms_);
   crowd_.reportInitial();
+  reportGasStart();
+  if (t_ms_ % kGasPeriod_ms == 0) gas_.advanceTo(timeS());  // fields at t for this step's frame
   if (t_ms_ % kFramePeriod_ms == 0) emitFrame();
   const double dt_s = static_cast<double>(kStep_ms) / 1000.0;
   // Both from the state at t: the people react to where the robot is now.

@@ -1,12 +1,15 @@
 #pragma once
-// The whole simulated robot and world in sim time: plant, sensors, MCU and
-// pedestrians, stepped at 1 kHz with a sensor frame every 10 ms. No I/O and no
-// clocks: bytes go in through receive(), frames come out of takeTx().
+// The whole simulated robot and world in sim time: plant, sensors, MCU,
+// pedestrians and gas, stepped at 1 kHz with a sensor frame every 10 ms. No I/O
+// and no clocks: bytes go in through receive(), frames come out of takeTx().
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "shared/config/robot_config.hpp"
+#include "sim/gas_model.hpp"
+#include "sim/gas_sensor.hpp"
 #include "sim/grayscale_model.hpp"
 #include "sim/mcu_emulator.hpp"
 #include "sim/pedestrian_crowd.hpp"
@@ -26,8 +29,13 @@ class Simulation {
   static constexpr uint64_t kPedestrianPeriod_ms = 100;
   /// Contact ends (and a new collision may be logged) once clearance exceeds body radius + this.
   static constexpr double kContactRelease_m = 0.005;
+  /// The gas fields advance every 50 ms of sim time.
+  static constexpr uint64_t kGasPeriod_ms = 50;
+  /// Gas ground truth (SimObserver::onGas, G rows) every 100 ms of sim time.
+  static constexpr uint64_t kGasLogPeriod_ms = 100;
 
-  /// Throws config::ConfigError when the start pose overlaps an obstacle.
+  /// Throws config::ConfigError when the start pose overlaps an obstacle, or a
+  /// leak or scripted gas fault names a gas that is not a channel of robot.gas.
   Simulation(const config::RobotConfig& robot, World world, uint64_t seed, SimObserver* observer = nullptr);
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -60,10 +68,31 @@ class Simulation {
   /// The robot's body as the pedestrians see it (true pose and velocity).
   behavior::Agent robotBody() const;
 
+  /// The gas concentration fields (as of the last 50 ms update).
+  const GasModel& gas() const { return gas_; }
+  /// The simulated gas sensors (responses, last readings).
+  const GasSensors& gasSensors() const { return gas_sensors_; }
+  /// World position of the gas sampling inlet at the current pose.
+  Vec2 gasInlet() const;
+  /// What gas channel `channel` (slot of robot.gas) would truly read at p now,
+  /// before the sensor's response: background + its gas + cross factor x each
+  /// other gas. NaN for a channel that is not configured.
+  double trueConcentration(int channel, Vec2 p) const;
+
  private:
+  using GasValues = std::array<double, serial::kGasChannels>;
+  // A channel's true value in terms of the gas fields.
+  struct GasChannelMap {
+    double background = 0.0;
+    int field = -1;                            // its own gas, or -1 when nothing leaks it
+    std::vector<std::pair<int, double>> cross;  // (field, factor) of the other gases that leak
+  };
   void emitFrame();
   void emitPedestrians();
   void checkPersonContacts();
+  void reportGasStart();
+  void sampleGas(McuInputs& in);
+  GasValues trueGas(Vec2 p) const;
 
   World world_;
   RobotPlant plant_;
@@ -84,6 +113,14 @@ class Simulation {
   bool people_wait_ = false;
   bool people_started_ = false;
   double people_t0_s_ = 0.0;
+  // Gas: fields, sensors, how channels read the fields.
+  config::GasConfig gas_cfg_;
+  GasModel gas_;
+  GasSensors gas_sensors_;
+  std::vector<GasChannelMap> gas_map_;
+  std::vector<bool> gas_fault_on_;  // per scripted fault: active at the last frame
+  bool gas_reported_ = false;
+  int64_t last_gas_sample_ms_ = -1;
 };
 
 }  // namespace inspect::sim

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -16,6 +17,8 @@ TruthLog::TruthLog(const std::string& path) : file_(std::fopen(path.c_str(), "w"
   comment("C,mono_ns,sim_t_s,seq,left_mrad_s,right_mrad_s,flags");
   comment("E,mono_ns,sim_t_s,event,detail");
   comment("P,mono_ns,sim_t_s,id,x_m,y_m,vx_m_s,vy_m_s,robot_dist_m");
+  comment("G,mono_ns,sim_t_s,inlet_x_m,inlet_y_m,true0,...,trueN-1,read0,...,readN-1 (N gas channels in slot order, "
+          "see the gas_channels event; read NaN = no data)");
 }
 
 TruthLog::~TruthLog() {
@@ -68,6 +71,25 @@ void TruthLog::onPedestrian(const PedestrianSample& s) {
                               static_cast<long long>(monoNowNs()), s.sim_t_s, id_len, s.id.data(), s.x_m, s.y_m,
                               s.vx_m_s, s.vy_m_s, s.robot_distance_m);
   line(buf, n);
+}
+
+void TruthLog::onGas(const GasSample& s) {
+  char buf[64];
+  std::string row = "G," + std::to_string(monoNowNs());
+  std::snprintf(buf, sizeof buf, ",%.3f,%.4f,%.4f", s.sim_t_s, s.inlet_x_m, s.inlet_y_m);
+  row += buf;
+  for (const auto values : {s.true_value, s.reading}) {
+    for (double v : values) {
+      if (std::isnan(v)) {
+        row += ",NaN";
+      } else {
+        std::snprintf(buf, sizeof buf, ",%.4f", v);
+        row += buf;
+      }
+    }
+  }
+  row += '\n';
+  line(row.data(), static_cast<int>(row.size()));
 }
 
 void TruthLog::comment(std::string_view text) {

@@ -1,7 +1,8 @@
 #pragma once
 // Ground-truth CSV log (--truth FILE): T (state per frame), C (accepted wheel
-// commands), E (events), P (pedestrians, 10 Hz) lines, '#' comments; every line flushed at once
-// because tests read the file while the simulator runs. Format: docs/simulator.md.
+// commands), E (events), P (pedestrians, 10 Hz), G (gas at the inlet, 10 Hz) lines,
+// '#' comments; every line flushed at once because tests read the file while the
+// simulator runs. Format: docs/simulator.md.
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -22,6 +23,7 @@ class TruthLog : public SimObserver {
   void onCommand(double sim_t_s, uint8_t seq, const serial::WheelCommand& cmd) override;
   void onEvent(double sim_t_s, std::string_view event, std::string_view detail) override;
   void onPedestrian(const PedestrianSample& s) override;
+  void onGas(const GasSample& s) override;
   /// Writes "# <text>".
   void comment(std::string_view text);
 

@@ -1,5 +1,6 @@
 #include "sim/world.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -129,6 +130,18 @@ std::vector<behavior::WallSegment> solidEdges(const World& w) {
   return out;
 }
 
+std::optional<Bounds> solidBounds(const World& w) {
+  std::optional<Bounds> b;
+  forEachSolidEdge(w, [&](const Segment& s) {
+    for (const Vec2 p : {s.a, s.b}) {
+      if (!b) b = Bounds{p, p};
+      b->lo = {std::min(b->lo.x_m, p.x_m), std::min(b->lo.y_m, p.y_m)};
+      b->hi = {std::max(b->hi.x_m, p.x_m), std::max(b->hi.y_m, p.y_m)};
+    }
+  });
+  return b;
+}
+
 bool onFloorLine(const World& w, Vec2 p) {
   for (const auto& l : w.floor_lines)
     if (geom::pointSegmentDistance(p, l.centre) <= l.width_m / 2.0) return true;
@@ -163,6 +176,7 @@ World loadWorld(const ConfigNode& root) {
   // After walls and obstacles: routes are checked against them.
   w.pedestrians = readPedestrianScripts(root, w);
   w.social_force = behavior::readSocialForceParams(root.optChild("social_force"));
+  w.gas = readGasSpec(root, w);
   return w;
 }
 

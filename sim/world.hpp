@@ -1,6 +1,6 @@
 #pragma once
 // The simulated world: walls, closed obstacles, floor lines, the robot's start
-// pose and scripted pedestrians, loaded from a YAML world file
+// pose, scripted pedestrians and gas leaks, loaded from a YAML world file
 // (docs/world-format.md).
 #include <optional>
 #include <string>
@@ -9,6 +9,7 @@
 #include "shared/behavior/social_force.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/control/diff_drive.hpp"
+#include "sim/gas_spec.hpp"
 #include "sim/geometry.hpp"
 #include "sim/pedestrian_script.hpp"
 
@@ -26,8 +27,7 @@ struct Obstacle {
   Polygon polygon;
 };
 
-/// Everything in a world file. Later issues add gas sources as further
-/// members filled by loadWorld().
+/// Everything in a world file.
 struct World {
   std::string name;
   std::string description;
@@ -38,6 +38,13 @@ struct World {
   std::vector<FloorLine> floor_lines;
   std::vector<PedestrianScript> pedestrians;  // moved by the social force model
   behavior::SocialForceParams social_force;   // the `social_force` section (defaults when absent)
+  GasSpec gas;                                // the `gas` section: leaks, dispersion, sensor faults
+};
+
+/// An axis-aligned box, lo <= hi.
+struct Bounds {
+  Vec2 lo;
+  Vec2 hi;
 };
 
 /// Distance from p to the nearest wall or obstacle edge; 0 when p is inside
@@ -49,6 +56,8 @@ std::optional<double> castRay(const World& w, Vec2 origin, double yaw_rad, doubl
 /// Every wall and obstacle edge, as the social force model sees them (corners
 /// where edges meet marked as joined).
 std::vector<behavior::WallSegment> solidEdges(const World& w);
+/// Bounding box of every wall and obstacle; nullopt when there is nothing solid.
+std::optional<Bounds> solidBounds(const World& w);
 /// True when p lies on a floor line (within half its width of the centre line).
 bool onFloorLine(const World& w, Vec2 p);
 

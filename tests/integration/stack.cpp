@@ -41,6 +41,18 @@ Truth readTruth(const std::string& path) {
       } else if (line[0] == 'P' && f.size() >= 9) {
         t.people.push_back({std::stod(f[2]), f[3], std::stod(f[4]), std::stod(f[5]), std::stod(f[6]), std::stod(f[7]),
                             std::stod(f[8])});
+      } else if (line[0] == 'G' && f.size() >= 7 && (f.size() - 5) % 2 == 0) {
+        TruthGas g;
+        g.mono_ns = std::stoll(f[1]);
+        g.t = std::stod(f[2]);
+        g.x = std::stod(f[3]);
+        g.y = std::stod(f[4]);
+        const std::size_t n = (f.size() - 5) / 2;
+        for (std::size_t i = 0; i < n; ++i) {
+          g.truth.push_back(std::stod(f[5 + i]));
+          g.reading.push_back(std::stod(f[5 + n + i]));
+        }
+        t.gas.push_back(std::move(g));
       } else if (line[0] == 'E' && f.size() >= 4) {
         t.events.push_back({std::stoll(f[1]), std::stod(f[2]), f[3], f.size() > 4 ? f[4] : ""});
       }

@@ -34,8 +34,15 @@ struct TruthPerson {
   std::string id;
   double x = 0, y = 0, vx = 0, vy = 0, robot_dist = 0;
 };
+/// One `G` row: gas at the sensor inlet (10 Hz of sim time), per channel the true value and the reading.
+struct TruthGas {
+  int64_t mono_ns = 0;
+  double t = 0, x = 0, y = 0;
+  std::vector<double> truth, reading;
+};
 struct Truth {
   std::vector<TruthRow> rows;
+  std::vector<TruthGas> gas;
   std::vector<TruthPerson> people;
   std::vector<TruthCommand> commands;
   std::vector<TruthEvent> events;
