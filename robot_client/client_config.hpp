@@ -20,6 +20,10 @@ struct SafetyParams {
   // time allowed to move (time scaled by the Eq 9 factor, so waiting for
   // people does not count) is given up: Ack FAILED, IDLE.
   double nav_stall_s = 120.0;
+  // Reaction to a gas HIGH (A2) alarm while on a route (goto/route/inspect):
+  // "continue", "stop" (stop and hold; `resume` goes on, `stop` ends the
+  // route) or "retreat" (back along the route's points to its start).
+  std::string gas_reaction = "stop";
 };
 
 /// Camera stream (docs/video.md); becomes video::SenderSettings.

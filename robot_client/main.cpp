@@ -41,6 +41,8 @@ options:
                        moved into the odometry frame (origin = the world's start
                        pose), people tracking treats as static (overrides
                        map: in the client config)
+  --gas-reaction R     reaction to a gas HIGH alarm on a route: continue, stop
+                       (hold until resume) or retreat (overrides safety.gas_reaction)
   --cmd-log FILE       write every wheel command sent to the MCU (CSV; for tests)
   --video-source URI   camera stream source (overrides video.source): synthetic,
                        v4l2:/dev/videoN or file:PATH
@@ -70,7 +72,7 @@ int main(int argc, char** argv) {
   std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
   std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
   std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
-  std::string serial_dev, server, id, cmd_log, map_path, video_source, video_port;
+  std::string serial_dev, server, id, cmd_log, map_path, video_source, video_port, gas_reaction;
   bool no_video = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -108,6 +110,10 @@ int main(int argc, char** argv) {
       video_port = value();
     } else if (a == "--no-video") {
       no_video = true;
+    } else if (a == "--gas-reaction") {
+      gas_reaction = value();
+      if (gas_reaction != "continue" && gas_reaction != "stop" && gas_reaction != "retreat")
+        usageError("--gas-reaction '" + gas_reaction + "' must be continue, stop or retreat");
     } else {
       usageError("unknown option '" + a + "'");
     }
@@ -120,6 +126,7 @@ int main(int argc, char** argv) {
     if (!robot_path.empty()) robot = config::loadRobotConfigFile(robot_path);
     if (!serial_dev.empty()) cfg.serial_device = serial_dev;
     if (!map_path.empty()) cfg.map_file = map_path;
+    if (!gas_reaction.empty()) cfg.safety.gas_reaction = gas_reaction;
     if (!id.empty()) {
       if (!client::validRobotId(id)) usageError("--id '" + id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
       cfg.robot_id = id;

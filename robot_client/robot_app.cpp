@@ -72,6 +72,8 @@ RobotApp::~RobotApp() {
 double RobotApp::now() const { return static_cast<double>(monoNowNs() - t0_ns_) * 1e-9; }
 
 void RobotApp::start() {
+  link_.setGasChannels(core_.gasChannels(), core_.gasMonitor().config().inlet_x_m,
+                       core_.gasMonitor().config().inlet_y_m);
   serial_.start([this](const serial::Message& m, uint8_t) { onSerialMessage(m); },
                 [this](bool open, const std::string&) {
                   core_.onSerialState(open, now());
@@ -157,11 +159,15 @@ v1::Ack RobotApp::onVideoCommand(const v1::Command& cmd) {
 }
 
 v1::Ack RobotApp::onPtzCommand(const v1::Command& cmd) {
-  const auto& p = cmd.ptz();
+  if (const std::string why = applyPtz(cmd.ptz()); !why.empty()) return ack(cmd.id(), v1::Ack::REJECTED, why);
+  return ack(cmd.id(), v1::Ack::ACCEPTED);
+}
+
+std::string RobotApp::applyPtz(const v1::Ptz& p) {
   if (!std::isfinite(p.pan_rad()) || !std::isfinite(p.tilt_rad()) || std::abs(p.pan_rad()) > M_PI ||
       std::abs(p.tilt_rad()) > M_PI / 2)
-    return ack(cmd.id(), v1::Ack::REJECTED, "ptz: pan must be within [-pi, pi] and tilt within [-pi/2, pi/2] rad");
-  if (!serial_.isOpen()) return ack(cmd.id(), v1::Ack::REJECTED, "ptz: the MCU's serial line is down");
+    return "ptz: pan must be within [-pi, pi] and tilt within [-pi/2, pi/2] rad";
+  if (!serial_.isOpen()) return "ptz: the MCU's serial line is down";
   serial::PtzCommand c;
   if (p.home()) {
     c.flags = 0x01;
@@ -173,7 +179,7 @@ v1::Ack RobotApp::onPtzCommand(const v1::Command& cmd) {
     ptz_tilt_rad_ = p.tilt_rad();
   }
   serial_.send(c);
-  return ack(cmd.id(), v1::Ack::ACCEPTED);
+  return "";
 }
 
 void RobotApp::fillVideoStatus(v1::Telemetry& t) const {
@@ -211,12 +217,16 @@ void RobotApp::flushEvents() {
     *env.mutable_ack() = a;
     link_.send(env);
   }
+  for (const auto& p : core_.takePtz()) {
+    if (const std::string why = applyPtz(p); !why.empty()) log::warn("core", "inspection point camera preset: ", why);
+  }
   for (auto& e : core_.takeEvents()) {
     log::info("core", v1::Event::Kind_Name(e.kind), ": ", e.text);
     v1::Envelope env;
     auto* ev = env.mutable_event();
     ev->set_kind(e.kind);
     ev->set_text(e.text);
+    if (e.gas_alarm) *ev->mutable_gas_alarm() = *e.gas_alarm;
     ev->set_robot_time_us(static_cast<uint64_t>(now() * 1e6));
     link_.send(env);
   }

@@ -39,6 +39,8 @@ class RobotApp {
   void mcuHeartbeat();
   v1::Ack onVideoCommand(const v1::Command& cmd);
   v1::Ack onPtzCommand(const v1::Command& cmd);
+  /// Sends a camera set-point to the MCU; "" or why not.
+  std::string applyPtz(const v1::Ptz& p);
   void fillVideoStatus(v1::Telemetry& t) const;
 
   boost::asio::io_context& io_;

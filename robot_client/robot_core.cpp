@@ -58,9 +58,124 @@ double slew(double cur, double target, double step) {
 
 RobotCore::RobotCore(const config::RobotConfig& robot, const SafetyParams& safety,
                      const config::ControlConfig& control, std::shared_ptr<control::FuzzyGainScheduler> scheduler)
-    : robot_(robot), safety_(safety), control_(control), scheduler_(std::move(scheduler)) {
+    : robot_(robot), safety_(safety), control_(control), scheduler_(std::move(scheduler)), gas_(robot.gas) {
   config::applyRobot(control_, robot_);
   events_.reserve(16);
+  gas_out_.reserve(16);
+}
+
+std::vector<v1::GasChannelInfo> RobotCore::gasChannels() const {
+  std::vector<v1::GasChannelInfo> out;
+  for (const auto& c : gas_.config().channels) {
+    v1::GasChannelInfo i;
+    i.set_name(c.name);
+    i.set_gas(c.gas);
+    i.set_unit(c.unit);
+    i.set_sensor(c.sensor);
+    i.set_alarm_low(c.alarm_low);
+    i.set_alarm_high(c.alarm_high);
+    i.set_falling(c.direction == config::AlarmDirection::Falling);
+    i.set_t90_s(c.t90_s);
+    i.set_range_min(c.range_min);
+    i.set_range_max(c.range_max);
+    i.set_background(c.background);
+    out.push_back(std::move(i));
+  }
+  return out;
+}
+
+std::vector<v1::Ptz> RobotCore::takePtz() {
+  std::vector<v1::Ptz> out;
+  out.swap(ptz_out_);
+  return out;
+}
+
+void RobotCore::onGasTransitions(double now_s) {
+  for (const auto& t : gas_out_) {
+    const auto& ch = gas_.config().channels[static_cast<std::size_t>(t.channel)];
+    v1::GasAlarm a;
+    a.set_id(t.id);
+    a.set_channel(static_cast<uint32_t>(t.channel));
+    a.set_channel_name(ch.name);
+    a.set_level(t.level == gas::AlarmLevel::Low    ? v1::GasAlarm::LOW
+                : t.level == gas::AlarmLevel::High ? v1::GasAlarm::HIGH
+                                                   : v1::GasAlarm::SENSOR_FAULT);
+    a.set_active(t.active);
+    a.set_value(t.value);
+    a.set_threshold(t.threshold);
+    a.set_unit(ch.unit);
+    a.mutable_pose()->set_x_m(pose_.x_m);
+    a.mutable_pose()->set_y_m(pose_.y_m);
+    a.mutable_pose()->set_theta_rad(pose_.theta_rad);
+    // The monitor's times are on the gas clock; the message's on the robot's.
+    a.set_since_us(static_cast<uint64_t>(std::max(0.0, now_s - (t.t_s - t.since_s)) * 1e6));
+    a.set_robot_time_us(static_cast<uint64_t>(now_s * 1e6));
+    a.set_fault(t.fault);
+    a.set_peak(t.peak);
+    char text[200];
+    if (t.level == gas::AlarmLevel::SensorFault)
+      std::snprintf(text, sizeof text, "gas sensor %s fault %s: %s at (%.2f, %.2f)", ch.name.c_str(),
+                    t.active ? "raised" : "cleared", t.fault, pose_.x_m, pose_.y_m);
+    else
+      std::snprintf(text, sizeof text, "gas %s %s alarm %s: %.2f %s (threshold %.2f%s) at (%.2f, %.2f)",
+                    ch.name.c_str(), gas::levelName(t.level), t.active ? "raised" : "cleared", t.value,
+                    ch.unit.c_str(), t.threshold, t.active ? "" : (", peak " + fmt2(t.peak)).c_str(), pose_.x_m,
+                    pose_.y_m);
+    events_.push_back({t.active ? v1::Event::ALARM_RAISED : v1::Event::ALARM_CLEARED, text, std::move(a)});
+
+    // The reaction to a HIGH alarm on a route (docs/gas.md).
+    if (t.level != gas::AlarmLevel::High || !t.active || mode_ != v1::NAVIGATING || !navigator_) continue;
+    const std::string why = ch.name + " HIGH alarm";
+    if (safety_.gas_reaction == "continue") {
+      events_.push_back({v1::Event::INFO, why + ": route continues (gas_reaction: continue)"});
+    } else if (safety_.gas_reaction == "stop") {
+      if (!gas_hold_ && !retreating_) {
+        gas_hold_ = true;
+        events_.push_back({v1::Event::INFO, why + ": stopped and holding (gas_reaction: stop); resume continues "
+                                                  "the route, stop ends it"});
+      }
+    } else if (!retreating_) {
+      startRetreat(why);
+    }
+  }
+  gas_out_.clear();
+}
+
+void RobotCore::startRetreat(const std::string& why) {
+  // Back through the goals already reached, newest first, to the route's start.
+  std::vector<navigation::Vec2> back;
+  for (std::size_t i = std::min(goal_index_, goals_.size()); i-- > 0;) back.push_back(goals_[i]);
+  back.push_back(route_start_);
+  goals_ = back;
+  goal_info_.assign(goals_.size(), GoalInfo{});
+  goal_index_ = 0;
+  dwell_left_s_ = 0.0;
+  gas_hold_ = false;
+  retreating_ = true;
+  retreat_reason_ = why;
+  navigator_->setGoal(goals_.front());
+  nav_best_m_ = std::numeric_limits<double>::infinity();
+  events_.push_back({v1::Event::INFO, why + ": retreating along the route to its start " +
+                                          fmtPoint(route_start_.x, route_start_.y) + " (gas_reaction: retreat)"});
+}
+
+void RobotCore::arriveAt(std::size_t i) {
+  if (i >= goal_info_.size()) return;
+  const auto& g = goal_info_[i];
+  if (g.has_ptz) ptz_out_.push_back(g.ptz);
+  if (g.dwell_s > 0.0) {
+    dwell_left_s_ = g.dwell_s;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "inspection point %zu/%zu%s%s%s: dwelling %.1f s", i + 1, goals_.size(),
+                  g.label.empty() ? "" : " '", g.label.c_str(), g.label.empty() ? "" : "'", g.dwell_s);
+    std::string text = buf;
+    if (g.has_ptz) {
+      std::snprintf(buf, sizeof buf, ", camera pan %.0f deg tilt %.0f deg", g.ptz.pan_rad() * 180.0 / M_PI,
+                    g.ptz.tilt_rad() * 180.0 / M_PI);
+      text += g.ptz.home() ? ", camera home" : buf;
+    }
+    events_.push_back({v1::Event::INFO, text});
+  }
 }
 
 v1::Ack RobotCore::startTrack(const v1::Command& cmd) {
@@ -124,9 +239,16 @@ v1::Ack RobotCore::startGoTo(const v1::Command& cmd) {
   if (g.points_size() == 0) return reject("no goal given");
   if (g.points_size() > kMaxGoals)
     return reject(std::to_string(g.points_size()) + " goals: at most " + std::to_string(kMaxGoals) + " per command");
-  for (int i = 0; i < g.points_size(); ++i)
-    if (!std::isfinite(g.points(i).x_m()) || !std::isfinite(g.points(i).y_m()))
+  for (int i = 0; i < g.points_size(); ++i) {
+    const auto& p = g.points(i);
+    if (!std::isfinite(p.x_m()) || !std::isfinite(p.y_m()))
       return reject("goal " + std::to_string(i + 1) + " has a non-finite coordinate");
+    if (!std::isfinite(p.dwell_s()) || p.dwell_s() < 0.0 || p.dwell_s() > 3600.0)
+      return reject("goal " + std::to_string(i + 1) + ": dwell_s must be within [0, 3600] s");
+    if (p.has_ptz() && (!std::isfinite(p.ptz().pan_rad()) || !std::isfinite(p.ptz().tilt_rad()) ||
+                        std::abs(p.ptz().pan_rad()) > M_PI || std::abs(p.ptz().tilt_rad()) > M_PI / 2))
+      return reject("goal " + std::to_string(i + 1) + ": camera pan must be within [-pi, pi], tilt [-pi/2, pi/2]");
+  }
   const double speed = g.speed_m_s();
   if (!std::isfinite(speed) || speed < 0.0) return reject("speed must be a number >= 0 m/s (0 = default)");
   if (speed > robot_.limits.max_v_m_s)
@@ -145,7 +267,17 @@ v1::Ack RobotCore::startGoTo(const v1::Command& cmd) {
   endAutonomy();
   navigator_ = std::move(nav);
   goals_.clear();
-  for (const auto& p : g.points()) goals_.push_back({p.x_m(), p.y_m()});
+  goal_info_.clear();
+  for (const auto& p : g.points()) {
+    goals_.push_back({p.x_m(), p.y_m()});
+    goal_info_.push_back({p.dwell_s(), p.has_ptz(), p.ptz(), p.label()});
+  }
+  route_name_ = g.name();
+  route_inspection_ = g.inspection();
+  route_start_ = {pose_.x_m, pose_.y_m};
+  dwell_left_s_ = 0.0;
+  gas_hold_ = retreating_ = false;
+  retreat_reason_.clear();
   goal_index_ = 0;
   nav_command_id_ = cmd.id();
   nav_switches_done_ = 0;
@@ -157,7 +289,7 @@ v1::Ack RobotCore::startGoTo(const v1::Command& cmd) {
   setpoint_ = {};
   setpoint_time_s_ = -1.0;
   const std::string what =
-      (g.name().empty() ? "" : "route '" + g.name() + "': ") +
+      (g.name().empty() ? "" : std::string(g.inspection() ? "inspection" : "route") + " '" + g.name() + "': ") +
       (goals_.size() == 1 ? "to " + fmtPoint(goals_[0].x, goals_[0].y)
                           : std::to_string(goals_.size()) + " goals") +
       " at " + fmt2(params.v_max_m_s) + " m/s";
@@ -173,10 +305,19 @@ void RobotCore::endAutonomy() {
   navigator_.reset();
   nav_command_id_ = 0;
   nav_twist_ = {};
+  dwell_left_s_ = 0.0;
+  gas_hold_ = retreating_ = false;
 }
 
 control::Twist RobotCore::navigationTwist(double dt_s) {
   if (dt_s <= 0.0) return nav_twist_;  // a command-time refresh: no tick
+  if (gas_hold_ || dwell_left_s_ > 0.0) {
+    // Standing still: holding after a gas alarm, or dwelling at an inspection
+    // point (the dwell runs down; the stall clock does not run).
+    if (!gas_hold_) dwell_left_s_ = std::max(0.0, dwell_left_s_ - dt_s);
+    nav_twist_ = {};
+    return nav_twist_;
+  }
   // People are not obstacles to steer round: their echoes get the Eq 9 factor
   // (below) instead, so a worker crossing the robot's way makes it wait, not
   // detour round them along the nearest wall. Anything closer than the
@@ -213,11 +354,30 @@ control::Twist RobotCore::navigationTwist(double dt_s) {
     events_.push_back({v1::Event::INFO, "goal " + std::to_string(goal_index_ + 1) + "/" +
                                             std::to_string(goals_.size()) + " " + fmtPoint(g.x, g.y) +
                                             " reached at " + fmtPoint(pose_.x_m, pose_.y_m)});
+    if (!retreating_) arriveAt(goal_index_);
     if (++goal_index_ < goals_.size()) {
       nav_switches_done_ += out.switch_count;
       navigator_->setGoal(goals_[goal_index_]);  // the obstacle memory is kept
       nav_best_m_ = std::numeric_limits<double>::infinity();
+      if (dwell_left_s_ > 0.0) {
+        nav_twist_ = {};
+        return nav_twist_;
+      }
+    } else if (dwell_left_s_ > 0.0) {
+      // The last point has a dwell: stay on it (goal_index_ = goal count), then complete.
+      --goal_index_;
+      goal_info_[goal_index_].dwell_s = 0.0;
+      goal_info_[goal_index_].has_ptz = false;
+      nav_twist_ = {};
+      return nav_twist_;
     } else {
+      if (retreating_) {
+        acks_.push_back(ackOf(nav_command_id_, v1::Ack::FAILED, "retreated to the route's start after " +
+                                                                    retreat_reason_));
+        endAutonomy();
+        setMode(v1::IDLE, "retreat completed");
+        return {};
+      }
       acks_.push_back(ackOf(nav_command_id_, v1::Ack::COMPLETED));
       endAutonomy();
       setMode(v1::IDLE, "route completed");
@@ -344,6 +504,10 @@ v1::Ack RobotCore::onCommand(const v1::Command& cmd, double now_s) {
       ack.set_status(v1::Ack::ACCEPTED);
       return ack;
     case v1::Command::kResume:
+      if (mode_ == v1::NAVIGATING && gas_hold_) {
+        gas_hold_ = false;
+        events_.push_back({v1::Event::INFO, "gas hold released by operator: route continues"});
+      }
       if (mode_ == v1::ESTOP || mode_ == v1::FAILSAFE) {
         if (faults_ & v1::FAULT_SENSOR_STALE) return reject("sensor frames still stale");
         if (faults_ & v1::FAULT_SERIAL_DOWN) return reject("serial device still down");
@@ -472,6 +636,11 @@ serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, doub
   }
   last_mcu_ms_ = f.mcu_time_ms;
   last_frame_ = f;
+  // Gas alarms run on the MCU's clock (like the people tracker), so that
+  // durations mean the same when the simulator runs faster than real time.
+  gas_clock_s_ += std::clamp(dt_s, 0.0, 0.1);
+  gas_.update(f.gas_raw, gas_clock_s_, gas_out_);
+  if (!gas_out_.empty()) onGasTransitions(now_s);
   measured_ = {f.wheel_speed_mrad_s[0] * 1e-3, f.wheel_speed_mrad_s[1] * 1e-3};
   clear(v1::FAULT_SENSOR_STALE, "");
   constexpr uint16_t kSerious = serial::kFaultMotorDriver | serial::kFaultEStopButton;
@@ -494,7 +663,11 @@ serial::WheelCommand RobotCore::commandNow() { return computeCommand(0.0); }
 
 std::optional<serial::WheelCommand> RobotCore::onTimer(double now_s) {
   checkTimeouts(now_s);
-  if (faults_ & v1::FAULT_SENSOR_STALE) return computeCommand(0.01);
+  if (faults_ & v1::FAULT_SENSOR_STALE) {
+    gas_.noFrames(gas_clock_s_ + (now_s - last_frame_s_), gas_out_);  // no frames, no gas readings
+    if (!gas_out_.empty()) onGasTransitions(now_s);
+    return computeCommand(0.01);
+  }
   return std::nullopt;
 }
 
@@ -517,7 +690,28 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
   for (uint16_t mm : last_frame_.ultrasonic_mm) t.add_ultrasonic_m(mm == serial::kNoEcho ? -1.0 : mm * 1e-3);
   t.set_grayscale(last_frame_.grayscale);
   t.clear_gas();
-  for (uint16_t g : last_frame_.gas_raw) t.add_gas(g * 0.01);
+  for (int i = 0; i < gas_.channels(); ++i) t.add_gas(gas_.value(i));  // NaN = no data
+  t.clear_active_alarms();
+  if (gas_.channels() > 0) {
+    std::vector<gas::AlarmTransition> act;
+    gas_.active(act);
+    for (const auto& a : act) {
+      auto* x = t.add_active_alarms();
+      x->set_id(a.id);
+      x->set_channel(static_cast<uint32_t>(a.channel));
+      x->set_channel_name(gas_.config().channels[static_cast<std::size_t>(a.channel)].name);
+      x->set_level(a.level == gas::AlarmLevel::Low    ? v1::GasAlarm::LOW
+                   : a.level == gas::AlarmLevel::High ? v1::GasAlarm::HIGH
+                                                      : v1::GasAlarm::SENSOR_FAULT);
+      x->set_active(true);
+      x->set_value(a.value);
+      x->set_threshold(a.threshold);
+      x->set_unit(gas_.config().channels[static_cast<std::size_t>(a.channel)].unit);
+      x->set_since_us(static_cast<uint64_t>(std::max(0.0, now_s - (gas_clock_s_ - a.since_s)) * 1e6));
+      x->set_fault(a.fault);
+      x->set_peak(a.peak);
+    }
+  }
   t.set_battery_v(last_frame_.battery_mv * 1e-3);
   t.set_mode(mode_);
   t.set_faults(faults_);
@@ -550,7 +744,14 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
   t.set_ki(track_gains_.ki);
   t.set_kd(track_gains_.kd);
   t.set_track_controller(tracker_ ? track_controller_ : std::string());
-  t.set_nav_mode(mode_ == v1::NAVIGATING && navigator_ ? navigation::toString(navigator_->output().mode) : "");
+  const bool nav = mode_ == v1::NAVIGATING && navigator_;
+  t.set_nav_mode(!nav              ? ""
+                 : gas_hold_       ? "GAS_HOLD"
+                 : dwell_left_s_ > 0 ? "DWELL"
+                 : retreating_     ? "RETREAT"
+                                   : navigation::toString(navigator_->output().mode));
+  t.set_dwell_remaining_s(nav ? dwell_left_s_ : 0.0);
+  t.set_waypoint_label(nav && goal_index_ < goal_info_.size() ? goal_info_[goal_index_].label : "");
   t.set_goal_distance_m(goal_distance_m_);
   t.set_goal_index(static_cast<uint32_t>(goal_index_));
   t.set_goal_count(static_cast<uint32_t>(goals_.size()));

@@ -17,6 +17,7 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/control/trajectory_tracker.hpp"
 #include "shared/control/diff_drive.hpp"
+#include "shared/gas/alarm_monitor.hpp"
 #include "shared/navigation/navigator.hpp"
 #include "shared/serial/frame_codec.hpp"
 
@@ -26,6 +27,7 @@ namespace inspect::client {
 struct CoreEvent {
   v1::Event::Kind kind = v1::Event::INFO;
   std::string text;
+  std::optional<v1::GasAlarm> gas_alarm;  // ALARM_RAISED / ALARM_CLEARED
 };
 
 class RobotCore {
@@ -66,6 +68,11 @@ class RobotCore {
   std::vector<CoreEvent> takeEvents();
   /// Moves out Acks the core produced on its own (COMPLETED of a track run or a route).
   std::vector<v1::Ack> takeAcks();
+  /// Moves out camera set-points of inspection points reached since the last call.
+  std::vector<v1::Ptz> takePtz();
+  /// The gas channels as announced in Hello.
+  std::vector<v1::GasChannelInfo> gasChannels() const;
+  const gas::AlarmMonitor& gasMonitor() const { return gas_; }
 
   v1::Mode mode() const { return mode_; }
   uint32_t faults() const { return faults_; }
@@ -93,6 +100,12 @@ class RobotCore {
   void raise(uint32_t fault, const std::string& why);
   void clear(uint32_t fault, const std::string& why);
   void latchFailsafe(const std::string& why);
+  /// Announces gas alarm transitions and applies the configured reaction.
+  void onGasTransitions(double now_s);
+  /// The navigation goal `i` was reached: dwell, PTZ preset.
+  void arriveAt(std::size_t i);
+  /// Turns the route round: back through the goals already reached to the start.
+  void startRetreat(const std::string& why);
   void checkTimeouts(double now_s);
   serial::WheelCommand computeCommand(double dt_s);
   /// Tracking: 1 when nothing is close ahead, down to 0 at safety.obstacle_stop_m (front sonars).
@@ -159,6 +172,26 @@ class RobotCore {
   double nav_best_m_ = std::numeric_limits<double>::infinity();  // closest to the current goal so far
   double nav_best_clock_s_ = 0.0;
   control::Twist nav_twist_;          // the last tick's navigation twist (after Eq 9)
+  struct GoalInfo {
+    double dwell_s = 0.0;
+    bool has_ptz = false;
+    v1::Ptz ptz;
+    std::string label;
+  };
+  std::vector<GoalInfo> goal_info_;   // per goal of goals_
+  std::string route_name_;
+  bool route_inspection_ = false;
+  navigation::Vec2 route_start_;      // where the route began (retreat target)
+  double dwell_left_s_ = 0.0;         // > 0: dwelling at the goal just reached
+  bool gas_hold_ = false;             // stopped and holding after a gas HIGH alarm
+  bool retreating_ = false;           // going back after a gas HIGH alarm
+  std::string retreat_reason_;
+  std::vector<v1::Ptz> ptz_out_;
+
+  // Gas alarms.
+  gas::AlarmMonitor gas_;
+  double gas_clock_s_ = 0.0;  // MCU time since the first frame (the alarm monitor's clock)
+  std::vector<gas::AlarmTransition> gas_out_;
 
   // Human awareness.
   std::unique_ptr<behavior::HumanAwareness> awareness_;

@@ -75,6 +75,10 @@ void ServerLink::onConnected() {
   h->add_capabilities("teleop");
   h->add_capabilities("video");
   h->add_capabilities("ptz");
+  if (!gas_channels_.empty()) h->add_capabilities("gas");
+  for (const auto& g : gas_channels_) *h->add_gas_channels() = g;
+  h->set_gas_inlet_x_m(gas_inlet_x_m_);
+  h->set_gas_inlet_y_m(gas_inlet_y_m_);
   h->set_software_version(INSPECT_VERSION);
   send(hello);
   const uint64_t gen = generation_;

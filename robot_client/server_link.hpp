@@ -27,6 +27,12 @@ class ServerLink {
   ServerLink(boost::asio::io_context& io, const ClientConfig& cfg);
 
   void start(Handlers h);
+  /// Gas channels announced in every Hello (set before start()).
+  void setGasChannels(std::vector<v1::GasChannelInfo> channels, double inlet_x_m, double inlet_y_m) {
+    gas_channels_ = std::move(channels);
+    gas_inlet_x_m_ = inlet_x_m;
+    gas_inlet_y_m_ = inlet_y_m;
+  }
   void stop();
 
   /// Queues an envelope (seq and send time are filled in). Dropped when the
@@ -48,6 +54,8 @@ class ServerLink {
 
   boost::asio::io_context& io_;
   ClientConfig cfg_;
+  std::vector<v1::GasChannelInfo> gas_channels_;
+  double gas_inlet_x_m_ = 0.0, gas_inlet_y_m_ = 0.0;
   Handlers h_;
   boost::asio::ip::tcp::resolver resolver_;
   boost::asio::ip::tcp::socket socket_;

@@ -55,6 +55,12 @@ v1::Command bare(uint64_t id, v1::Command::KindCase kind) {
 // An ideal differential-drive robot at 100 Hz: the wheels turn at the
 // commanded speed (0 when the drive is disabled), the frame reports wheel
 // travel and the integrated heading.
+config::RobotConfig withGas(bool on) {
+  config::RobotConfig r;
+  if (on) r.gas = config::defaultGasConfig();
+  return r;
+}
+
 struct KinematicRobot {
   config::RobotConfig robot;
   client::SafetyParams safety;
@@ -67,7 +73,11 @@ struct KinematicRobot {
   std::vector<v1::Ack> acks;
   std::vector<client::CoreEvent> events;
 
-  explicit KinematicRobot(const client::SafetyParams& s = {}) : safety(s) {
+  std::array<double, 4> gas{0.0, 0.0, 0.0, 20.9};  // values in the default channels' units
+  int frames = 0;
+
+  explicit KinematicRobot(const client::SafetyParams& s = {}, bool with_gas = false)
+      : robot(withGas(with_gas)), safety(s) {
     f.ultrasonic_mm = {serial::kNoEcho, serial::kNoEcho, serial::kNoEcho, serial::kNoEcho};
     core.onSerialState(true, 0.0);
     core.onLinkUp(0.0);
@@ -91,6 +101,12 @@ struct KinematicRobot {
     f.wheel_speed_mrad_s = {static_cast<int16_t>(enable * last.left_mrad_s),
                             static_cast<int16_t>(enable * last.right_mrad_s)};
     f.heading_0p1mrad = static_cast<int16_t>(std::lround(theta * 1e4));
+    // Gas readings with a count of wobble (a live sensor never reads the same for long).
+    for (std::size_t i = 0; i < robot.gas.channels.size(); ++i)
+      f.gas_raw[i] = std::isnan(gas[i]) ? config::kGasNoData
+                                        : static_cast<uint16_t>(std::lround(gas[i] / robot.gas.channels[i].scale) +
+                                                                (frames % 2));
+    ++frames;
     last = core.onSensorFrame(f, t);
     for (auto& a : core.takeAcks()) acks.push_back(a);
     for (auto& e : core.takeEvents()) events.push_back(e);
@@ -420,4 +436,194 @@ TEST(RobotCoreNavigation, AGoalWithoutProgressIsGivenUpWithFailed) {
   EXPECT_GE(r.t, 3.0);
   EXPECT_LT(r.t, 6.0);
   EXPECT_EQ(r.countEvents("not reached"), 1);
+}
+
+// ---- Gas: alarms on the robot, the reaction to a HIGH alarm, inspection points ----
+
+namespace {
+
+int countKind(const std::vector<client::CoreEvent>& ev, v1::Event::Kind k, v1::GasAlarm::Level level) {
+  int n = 0;
+  for (const auto& e : ev) n += e.kind == k && e.gas_alarm && e.gas_alarm->level() == level;
+  return n;
+}
+
+client::SafetyParams reaction(const std::string& r) {
+  client::SafetyParams s;
+  s.gas_reaction = r;
+  return s;
+}
+
+}  // namespace
+
+TEST(RobotCoreGas, AlarmsGoOutAsEventsWithPoseAndAreListedInTelemetry) {
+  KinematicRobot r({}, true);
+  r.run(1.0);
+  EXPECT_TRUE(r.events.empty());
+  auto tl = r.telemetry();
+  ASSERT_EQ(tl.gas_size(), 4);
+  EXPECT_NEAR(tl.gas(0), 0.0, 0.011);
+  EXPECT_NEAR(tl.gas(3), 20.9, 0.011);
+  EXPECT_EQ(tl.active_alarms_size(), 0);
+  r.gas[1] = 12.0;  // H2S above A1 5 and A2 10 ppm
+  r.run(3.0);
+  ASSERT_EQ(countKind(r.events, v1::Event::ALARM_RAISED, v1::GasAlarm::LOW), 1);
+  ASSERT_EQ(countKind(r.events, v1::Event::ALARM_RAISED, v1::GasAlarm::HIGH), 1);
+  for (const auto& e : r.events) {
+    if (!e.gas_alarm) continue;
+    EXPECT_EQ(e.gas_alarm->channel_name(), "H2S");
+    EXPECT_EQ(e.gas_alarm->unit(), "ppm");
+    EXPECT_TRUE(e.gas_alarm->active());
+    EXPECT_TRUE(e.gas_alarm->has_pose());
+    EXPECT_NE(e.text.find("H2S"), std::string::npos) << e.text;
+  }
+  tl = r.telemetry();
+  EXPECT_EQ(tl.active_alarms_size(), 2);
+  r.gas[1] = 0.0;
+  r.run(4.0);
+  EXPECT_EQ(countKind(r.events, v1::Event::ALARM_CLEARED, v1::GasAlarm::HIGH), 1);
+  EXPECT_EQ(countKind(r.events, v1::Event::ALARM_CLEARED, v1::GasAlarm::LOW), 1);
+  EXPECT_EQ(r.telemetry().active_alarms_size(), 0);
+  // The channels as announced in Hello.
+  const auto ch = r.core.gasChannels();
+  ASSERT_EQ(ch.size(), 4u);
+  EXPECT_EQ(ch[3].name(), "O2");
+  EXPECT_TRUE(ch[3].falling());
+}
+
+TEST(RobotCoreGas, NoDataReadsAsNaNAndRaisesASensorFault) {
+  KinematicRobot r({}, true);
+  r.run(0.5);
+  r.gas[2] = std::numeric_limits<double>::quiet_NaN();  // CO sends 0xFFFF
+  r.run(0.3);
+  EXPECT_EQ(countKind(r.events, v1::Event::ALARM_RAISED, v1::GasAlarm::SENSOR_FAULT), 0) << "0.5 s grace";
+  r.run(0.3);
+  auto tl = r.telemetry();
+  ASSERT_EQ(countKind(r.events, v1::Event::ALARM_RAISED, v1::GasAlarm::SENSOR_FAULT), 1);
+  for (const auto& e : r.events)
+    if (e.gas_alarm) EXPECT_EQ(e.gas_alarm->fault(), "no_data");
+  EXPECT_TRUE(std::isnan(tl.gas(2)));
+}
+
+TEST(RobotCoreGas, HighAlarmOnARouteStopsAndHoldsUntilResume) {
+  KinematicRobot r(reaction("stop"), true);
+  r.run(0.05);
+  ASSERT_EQ(r.core.onCommand(goTo(1, {{6.0, 0.0}}, 0.5), r.t).status(), v1::Ack::ACCEPTED);
+  r.run(3.0);
+  r.gas[0] = 30.0;  // CH4 above A2 20 %LEL
+  r.run(4.0);
+  EXPECT_EQ(r.countEvents("stopped and holding"), 1);
+  const double x_hold = r.x;
+  r.run(5.0);
+  EXPECT_NEAR(r.x, x_hold, 0.01) << "holding";
+  auto tl = r.telemetry();
+  EXPECT_EQ(tl.mode(), v1::NAVIGATING);
+  EXPECT_EQ(tl.nav_mode(), "GAS_HOLD");
+  EXPECT_TRUE(r.acks.empty());
+  r.gas[0] = 0.0;
+  r.run(3.0);
+  EXPECT_NEAR(r.x, x_hold, 0.01) << "the alarm clearing does not restart the robot";
+  ASSERT_EQ(r.core.onCommand(bare(2, v1::Command::kResume), r.t).status(), v1::Ack::ACCEPTED);
+  ASSERT_TRUE(r.runUntilAck(30.0));
+  EXPECT_EQ(r.acks.back().status(), v1::Ack::COMPLETED);
+  EXPECT_LT(r.distanceTo(6.0, 0.0), 0.15);
+}
+
+TEST(RobotCoreGas, HighAlarmWithContinueKeepsGoing) {
+  KinematicRobot r(reaction("continue"), true);
+  r.run(0.05);
+  ASSERT_EQ(r.core.onCommand(goTo(1, {{4.0, 0.0}}, 0.5), r.t).status(), v1::Ack::ACCEPTED);
+  r.run(2.0);
+  r.gas[0] = 30.0;
+  ASSERT_TRUE(r.runUntilAck(30.0));
+  EXPECT_EQ(r.acks.back().status(), v1::Ack::COMPLETED);
+  EXPECT_EQ(r.countEvents("route continues"), 1);
+}
+
+TEST(RobotCoreGas, HighAlarmWithRetreatGoesBackAlongTheRoute) {
+  KinematicRobot r(reaction("retreat"), true);
+  r.run(0.05);
+  ASSERT_EQ(r.core.onCommand(goTo(1, {{3.0, 0.0}, {3.0, 2.0}, {0.0, 2.0}}, 0.5), r.t).status(),
+            v1::Ack::ACCEPTED);
+  // Past the first point and on the way to the second.
+  for (int k = 0; k < 4000 && r.telemetry().goal_index() < 1; ++k) r.step();
+  r.run(1.0);
+  ASSERT_EQ(r.telemetry().goal_index(), 1u);
+  r.gas[0] = 30.0;
+  r.run(3.0);
+  EXPECT_EQ(r.countEvents("retreating along the route"), 1);
+  EXPECT_EQ(r.telemetry().nav_mode(), "RETREAT");
+  double closest_first = 1e9;
+  for (int k = 0; k < 6000 && r.acks.empty(); ++k) {
+    r.step();
+    closest_first = std::min(closest_first, r.distanceTo(3.0, 0.0));
+  }
+  ASSERT_EQ(r.acks.size(), 1u);
+  EXPECT_EQ(r.acks[0].status(), v1::Ack::FAILED);
+  EXPECT_NE(r.acks[0].reason().find("retreated to the route's start after CH4 HIGH alarm"), std::string::npos)
+      << r.acks[0].reason();
+  EXPECT_LT(closest_first, 0.15) << "back through the point already reached";
+  EXPECT_LT(r.distanceTo(0.0, 0.0), 0.15);
+  EXPECT_EQ(r.core.mode(), v1::IDLE);
+}
+
+TEST(RobotCoreGas, InspectionPointsDwellAndPointTheCamera) {
+  KinematicRobot plain;
+  plain.run(0.05);
+  ASSERT_EQ(plain.core.onCommand(goTo(1, {{2.0, 0.0}, {2.0, 1.5}}, 0.5), plain.t).status(), v1::Ack::ACCEPTED);
+  ASSERT_TRUE(plain.runUntilAck(40.0));
+  const double t_plain = plain.t;
+
+  KinematicRobot r;
+  r.run(0.05);
+  auto cmd = goTo(1, {{2.0, 0.0}, {2.0, 1.5}}, 0.5, "tour");
+  cmd.mutable_go_to()->set_inspection(true);
+  auto* p0 = cmd.mutable_go_to()->mutable_points(0);
+  p0->set_dwell_s(4.0);
+  p0->set_label("valve_A");
+  p0->mutable_ptz()->set_pan_rad(M_PI / 2);
+  p0->mutable_ptz()->set_tilt_rad(-0.2);
+  auto* p1 = cmd.mutable_go_to()->mutable_points(1);
+  p1->set_dwell_s(2.0);
+  ASSERT_EQ(r.core.onCommand(cmd, r.t).status(), v1::Ack::ACCEPTED);
+  EXPECT_EQ(r.telemetry().waypoint_label(), "valve_A");
+  bool saw_dwell = false;
+  double max_dwell_left = 0.0;
+  std::vector<v1::Ptz> ptz;
+  for (int k = 0; k < 6000 && r.acks.empty(); ++k) {
+    r.step();
+    for (auto& x : r.core.takePtz()) ptz.push_back(x);
+    const auto tl = r.telemetry();
+    if (tl.nav_mode() == "DWELL") {
+      saw_dwell = true;
+      max_dwell_left = std::max(max_dwell_left, tl.dwell_remaining_s());
+      EXPECT_LE(std::hypot(tl.cmd_v_m_s(), 0.0), 0.3);
+    }
+  }
+  ASSERT_EQ(r.acks.size(), 1u);
+  EXPECT_EQ(r.acks[0].status(), v1::Ack::COMPLETED);
+  EXPECT_TRUE(saw_dwell);
+  EXPECT_NEAR(max_dwell_left, 4.0, 0.05);
+  ASSERT_EQ(ptz.size(), 1u);
+  EXPECT_NEAR(ptz[0].pan_rad(), M_PI / 2, 1e-9);
+  EXPECT_EQ(r.countEvents("inspection point 1/2 'valve_A': dwelling 4.0 s, camera pan 90 deg tilt -11 deg"), 1);
+  EXPECT_EQ(r.countEvents("inspection point 2/2: dwelling 2.0 s"), 1);
+  // Both dwells add to the time of the same route without them.
+  EXPECT_NEAR(r.t - t_plain, 6.0, 0.6);
+  EXPECT_LT(r.distanceTo(2.0, 1.5), 0.15);
+}
+
+TEST(RobotCoreGas, BadInspectionPointsAreRejected) {
+  KinematicRobot r;
+  r.run(0.05);
+  auto cmd = goTo(1, {{2.0, 0.0}});
+  cmd.mutable_go_to()->mutable_points(0)->set_dwell_s(-1.0);
+  auto ack = r.core.onCommand(cmd, r.t);
+  EXPECT_EQ(ack.status(), v1::Ack::REJECTED);
+  EXPECT_NE(ack.reason().find("dwell_s"), std::string::npos);
+  cmd = goTo(2, {{2.0, 0.0}});
+  cmd.mutable_go_to()->mutable_points(0)->mutable_ptz()->set_tilt_rad(3.0);
+  ack = r.core.onCommand(cmd, r.t);
+  EXPECT_EQ(ack.status(), v1::Ack::REJECTED);
+  EXPECT_NE(ack.reason().find("tilt"), std::string::npos);
 }
