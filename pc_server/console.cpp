@@ -107,6 +107,29 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  last point ('robot1: route completed'); goal_index counts the points reached.\n"
        "  example: route config/routes/warehouse_tour.yaml\n",
        &Console::cmdRoute},
+      {"inspect", "inspect <route> [speed_m_s]", "run a gas inspection route as a recorded run",
+       "  <route> is a file or a name in config/routes/ (config/routes/<name>.yaml). The route's\n"
+       "  points may carry dwell_s (the robot stops there), a camera preset (ptz: {pan_deg,\n"
+       "  tilt_deg} or {home: true}) and a label; `map` names the site's world file, which the\n"
+       "  run's report draws the concentration maps on. The robot navigates with the behaviour\n"
+       "  strategy (people get right of way, Eq 9) and reacts to a gas HIGH alarm as configured\n"
+       "  (client.yaml safety.gas_reaction: continue, stop = hold until resume, retreat). The run\n"
+       "  is recorded (named 'inspection <name>') and ends with the route. Then: report <run-id>.\n"
+       "  example: inspect gas_lab_inspection\n",
+       &Console::cmdInspect},
+      {"alarms", "alarms [all]", "gas alarms and gas sensor faults: active and unacknowledged ones, or all",
+       "  One line per alarm: #number, robot, gas, level (LOW = A1, HIGH = A2, SENSOR_FAULT with\n"
+       "  stuck, out_of_range or no_data), the reading and threshold, the worst reading, where the\n"
+       "  robot was, how long ago it was raised, whether it is still active and acknowledged.\n"
+       "  The robot raises and clears alarms (thresholds with hysteresis, minimum duration); the\n"
+       "  operator acknowledges them with ack. Raised alarms print at once, in red with a bell on a\n"
+       "  terminal, and the status line shows '| ALARM ...' while they are active.\n",
+       &Console::cmdAlarms},
+      {"ack", "ack <number>|all", "acknowledge a gas alarm (alarms lists the numbers)",
+       "  Acknowledging does not clear an alarm (the robot does, when the gas is gone); it records\n"
+       "  that the operator has seen it (catalog and run).\n"
+       "  example: ack 3\n",
+       &Console::cmdAck},
       {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
        "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
        "  'robot1: no ack within 1 s' (the last two are errors).\n",
@@ -171,7 +194,8 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "    tracking: pos_err ang_err max_pos_err max_ang_err progress ref_x ref_y kp ki kd\n"
        "    people: pattern (0 none, 1 crossing, 2 encountering, 3 leading, 4 confronting) person_m\n"
        "      speed_factor people\n"
-       "    navigation: nav_mode goal_dist goal_index goal_count nav_switches\n"
+       "    navigation: nav_mode goal_dist goal_index goal_count nav_switches dwell\n"
+       "    gas: gas0 gas1 gas2 gas3 (channel values) alarms alarms_high (active on the robot)\n"
        "  and: robots (number of connected robots).\n"
        "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING; nav_mode takes NONE,\n"
        "  GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL; integer fields take 0x.. too.\n"
@@ -261,8 +285,13 @@ std::string Console::background() {
       s += "selected " + first + " (the first robot to connect)\n";
     }
   }
-  for (const auto& e : registry_.takeEvents())
-    s += "[" + e.robot_id + "] " + v1::Event::Kind_Name(e.event.kind()) + ": " + e.event.text() + "\n";
+  for (const auto& e : registry_.takeEvents()) {
+    const std::string line = "[" + e.robot_id + "] " + v1::Event::Kind_Name(e.event.kind()) + ": " + e.event.text();
+    if (e.event.kind() == v1::Event::ALARM_RAISED && alarm_style_)
+      s += "\a\x1b[1;31m" + line + "\x1b[0m\n";  // red, with the terminal bell
+    else
+      s += line + "\n";
+  }
   for (auto it = runs_.begin(); it != runs_.end();) {
     const auto a = registry_.ack(it->robot_id, it->command_id);
     if (a && a->status() == v1::Ack::COMPLETED) {
@@ -649,7 +678,7 @@ bool Console::cmdRoute(const Args& args, const std::string&, int) {
   }
   v1::Command c;
   *c.mutable_go_to() = goToOf(r);
-  out_ << "route '" << r.name << "': " << r.waypoints_m.size() / 2 << " points"
+  out_ << "route '" << r.name << "': " << r.points.size() << " points"
        << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string()) << "\n";
   return sendAndReport("route", std::move(c), true);
 }

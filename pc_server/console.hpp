@@ -55,6 +55,8 @@ class Console {
   void pump();
   /// Called while the console waits (e.g. to refresh the status line).
   void setIdleHook(std::function<void()> hook) { idle_hook_ = std::move(hook); }
+  /// Interactive terminals: alarm lines in red with the terminal bell.
+  void setAlarmStyle(bool on) { alarm_style_ = on; }
   /// Enables `teleop` (only an interactive terminal has one).
   void setTeleopHandler(TeleopHandler handler) { teleop_handler_ = std::move(handler); }
 
@@ -110,6 +112,9 @@ class Console {
   bool cmdReport(const Args& args, const std::string& rest, int line_no);
   bool cmdExport(const Args& args, const std::string& rest, int line_no);
   bool cmdReplay(const Args& args, const std::string& rest, int line_no);
+  bool cmdInspect(const Args& args, const std::string& rest, int line_no);
+  bool cmdAlarms(const Args& args, const std::string& rest, int line_no);
+  bool cmdAck(const Args& args, const std::string& rest, int line_no);
   /// A run of the catalog and its directory; prints why not (as `cmd`) when there is none.
   std::optional<std::pair<catalog::RunDetail, std::string>> findRun(const std::string& cmd, const std::string& id);
   bool cmdWait(const Args& args, const std::string& rest, int line_no);
@@ -140,6 +145,7 @@ class Console {
   TeleopHandler teleop_handler_;
   VideoHub* video_ = nullptr;
   Recorder* recorder_ = nullptr;
+  bool alarm_style_ = false;
   std::string selected_;
   bool quit_ = false;
   Tally tally_;

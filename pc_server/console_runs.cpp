@@ -10,6 +10,7 @@
 #include "pc_server/text_util.hpp"
 #include "shared/record/csv_export.hpp"
 #include "shared/record/mcap_reader.hpp"
+#include "sim/world.hpp"
 
 namespace inspect::server {
 
@@ -21,6 +22,8 @@ constexpr const char* kNoRecorder = "the server records nothing (recording.enabl
 struct RunLog {
   std::vector<v1::Telemetry> telemetry;
   std::vector<std::pair<double, std::string>> events;  // s from the first telemetry, text
+  std::vector<std::pair<double, v1::GasAlarm>> gas_alarms;  // same clock as events
+  std::optional<v1::Hello> hello;                            // /robot_info
   std::vector<uint64_t> telemetry_log_ns;
   bool truncated = false;
 };
@@ -46,7 +49,11 @@ RunLog readRunLog(const std::string& mcap_path) {
                              ? 0.0
                              : (static_cast<double>(m.log_time_ns) - static_cast<double>(log.telemetry_log_ns[0])) * 1e-9;
         log.events.emplace_back(t, (m.topic == "/event" ? "" : "server: ") + e.text());
+        if (e.has_gas_alarm()) log.gas_alarms.emplace_back(t, e.gas_alarm());
       }
+    } else if (m.topic == "/robot_info" && !log.hello) {
+      v1::Hello h;
+      if (h.ParseFromArray(m.data.data(), static_cast<int>(m.data.size()))) log.hello = std::move(h);
     }
     return true;
   });
@@ -87,11 +94,49 @@ bool Console::cmdReport(const Args& args, const std::string&, int) {
     in.ended_utc = d.info.end ? catalog::formatIsoUtc(*d.info.end) : "";
     in.telemetry = log.telemetry;
     in.events = log.events;
-    for (const auto& f : d.files) in.files.push_back(f.path);
+    in.gas_alarms = log.gas_alarms;
+    if (log.hello) {
+      in.gas_channels.assign(log.hello->gas_channels().begin(), log.hello->gas_channels().end());
+      in.gas_inlet_x_m = log.hello->gas_inlet_x_m();
+      in.gas_inlet_y_m = log.hello->gas_inlet_y_m();
+    }
+    for (const auto& f : d.files) {
+      in.files.push_back(f.path);
+      if (f.kind != "map" || in.have_map) continue;
+      // The site map of an inspection route: walls and obstacle edges in the world frame.
+      try {
+        const auto w = sim::loadWorldFile(f.path);
+        for (const auto& s : w.walls) in.walls.push_back({s.a.x_m, s.a.y_m, s.b.x_m, s.b.y_m});
+        for (const auto& o : w.obstacles)
+          for (std::size_t i = 0; i < o.polygon.vertices.size(); ++i) {
+            const auto& a = o.polygon.vertices[i];
+            const auto& b = o.polygon.vertices[(i + 1) % o.polygon.vertices.size()];
+            in.walls.push_back({a.x_m, a.y_m, b.x_m, b.y_m});
+          }
+        in.have_map = true;
+        in.start_x_m = w.start.x_m;
+        in.start_y_m = w.start.y_m;
+        in.start_theta_rad = w.start.theta_rad;
+        in.map_name = w.name;
+      } catch (const std::exception& e) {
+        out_ << "report: map " << f.path << " not drawn: " << e.what() << "\n";
+      }
+    }
     const auto r = writeRunReport(in, dir + "/report");
     out_ << d.info.id << ": report " << r.summary_path << " (" << r.pngs.size() << " plots, "
          << log.telemetry.size() << " telemetry messages" << (log.truncated ? ", MCAP cut short" : "") << ")\n";
     for (const auto& p : r.pngs) out_ << "  " << p << "\n";
+    for (const auto& l : r.leaks) {
+      out_ << "  " << l.channel << ": max " << fmtShort(l.max_value, 2) << " " << l.unit << ", mean "
+           << fmtShort(l.mean_value, 2) << " " << l.unit << ", map peak (" << fmtFixed(l.peak_x_m) << ", "
+           << fmtFixed(l.peak_y_m) << ")";
+      if (l.found)
+        out_ << ", leak source estimate (" << fmtFixed(l.x_m) << ", " << fmtFixed(l.y_m) << ") +- "
+             << fmtFixed(l.radius95_m) << " m (95 %)";
+      else
+        out_ << ", no leak source estimate" << (l.note.empty() ? std::string() : ": " + l.note);
+      out_ << (in.have_map ? " [world frame]" : " [odometry frame]") << "\n";
+    }
     return true;
   } catch (const std::exception& e) {
     return fail("report", d.info.id + ": " + e.what());

@@ -1,5 +1,7 @@
 #include "pc_server/expect_check.hpp"
 
+#include <limits>
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -22,7 +24,18 @@ struct FieldDef {
 };
 
 // Telemetry.nav_mode is a string; expect compares its index here ("" = NONE).
-constexpr std::array<const char*, 6> kNavModes = {"NONE", "GO_TO_GOAL", "AVOID", "FOLLOW_CW", "FOLLOW_CCW", "AT_GOAL"};
+constexpr std::array<const char*, 9> kNavModes = {"NONE",       "GO_TO_GOAL", "AVOID", "FOLLOW_CW", "FOLLOW_CCW",
+                                                  "AT_GOAL",    "DWELL",      "GAS_HOLD", "RETREAT"};
+
+double gasValue(const RobotSnapshot& s, int i) {
+  return i < s.telemetry.gas_size() ? s.telemetry.gas(i) : std::numeric_limits<double>::quiet_NaN();
+}
+
+double alarmCount(const RobotSnapshot& s, bool high_only) {
+  int n = 0;
+  for (const auto& a : s.telemetry.active_alarms()) n += !high_only || a.level() == v1::GasAlarm::HIGH;
+  return n;
+}
 
 double navModeNumber(const std::string& name) {
   if (name.empty()) return 0.0;
@@ -81,6 +94,13 @@ const std::vector<FieldDef>& fieldDefs() {
       {"goal_index", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.goal_index()); }},
       {"goal_count", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.goal_count()); }},
       {"nav_switches", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.nav_switches()); }},
+      {"dwell", false, true, true, [](const S& s) { return s.telemetry.dwell_remaining_s(); }},
+      {"alarms", true, true, true, [](const S& s) { return alarmCount(s, false); }},
+      {"alarms_high", true, true, true, [](const S& s) { return alarmCount(s, true); }},
+      {"gas0", false, true, true, [](const S& s) { return gasValue(s, 0); }},
+      {"gas1", false, true, true, [](const S& s) { return gasValue(s, 1); }},
+      {"gas2", false, true, true, [](const S& s) { return gasValue(s, 2); }},
+      {"gas3", false, true, true, [](const S& s) { return gasValue(s, 3); }},
       {"robots", true, false, false, nullptr},
   };
   return kDefs;
@@ -152,7 +172,7 @@ std::variant<ExpectSpec, std::string> parseExpect(const std::vector<std::string>
   } else {
     return "expect: '" + args[2] + "' is not a number" +
            (s.field == "mode" ? " or a mode (IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING)"
-            : s.field == "nav_mode" ? " or a navigation mode (NONE, GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL)"
+            : s.field == "nav_mode" ? " or a navigation mode (NONE, GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL, DWELL, GAS_HOLD, RETREAT)"
                                     : "");
   }
   std::size_t i = 3;

@@ -52,6 +52,7 @@ void InteractiveConsole::run() {
   if (tty) {
     console_.setTeleopHandler([this](KeyboardTeleop::Mode m, const std::string& r) { return teleop(m, r); });
     term_.enableStatusLine();
+    console_.setAlarmStyle(true);
   }
   console_.setIdleHook([this] { refreshStatus(false); });
   std::cout << "pc_server console: 'help' lists the commands, 'quit' leaves\n" << kPrompt;

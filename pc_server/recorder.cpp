@@ -48,7 +48,7 @@ std::string gainsJson(const v1::Telemetry& t) {
 struct Recorder::Run {
   catalog::RunInfo info;
   record::McapWriter mcap;
-  uint16_t ch_telemetry = 0, ch_command = 0, ch_ack = 0, ch_event = 0, ch_server = 0, ch_camera = 0;
+  uint16_t ch_telemetry = 0, ch_command = 0, ch_ack = 0, ch_event = 0, ch_server = 0, ch_camera = 0, ch_info = 0;
   std::unique_ptr<video::Mp4Writer> mp4;
   std::string mp4_error;
   RunStats stats;
@@ -110,6 +110,40 @@ void Recorder::setGainsSource(std::function<std::string(const std::string&)> f) 
   gains_source_ = std::move(f);
 }
 
+void Recorder::setHelloSource(std::function<std::optional<v1::Hello>(const std::string&)> f) {
+  std::lock_guard lk(mu_);
+  hello_source_ = std::move(f);
+}
+
+void Recorder::setRunMap(const std::string& robot, const std::string& map_path) {
+  std::lock_guard lk(mu_);
+  if (auto it = runs_.find(robot); it != runs_.end()) {
+    catalog_->addFile(it->second->info.id, "map", map_path, fileBytes(map_path));
+    return;
+  }
+  pending_map_[robot] = map_path;
+}
+
+namespace {
+const char* alarmLevelName(v1::GasAlarm::Level l) {
+  switch (l) {
+    case v1::GasAlarm::LOW: return "LOW";
+    case v1::GasAlarm::HIGH: return "HIGH";
+    case v1::GasAlarm::SENSOR_FAULT: return "SENSOR_FAULT";
+    default: return "?";
+  }
+}
+}  // namespace
+
+void Recorder::noteAlarmAck(const std::string& robot, const v1::GasAlarm& a, const std::string& text) {
+  std::lock_guard lk(mu_);
+  auto it = runs_.find(robot);
+  const std::string run_id = it == runs_.end() ? "" : it->second->info.id;
+  if (it != runs_.end()) noteLocked(*it->second, robot, text);
+  catalog_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), alarmLevelName(a.level()),
+                     "acked", a.value(), a.pose().x_m(), a.pose().y_m());
+}
+
 void Recorder::setVideoFigures(std::function<std::optional<VideoFigures>(const std::string&)> f) {
   std::lock_guard lk(mu_);
   video_figures_ = std::move(f);
@@ -155,6 +189,7 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
     run->ch_event = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/event");
     run->ch_server = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/server_event");
     run->ch_camera = run->mcap.addProtobufChannel(foxglove::CompressedVideo::descriptor(), "/camera");
+    run->ch_info = run->mcap.addProtobufChannel(v1::Hello::descriptor(), "/robot_info");
     video::Mp4Settings ms;
     ms.max_fragment_s = config_.max_fragment_s;
     run->mp4 = std::make_unique<video::Mp4Writer>(run->info.dir + "/video.mp4", ms);
@@ -167,6 +202,18 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
   const std::string id = run->info.id;
   noteLocked(*run, robot, "run " + id + " started" + (name.empty() ? "" : " (" + name + ")"));
   catalog_->addFile(id, "mcap", run->info.dir + "/run.mcap", 0);
+  if (auto pm = pending_map_.find(robot); pm != pending_map_.end()) {
+    catalog_->addFile(id, "map", pm->second, fileBytes(pm->second));
+    pending_map_.erase(pm);
+  }
+  // The robot as it announced itself (gas channels and units), for reports and tools.
+  if (hello_source_) {
+    if (const auto h = hello_source_(robot)) {
+      const uint64_t now = wallNowNs();
+      run->mcap.write(run->ch_info, now, now, *h);
+      hello_[robot] = *h;
+    }
+  }
   runs_[robot] = std::move(run);
   log::info(kTag, robot, ": recording run ", id);
   return id;
@@ -201,7 +248,12 @@ std::string Recorder::stopLocked(const std::string& robot, const std::string& ou
       s.video_packets_lost = v->packets_lost;
     }
   }
-  for (const auto& g : fig.gas) s.gas.push_back({"gas" + std::to_string(g.channel), "", g.max, g.mean});
+  const auto hello = hello_.find(robot);
+  for (const auto& g : fig.gas) {
+    const bool named = hello != hello_.end() && g.channel < hello->second.gas_channels_size();
+    s.gas.push_back({named ? hello->second.gas_channels(static_cast<int>(g.channel)).name() : "gas" + std::to_string(g.channel),
+                     named ? hello->second.gas_channels(static_cast<int>(g.channel)).unit() : "", g.max, g.mean});
+  }
   catalog_->setSummary(r.info.id, s);
   catalog_->addFile(r.info.id, "mcap", r.info.dir + "/run.mcap", fileBytes(r.info.dir + "/run.mcap"));
   if (r.mp4)
@@ -230,7 +282,9 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
     const auto& c = env.command();
     std::string name;
     if (c.has_track()) name = "track";
-    if (c.has_go_to()) name = c.go_to().name().empty() ? "goto" : "route " + c.go_to().name();
+    if (c.has_go_to())
+      name = c.go_to().name().empty() ? "goto"
+                                      : (c.go_to().inspection() ? "inspection " : "route ") + c.go_to().name();
     if (!name.empty()) {
       try {
         startLocked(robot, name, c.has_go_to() ? c.go_to().name() : "", c.id());
@@ -238,6 +292,17 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
       } catch (const std::exception& e) {
         log::error(kTag, robot, ": cannot start a run: ", e.what());
       }
+    }
+  }
+  // Gas alarms go into the catalog during runs and outside them.
+  if (inbound && env.has_event() && env.event().has_gas_alarm()) {
+    const auto& a = env.event().gas_alarm();
+    try {
+      catalog_->addAlarm(it == runs_.end() ? "" : it->second->info.id, robot, std::chrono::system_clock::now(),
+                         a.channel_name(), alarmLevelName(a.level()), a.active() ? "raised" : "cleared", a.value(),
+                         a.pose().x_m(), a.pose().y_m());
+    } catch (const std::exception& e) {
+      log::error(kTag, robot, ": alarm not in the catalog: ", e.what());
     }
   }
   if (it == runs_.end()) return;

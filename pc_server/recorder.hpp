@@ -61,6 +61,15 @@ class Recorder {
   void setGainsSource(std::function<std::string(const std::string& robot)> f);
   /// Where run summaries get the robot's video figures.
   void setVideoFigures(std::function<std::optional<VideoFigures>(const std::string& robot)> f);
+  /// Where a run gets the robot's Hello (gas channel names and units), written
+  /// to the run's /robot_info channel at its start.
+  void setHelloSource(std::function<std::optional<v1::Hello>(const std::string& robot)> f);
+  /// The site map (world file) of the robot's current run, or of its next one
+  /// when none is running (`inspect` with a route that names a map); listed
+  /// as the run's "map" file, which reports draw.
+  void setRunMap(const std::string& robot, const std::string& map_path);
+  /// The operator acknowledged a gas alarm: /server_event and the catalog's alarms.
+  void noteAlarmAck(const std::string& robot, const v1::GasAlarm& alarm, const std::string& text);
 
   catalog::Catalog& catalog() { return *catalog_; }
   const RecordingConfig& config() const { return config_; }
@@ -80,6 +89,9 @@ class Recorder {
   std::string startup_report_;
   std::function<std::optional<VideoFigures>(const std::string&)> video_figures_;
   std::function<std::string(const std::string&)> gains_source_;
+  std::function<std::optional<v1::Hello>(const std::string&)> hello_source_;
+  std::map<std::string, std::string> pending_map_;  // robot -> map for its next run
+  std::map<std::string, v1::Hello> hello_;          // robot -> Hello at its run's start
   mutable std::mutex mu_;
   std::map<std::string, std::unique_ptr<Run>> runs_;  // robot -> its run
 };

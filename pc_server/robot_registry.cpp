@@ -23,6 +23,7 @@ void RobotRegistry::onConnected(const std::string& id, const std::string& addres
   e.state_change_ns = now_ns;
   e.close_reason.clear();
   e.rx_times_ns.clear();
+  e.hello = hello;
 }
 
 void RobotRegistry::onDisconnected(const std::string& id, uint64_t serial, const std::string& reason,
@@ -43,14 +44,99 @@ void RobotRegistry::onTelemetry(const std::string& id, uint64_t serial, const v1
   e->has_telemetry = true;
   e->telemetry_rx_ns = now_ns;
   ++e->telemetry_count;
+  // Resync the alarm book with the alarms the robot says are in force (a
+  // raise or clear event lost across a reconnect or a server restart).
+  for (const auto& a : t.active_alarms()) {
+    bool known = false;
+    for (auto& r : alarms_) {
+      if (r.robot_id != id || !r.active() || r.alarm.id() != a.id()) continue;
+      known = true;
+      // The reading now and the worst so far; where and when it was raised stay.
+      r.alarm.set_value(a.value());
+      r.alarm.set_peak(a.peak());
+    }
+    if (!known) noteAlarmLocked(id, a, now_ns);
+  }
+  for (auto& r : alarms_) {
+    if (r.robot_id != id || !r.active()) continue;
+    bool listed = false;
+    for (const auto& a : t.active_alarms()) listed |= a.id() == r.alarm.id();
+    if (!listed && now_ns - r.raised_ns > 1'000'000'000) {  // not a raise still in flight
+      r.cleared_ns = now_ns;
+      r.alarm.set_active(false);
+    }
+  }
   e->rx_times_ns.push_back(now_ns);
   while (!e->rx_times_ns.empty() && e->rx_times_ns.front() <= now_ns - kRateWindowNs) e->rx_times_ns.pop_front();
 }
 
-void RobotRegistry::onEvent(const std::string& id, uint64_t serial, const v1::Event& ev) {
+void RobotRegistry::noteAlarmLocked(const std::string& id, const v1::GasAlarm& a, int64_t now_ns) {
+  for (auto it = alarms_.rbegin(); it != alarms_.rend(); ++it) {
+    if (it->robot_id != id || !it->active() || it->alarm.id() != a.id()) continue;
+    it->alarm = a;
+    if (!a.active()) it->cleared_ns = now_ns;
+    return;
+  }
+  if (!a.active()) return;  // the clear of an alarm never seen raised (or already resynced away)
+  AlarmRecord r;
+  r.number = ++alarm_counter_;
+  r.robot_id = id;
+  r.alarm = a;
+  r.raised_ns = now_ns;
+  alarms_.push_back(std::move(r));
+  // Drop the oldest finished ones beyond the bound (active alarms are never dropped).
+  while (alarms_.size() > kMaxAlarms) {
+    auto it = std::find_if(alarms_.begin(), alarms_.end(), [](const AlarmRecord& x) { return !x.active(); });
+    if (it == alarms_.end()) break;
+    alarms_.erase(it);
+  }
+}
+
+std::vector<AlarmRecord> RobotRegistry::alarms(bool all, const std::string& robot_id) const {
+  std::lock_guard lk(mu_);
+  std::vector<AlarmRecord> out;
+  for (const auto& r : alarms_)
+    if ((all || r.active() || !r.acked) && (robot_id.empty() || r.robot_id == robot_id)) out.push_back(r);
+  return out;
+}
+
+std::optional<AlarmRecord> RobotRegistry::ackAlarm(int number, int64_t now_ns) {
+  std::lock_guard lk(mu_);
+  for (auto& r : alarms_) {
+    if (r.number != number) continue;
+    if (!r.acked) {
+      r.acked = true;
+      r.acked_ns = now_ns;
+    }
+    return r;
+  }
+  return std::nullopt;
+}
+
+std::vector<AlarmRecord> RobotRegistry::ackAllAlarms(int64_t now_ns) {
+  std::lock_guard lk(mu_);
+  std::vector<AlarmRecord> out;
+  for (auto& r : alarms_) {
+    if (r.acked) continue;
+    r.acked = true;
+    r.acked_ns = now_ns;
+    out.push_back(r);
+  }
+  return out;
+}
+
+int RobotRegistry::unackedAlarms(const std::string& robot_id) const {
+  std::lock_guard lk(mu_);
+  int n = 0;
+  for (const auto& r : alarms_) n += r.active() && !r.acked && (robot_id.empty() || r.robot_id == robot_id);
+  return n;
+}
+
+void RobotRegistry::onEvent(const std::string& id, uint64_t serial, const v1::Event& ev, int64_t now_ns) {
   std::lock_guard lk(mu_);
   Entry* e = current(id, serial);
   if (!e) return;
+  if (ev.has_gas_alarm()) noteAlarmLocked(id, ev.gas_alarm(), now_ns);
   e->events.push_back(ev);
   if (e->events.size() > kMaxEventsPerRobot) e->events.pop_front();
   pending_.push_back({id, ev});
@@ -90,6 +176,7 @@ RobotSnapshot RobotRegistry::makeSnapshot(const std::string& id, const Entry& e,
   s.telemetry_hz = e.connected || n > 0 ? static_cast<double>(n) / (e.connected ? span_s : 1.0) : 0.0;
   s.state_age_s = static_cast<double>(now_ns - e.state_change_ns) * 1e-9;
   s.close_reason = e.close_reason;
+  s.hello = e.hello;
   return s;
 }
 

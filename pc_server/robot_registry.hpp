@@ -28,6 +28,21 @@ struct RobotSnapshot {
   uint64_t telemetry_count = 0;  // over the server's lifetime
   double state_age_s = 0;        // since the robot connected / disconnected
   std::string close_reason;      // why the last connection ended
+  v1::Hello hello;               // the last Hello (gas channels, capabilities)
+};
+
+/// A gas alarm or gas sensor fault as the operator sees it (docs/gas.md):
+/// numbered by the server (#1, #2 ...), raised/cleared by the robot,
+/// acknowledged by the operator.
+struct AlarmRecord {
+  int number = 0;
+  std::string robot_id;
+  v1::GasAlarm alarm;          // the latest transition (active = still raised)
+  int64_t raised_ns = 0;       // server monotonic time the raise arrived
+  int64_t cleared_ns = 0;      // 0 = still active
+  bool acked = false;
+  int64_t acked_ns = 0;
+  bool active() const { return cleared_ns == 0; }
 };
 
 /// One robot event waiting to be shown on the console.
@@ -49,7 +64,7 @@ class RobotRegistry {
                    int64_t now_ns);
   void onDisconnected(const std::string& id, uint64_t serial, const std::string& reason, int64_t now_ns);
   void onTelemetry(const std::string& id, uint64_t serial, const v1::Telemetry& t, int64_t now_ns);
-  void onEvent(const std::string& id, uint64_t serial, const v1::Event& e);
+  void onEvent(const std::string& id, uint64_t serial, const v1::Event& e, int64_t now_ns = 0);
   void onAck(const std::string& id, uint64_t serial, const v1::Ack& a);
 
   /// State of one robot; nullopt if it never connected.
@@ -68,6 +83,17 @@ class RobotRegistry {
   /// The robot's recent events, oldest first.
   std::vector<v1::Event> events(const std::string& id) const;
 
+  /// Gas alarms: active ones, or (all) also the cleared ones kept (newest
+  /// kMaxAlarms), oldest first; robot_id "" = every robot.
+  std::vector<AlarmRecord> alarms(bool all, const std::string& robot_id = "") const;
+  /// Acknowledges alarm #number; the record as acknowledged, or nullopt when there is no such alarm.
+  std::optional<AlarmRecord> ackAlarm(int number, int64_t now_ns);
+  /// Acknowledges every unacknowledged alarm (active or not); returns them.
+  std::vector<AlarmRecord> ackAllAlarms(int64_t now_ns);
+  /// Active alarms not yet acknowledged.
+  int unackedAlarms(const std::string& robot_id = "") const;
+  static constexpr std::size_t kMaxAlarms = 500;
+
  private:
   struct Entry {
     uint64_t serial = 0;
@@ -85,6 +111,7 @@ class RobotRegistry {
     std::deque<int64_t> rx_times_ns;
     std::map<uint64_t, v1::Ack> acks;
     std::deque<v1::Event> events;
+    v1::Hello hello;
   };
   Entry* current(const std::string& id, uint64_t serial);
   RobotSnapshot makeSnapshot(const std::string& id, const Entry& e, int64_t now_ns) const;
@@ -93,6 +120,10 @@ class RobotRegistry {
   std::map<std::string, Entry> robots_;
   uint64_t connect_counter_ = 0;
   std::deque<PendingEvent> pending_;
+  /// Applies a robot's alarm transition (or telemetry resync) to the book; mu_ held.
+  void noteAlarmLocked(const std::string& id, const v1::GasAlarm& a, int64_t now_ns);
+  std::deque<AlarmRecord> alarms_;
+  int alarm_counter_ = 0;
   uint64_t dropped_events_ = 0;
 };
 

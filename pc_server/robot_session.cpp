@@ -182,7 +182,7 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
       server_.observe(robot_id_, address_, env, true, monoNowUs());
       return true;
     case v1::Envelope::kEvent:
-      registry_.onEvent(robot_id_, serial_, env.event());
+      registry_.onEvent(robot_id_, serial_, env.event(), monoNowNs());
       server_.observe(robot_id_, address_, env, true, monoNowUs());
       if (server_.logEvents())
         log::info(kTag, "[", robot_id_, "] ", v1::Event::Kind_Name(env.event().kind()), ": ", env.event().text());

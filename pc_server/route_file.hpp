@@ -1,6 +1,10 @@
 #pragma once
-// Route files for the console's `route <file>` (config/routes/*.yaml): a name,
-// an optional cruise speed and the waypoints in the robot's odometry frame.
+// Route files for the console's `route <file>` and `inspect <route>`
+// (config/routes/*.yaml): a name, an optional cruise speed, the site map the
+// points refer to, and the points in the robot's odometry frame - either as a
+// flat `waypoints_m` list or as `points` with inspection dwell times, camera
+// presets and labels (docs/console.md, docs/gas.md).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -8,25 +12,46 @@
 
 namespace inspect::server {
 
+/// One point of a route.
+struct RoutePoint {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double dwell_s = 0.0;             // > 0: an inspection point (stop this long)
+  std::optional<v1::Ptz> ptz;       // camera preset applied on arrival
+  std::string label;
+};
+
 /// A route as read from its file.
 struct Route {
   std::string name;
-  double speed_m_s = 0.0;  // 0 = the robot's default
-  std::vector<double> waypoints_m;  // x0, y0, x1, y1, ...
+  std::string file;                 // the file it was read from
+  double speed_m_s = 0.0;           // 0 = the robot's default
+  std::string map;                  // world file of the site (resolved path; "" = none)
+  std::vector<RoutePoint> points;
+  /// x0, y0, x1, y1, ... (the points' coordinates)
+  std::vector<double> waypointsM() const;
+  /// Points with a dwell time.
+  int inspectionPoints() const;
 };
 
 /// Most waypoints a route may have (the robot accepts as many goals per command).
 inline constexpr int kMaxRoutePoints = 100;
 /// Fastest cruise speed a route may ask for, m/s.
 inline constexpr double kMaxRouteSpeed_m_s = 1.0;
+/// Longest dwell at one point, s.
+inline constexpr double kMaxDwell_s = 3600.0;
 
 /// Reads and checks a route file; throws config::ConfigError naming the file and key
-/// (unknown keys, an odd or empty waypoint list, non-finite or out-of-range values).
+/// (unknown keys, an odd or empty waypoint list, non-finite or out-of-range values,
+/// a map file that does not exist).
 Route loadRouteFile(const std::string& path);
 /// The same from YAML text (`name` stands in for the file in messages).
 Route loadRouteText(const std::string& yaml, const std::string& name);
+/// `inspect`'s argument: a file path, or a name looked up as config/routes/<name>.yaml
+/// (relative to the working directory). Returns the path; throws config::ConfigError when none exists.
+std::string resolveRoute(const std::string& name_or_path);
 
-/// The GoTo command body of a route.
-v1::GoTo goToOf(const Route& r);
+/// The GoTo command body of a route (inspection: the gas reaction and dwell apply).
+v1::GoTo goToOf(const Route& r, bool inspection = false);
 
 }  // namespace inspect::server

@@ -36,6 +36,7 @@ void RunStats::add(const v1::Telemetry& t) {
     gas_sum_.resize(f_.gas.size(), 0.0);
   }
   for (int c = 0; c < t.gas_size(); ++c) {
+    if (std::isnan(t.gas(c))) continue;  // no data from that sensor
     auto& g = f_.gas[static_cast<std::size_t>(c)];
     g.max = g.samples ? std::max(g.max, t.gas(c)) : t.gas(c);
     ++g.samples;

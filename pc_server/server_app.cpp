@@ -116,6 +116,11 @@ int runServer(const CliOptions& options) {
       const auto snap = registry.snapshot(robot, monoNowNs());
       return snap && snap->has_telemetry ? gainsJson(snap->telemetry) : std::string("{}");
     });
+    recorder->setHelloSource([&registry](const std::string& robot) -> std::optional<v1::Hello> {
+      const auto snap = registry.snapshot(robot, monoNowNs());
+      if (!snap) return std::nullopt;
+      return snap->hello;
+    });
     std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog.sqlite)";
     if (!recorder->startupReport().empty()) std::cout << "; " << recorder->startupReport();
     std::cout << std::endl;

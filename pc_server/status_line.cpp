@@ -1,6 +1,7 @@
 #include "pc_server/status_line.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 
 #include "pc_server/expect_check.hpp"
@@ -118,7 +119,27 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
   }
   if (t.gas_size() > 0) {
     s += " | gas";
-    for (double g : t.gas()) s += " " + fmtShort(g, 1);
+    const auto& ch = snap->hello.gas_channels();
+    for (int i = 0; i < t.gas_size(); ++i) {
+      const double g = t.gas(i);
+      s += " " + (i < ch.size() ? ch[i].name() : "gas" + std::to_string(i)) + " " +
+           (std::isnan(g) ? std::string("--") : fmtShort(g, 1));
+    }
+  }
+  if (t.active_alarms_size() > 0) {
+    // The worst first: HIGH, then LOW, then sensor faults.
+    std::string high, low, fault;
+    for (const auto& a : t.active_alarms()) {
+      if (a.level() == v1::GasAlarm::SENSOR_FAULT) {
+        fault += " " + a.channel_name() + " " + a.fault();
+        continue;
+      }
+      std::string& dst = a.level() == v1::GasAlarm::HIGH ? high : low;
+      dst += " " + a.channel_name() + (a.level() == v1::GasAlarm::HIGH ? " HIGH " : " LOW ") +
+             (std::isnan(a.value()) ? std::string("--") : fmtShort(a.value(), 1)) + " " + a.unit();
+    }
+    if (!high.empty() || !low.empty()) s += " | ALARM" + high + low;
+    if (!fault.empty()) s += " | SENSOR FAULT" + fault;
   }
   if (t.battery_v() > 0) s += " | bat " + fmtFixed(t.battery_v(), 1) + " V";
   s += " | faults " + faultNames(t.faults());
@@ -133,7 +154,8 @@ bool statusIsAlarm(const std::optional<RobotSnapshot>& snap) {
   if (!snap || !snap->connected) return true;
   if (!snap->has_telemetry) return false;
   const auto m = snap->telemetry.mode();
-  return m == v1::ESTOP || m == v1::FAILSAFE || snap->telemetry.faults() != 0;
+  return m == v1::ESTOP || m == v1::FAILSAFE || snap->telemetry.faults() != 0 ||
+         snap->telemetry.active_alarms_size() > 0;
 }
 
 }  // namespace inspect::server

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Runs the main job on an already built tree: mcu_sim (square_room world) on a
-# pty, robot_client on that pty, pc_server on loopback running
-# scripts/demo/square.console, then prints what the robot did.
+# Runs the main job on an already built tree: mcu_sim (gas_lab world: two
+# leaks, a technician in the aisle) on a pty, robot_client on that pty,
+# pc_server on loopback running scripts/demo/gas_inspection.console (a
+# recorded gas inspection round, alarms, report), then prints what happened.
 #
 #   scripts/run_demo.sh [--interactive|--batch] [--port N]
 #
@@ -36,7 +37,7 @@ cleanup() {
 trap cleanup EXIT
 
 echo "demo: logs and ground truth in $OUT"
-"$BIN/mcu_sim" --world config/worlds/square_room.yaml --robot config/robot.yaml \
+"$BIN/mcu_sim" --world config/worlds/gas_lab.yaml --robot config/robot.yaml --people-wait-motion \
   --pty-link "$OUT/mcu" --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
 SIM=$!
 PIDS+=("$SIM")
@@ -49,7 +50,7 @@ head -n 1 "$OUT/mcu_sim.out"
   for _ in $(seq 200); do [ -s "$OUT/port" ] && [ -s "$OUT/video_port" ] && break; sleep 0.05; done
   exec "$BIN/robot_client" --config config/client.yaml --robot-config config/robot.yaml \
     --serial "$OUT/mcu" --server "127.0.0.1:$(cat "$OUT/port")" --video-port "$(cat "$OUT/video_port")" \
-    --id robot1 2>"$OUT/robot_client.err"
+    --map config/worlds/gas_lab.yaml --id robot1 2>"$OUT/robot_client.err"
 ) &
 CLIENT=$!
 PIDS+=("$CLIENT")
@@ -57,7 +58,7 @@ PIDS+=("$CLIENT")
 # Video on an ephemeral UDP port (5600 may be taken); SDP and snapshots in $OUT/video.
 ARGS=(--config config/server.yaml --bind 127.0.0.1 --port "$PORT" --port-file "$OUT/port"
       --video-port 0 --video-port-file "$OUT/video_port" --video-dir "$OUT/video" --runs-dir "$OUT/runs"
-      --script scripts/demo/square.console)
+      --script scripts/demo/gas_inspection.console)
 echo "demo: camera: $OUT/video/robot1.sdp (play it while the console runs:"
 echo "        ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay $OUT/video/robot1.sdp)"
 echo "      snapshots: $OUT/video/robot1_latest.png (refreshed every 5 s), 'snapshot' at the console" 

@@ -12,9 +12,12 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <cmath>
+#include <limits>
 
 #include "pc_server/console.hpp"
 #include "pc_server/route_file.hpp"
+#include "pc_server/status_line.hpp"
 #include "shared/util/clock.hpp"
 
 using namespace inspect;
@@ -481,8 +484,8 @@ TEST_F(ConsoleTest, RouteFileIsSentAsOneGoTo) {
 TEST_F(ConsoleTest, ShippedExampleRouteLoads) {
   const Route r = loadRouteFile(std::string(INSPECT_SOURCE_DIR) + "/config/routes/warehouse_tour.yaml");
   EXPECT_EQ(r.name, "warehouse_tour");
-  EXPECT_GE(r.waypoints_m.size(), 4u);
-  EXPECT_EQ(r.waypoints_m.size() % 2, 0u);
+  EXPECT_GE(r.waypointsM().size(), 4u);
+  EXPECT_EQ(r.waypointsM().size() % 2, 0u);
 }
 
 TEST_F(ConsoleTest, BadRouteFileIsOneLineNamingFileAndKey) {
@@ -614,4 +617,141 @@ TEST_F(ConsoleTest, RecordingCommandsWithoutARecorderSaySo) {
     EXPECT_FALSE(ok) << line;
     EXPECT_HAS(out, "the server records nothing");
   }
+}
+
+// ---- Gas: inspect, alarms, ack, the status line ----
+
+TEST_F(ConsoleTest, InspectSendsAnInspectionGoToWithDwellPresetsAndLabels) {
+  connectRobot();
+  const TempFile f("lab.yaml",
+                   "name: lab\nspeed_m_s: 0.3\npoints:\n"
+                   "  - {at: [1, 0]}\n"
+                   "  - {at: [2, 0.5], dwell_s: 4, ptz: {pan_deg: 90, tilt_deg: -10}, label: valve}\n"
+                   "  - {at: [0, 0], ptz: {home: true}}\n");
+  auto [ok, out] = run("inspect " + f.path);
+  EXPECT_TRUE(ok) << out;
+  EXPECT_EQ(out,
+            "inspect: note: the server records nothing (--no-record): no run, no report\n"
+            "inspection 'lab': 3 points, 1 inspection points at 0.3 m/s\nrobot1: inspect accepted\n");
+  ASSERT_EQ(sink_.sent.size(), 1u);
+  const auto& g = sink_.sent[0].go_to();
+  EXPECT_TRUE(g.inspection());
+  ASSERT_EQ(g.points_size(), 3);
+  EXPECT_DOUBLE_EQ(g.points(1).dwell_s(), 4.0);
+  EXPECT_EQ(g.points(1).label(), "valve");
+  EXPECT_NEAR(g.points(1).ptz().pan_rad(), M_PI / 2, 1e-12);
+  EXPECT_NEAR(g.points(1).ptz().tilt_rad(), -10 * M_PI / 180, 1e-12);
+  EXPECT_TRUE(g.points(2).ptz().home());
+  EXPECT_FALSE(g.points(0).has_ptz());
+  // A speed on the command line wins over the file's.
+  std::tie(ok, out) = run("inspect " + f.path + " 0.5");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_DOUBLE_EQ(sink_.sent.back().go_to().speed_m_s(), 0.5);
+  std::tie(ok, out) = run("inspect " + f.path + " 3");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "inspect: speed_m_s '3' must be a number in (0, 1] m/s\n");
+}
+
+TEST_F(ConsoleTest, ShippedInspectionRouteLoadsWithItsMap) {
+  const Route r = loadRouteFile(std::string(INSPECT_SOURCE_DIR) + "/config/routes/gas_lab_inspection.yaml");
+  EXPECT_EQ(r.name, "gas_lab_inspection");
+  EXPECT_EQ(r.points.size(), 7u);
+  EXPECT_EQ(r.inspectionPoints(), 2);
+  EXPECT_NE(r.map.find("gas_lab.yaml"), std::string::npos) << r.map;
+}
+
+TEST_F(ConsoleTest, BadInspectionRoutesNameTheKey) {
+  connectRobot();
+  struct Case {
+    const char* yaml;
+    const char* key_and_reason;
+  };
+  for (const Case& c :
+       {Case{"points: [{at: [1, 1], dwell_s: -1}]\n", "points[0].dwell_s"},
+        Case{"points: [{at: [1]}]\n", "points[0].at"},
+        Case{"points: [{at: [1, 1], ptz: {pan_deg: 400}}]\n", "points[0].ptz.pan_deg"},
+        Case{"points: [{at: [1, 1], colour: red}]\n", "points[0].colour: unknown key"},
+        Case{"points: [{at: [1, 1]}]\nwaypoints_m: [1, 1]\n", "points: give either waypoints_m or points"},
+        Case{"points: [{at: [1, 1]}]\nmap: /nonexistent/world.yaml\n", "map: '/nonexistent/world.yaml' does not exist"}}) {
+    const TempFile f("bad.yaml", c.yaml);
+    const auto [ok, out] = run("inspect " + f.path);
+    EXPECT_FALSE(ok) << c.yaml;
+    EXPECT_EQ(out.rfind("inspect: " + f.path + ": " + c.key_and_reason, 0), 0u) << out;
+  }
+  const auto [ok, out] = run("inspect no_such_route");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "inspect: no route 'no_such_route': neither a file nor config/routes/no_such_route.yaml\n");
+  EXPECT_TRUE(sink_.sent.empty());
+}
+
+TEST_F(ConsoleTest, AlarmsAreListedAndAcknowledged) {
+  connectRobot();
+  auto [ok, out] = run("alarms");
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(out, "no active or unacknowledged gas alarms\n");
+  v1::Event e;
+  e.set_kind(v1::Event::ALARM_RAISED);
+  e.set_text("gas H2S HIGH alarm raised: 12.30 ppm (threshold 10.00) at (2.35, 3.02)");
+  auto* a = e.mutable_gas_alarm();
+  a->set_id(4);
+  a->set_channel_name("H2S");
+  a->set_level(v1::GasAlarm::HIGH);
+  a->set_active(true);
+  a->set_value(12.3);
+  a->set_threshold(10.0);
+  a->set_peak(12.3);
+  a->set_unit("ppm");
+  a->mutable_pose()->set_x_m(2.35);
+  a->mutable_pose()->set_y_m(3.02);
+  registry_.onEvent("robot1", kSerial, e, monoNowNs());
+  // Printed at once (plain text here; red with a bell on a terminal).
+  EXPECT_EQ(console_.background(),
+            "[robot1] ALARM_RAISED: gas H2S HIGH alarm raised: 12.30 ppm (threshold 10.00) at (2.35, 3.02)\n");
+  std::tie(ok, out) = run("alarms");
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(out.rfind("#1 robot1 H2S HIGH 12.3 ppm (A2 10 ppm, worst 12.3 ppm) at (2.35, 3.02): raised ", 0), 0u)
+      << out;
+  EXPECT_NE(out.find("ACTIVE, unacknowledged"), std::string::npos) << out;
+  std::tie(ok, out) = run("ack 9");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "ack: no alarm #9 (alarms lists them)\n");
+  std::tie(ok, out) = run("ack x");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "ack: 'x' is not an alarm number (alarms lists them)\n");
+  std::tie(ok, out) = run("ack 1");
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(out, "robot1: alarm #1 (H2S HIGH) acknowledged by the operator\n");
+  std::tie(ok, out) = run("alarms");
+  EXPECT_NE(out.find("ACTIVE, acknowledged"), std::string::npos) << "active alarms stay listed: " << out;
+  std::tie(ok, out) = run("ack all");
+  EXPECT_EQ(out, "ack: nothing to acknowledge\n");
+  std::tie(ok, out) = run("alarms everything");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(out, "alarms: syntax: alarms [all]\n");
+}
+
+TEST_F(ConsoleTest, StatusLineNamesGasChannelsAndShowsAlarms) {
+  v1::Hello h;
+  h.set_robot_id("robot1");
+  for (const char* n : {"CH4", "H2S"}) h.add_gas_channels()->set_name(n);
+  registry_.onConnected("robot1", "127.0.0.1:1", kSerial, h, monoNowNs());
+  (void)console_.background();
+  v1::Telemetry t;
+  t.set_mode(v1::NAVIGATING);
+  t.add_gas(25.04);
+  t.add_gas(std::numeric_limits<double>::quiet_NaN());
+  auto* a = t.add_active_alarms();
+  a->set_channel_name("CH4");
+  a->set_level(v1::GasAlarm::HIGH);
+  a->set_value(25.04);
+  a->set_unit("%LEL");
+  auto* f = t.add_active_alarms();
+  f->set_channel_name("H2S");
+  f->set_level(v1::GasAlarm::SENSOR_FAULT);
+  f->set_fault("no_data");
+  registry_.onTelemetry("robot1", kSerial, t, monoNowNs());
+  const std::string s = console_.statusText("robot1");
+  EXPECT_NE(s.find("| gas CH4 25 H2S -- |"), std::string::npos) << s;
+  EXPECT_NE(s.find("| ALARM CH4 HIGH 25 %LEL | SENSOR FAULT H2S no_data"), std::string::npos) << s;
+  EXPECT_TRUE(statusIsAlarm(registry_.snapshot("robot1", monoNowNs())));
 }

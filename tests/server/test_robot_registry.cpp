@@ -85,3 +85,87 @@ TEST(RobotRegistry, FirstConnectedIsByConnectionOrder) {
   EXPECT_EQ(reg.connectedCount(), 1);
   EXPECT_EQ(reg.snapshots(0).size(), 2u);
 }
+
+// ---- The gas alarm book ----
+
+namespace {
+v1::Event alarmEvent(uint64_t id, const std::string& ch, v1::GasAlarm::Level level, bool active, double value) {
+  v1::Event e;
+  e.set_kind(active ? v1::Event::ALARM_RAISED : v1::Event::ALARM_CLEARED);
+  auto* a = e.mutable_gas_alarm();
+  a->set_id(id);
+  a->set_channel_name(ch);
+  a->set_level(level);
+  a->set_active(active);
+  a->set_value(value);
+  a->set_peak(value);
+  a->set_unit("ppm");
+  return e;
+}
+}  // namespace
+
+TEST(RobotRegistryAlarms, RaiseUpdateClearAndAcknowledge) {
+  RobotRegistry reg;
+  reg.onConnected("r", "a:1", 1, hello("r"), 0);
+  reg.onEvent("r", 1, alarmEvent(7, "H2S", v1::GasAlarm::HIGH, true, 11.0), kSec);
+  auto list = reg.alarms(false);
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_EQ(list[0].number, 1);
+  EXPECT_TRUE(list[0].active());
+  EXPECT_EQ(reg.unackedAlarms(), 1);
+  // Telemetry carries the reading now and the worst so far.
+  v1::Telemetry t;
+  auto* a = t.add_active_alarms();
+  *a = alarmEvent(7, "H2S", v1::GasAlarm::HIGH, true, 14.0).gas_alarm();
+  reg.onTelemetry("r", 1, t, 2 * kSec);
+  list = reg.alarms(false);
+  ASSERT_EQ(list.size(), 1u) << "the same alarm, not a new one";
+  EXPECT_DOUBLE_EQ(list[0].alarm.peak(), 14.0);
+  reg.onEvent("r", 1, alarmEvent(7, "H2S", v1::GasAlarm::HIGH, false, 8.0), 5 * kSec);
+  list = reg.alarms(false);
+  ASSERT_EQ(list.size(), 1u) << "cleared but unacknowledged: still listed";
+  EXPECT_FALSE(list[0].active());
+  EXPECT_EQ(list[0].cleared_ns - list[0].raised_ns, 4 * kSec);
+  EXPECT_EQ(reg.unackedAlarms(), 0) << "only active ones count";
+  const auto acked = reg.ackAlarm(1, 6 * kSec);
+  ASSERT_TRUE(acked);
+  EXPECT_TRUE(acked->acked);
+  EXPECT_TRUE(reg.alarms(false).empty());
+  EXPECT_EQ(reg.alarms(true).size(), 1u);
+  EXPECT_FALSE(reg.ackAlarm(2, 6 * kSec));
+}
+
+TEST(RobotRegistryAlarms, TelemetryResyncsMissedRaisesAndClears) {
+  RobotRegistry reg;
+  reg.onConnected("r", "a:1", 1, hello("r"), 0);
+  v1::Telemetry t;
+  *t.add_active_alarms() = alarmEvent(3, "CH4", v1::GasAlarm::LOW, true, 12.0).gas_alarm();
+  reg.onTelemetry("r", 1, t, kSec);  // the raise event was lost (e.g. the server restarted)
+  ASSERT_EQ(reg.alarms(false).size(), 1u);
+  reg.onTelemetry("r", 1, t, kSec + 1000);
+  EXPECT_EQ(reg.alarms(true).size(), 1u) << "known by id: not added twice";
+  t.clear_active_alarms();
+  reg.onTelemetry("r", 1, t, 3 * kSec);  // and its clear was lost too
+  const auto list = reg.alarms(true);
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_FALSE(list[0].active());
+  // A clear of an alarm never seen raised is ignored.
+  reg.onEvent("r", 1, alarmEvent(99, "CO", v1::GasAlarm::HIGH, false, 1.0), 4 * kSec);
+  EXPECT_EQ(reg.alarms(true).size(), 1u);
+  EXPECT_EQ(reg.ackAllAlarms(5 * kSec).size(), 1u);
+  EXPECT_TRUE(reg.ackAllAlarms(5 * kSec).empty());
+}
+
+TEST(RobotRegistryAlarms, TheBookIsBoundedButKeepsActiveAlarms) {
+  RobotRegistry reg;
+  reg.onConnected("r", "a:1", 1, hello("r"), 0);
+  reg.onEvent("r", 1, alarmEvent(1, "CH4", v1::GasAlarm::HIGH, true, 30.0), 0);  // stays active
+  for (uint64_t id = 2; id < RobotRegistry::kMaxAlarms + 50; ++id) {
+    reg.onEvent("r", 1, alarmEvent(id, "H2S", v1::GasAlarm::LOW, true, 6.0), static_cast<int64_t>(id));
+    reg.onEvent("r", 1, alarmEvent(id, "H2S", v1::GasAlarm::LOW, false, 3.0), static_cast<int64_t>(id) + 1);
+  }
+  const auto all = reg.alarms(true);
+  EXPECT_EQ(all.size(), RobotRegistry::kMaxAlarms);
+  EXPECT_EQ(all.front().number, 1) << "the active alarm is never dropped";
+  EXPECT_TRUE(all.front().active());
+}

@@ -1,0 +1,173 @@
+// Gas inspection through the full stack (issue 7's acceptance): mcu_sim's
+// gas_lab world (valve_A leaks CH4, drain_B leaks H2S, the CO sensor sticks at
+// 30 s, a technician walks the south aisle), robot_client with the alarm
+// logic, pc_server running `inspect gas_lab_inspection` in real time. Checks
+// the alarms raised and cleared (no chattering), the scripted stuck-sensor
+// fault, the report's concentration-map peaks and leak-source estimates
+// against the simulator's true sources, and prints the alarm latencies
+// (leak reached by the sensor inlet -> alarm on the server's console).
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <regex>
+
+#include "shared/config/gas_config.hpp"
+#include "shared/util/clock.hpp"
+#include "tests/integration/stack.hpp"
+
+using namespace inspect::test;
+
+namespace {
+
+struct Source {
+  std::string name, gas;
+  double x = 0, y = 0;
+};
+
+std::vector<Source> sources(const Truth& t) {
+  std::vector<Source> out;
+  const std::regex re(R"(name=(\S+) gas=(\S+) x=([-0-9.]+) y=([-0-9.]+))");
+  for (const auto& e : t.events) {
+    std::smatch m;
+    if (e.name == "gas_source" && std::regex_search(e.detail, m, re))
+      out.push_back({m[1], m[2], std::stod(m[3]), std::stod(m[4])});
+  }
+  return out;
+}
+
+struct AlarmRow {
+  double time_unix = 0;
+  std::string channel, level, state;
+};
+
+std::vector<AlarmRow> catalogAlarms(const std::string& db_path) {
+  std::vector<AlarmRow> out;
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+    sqlite3_close(db);
+    return out;
+  }
+  sqlite3_stmt* st = nullptr;
+  if (sqlite3_prepare_v2(db, "SELECT time_unix, channel, level, state FROM alarms ORDER BY id", -1, &st, nullptr) ==
+      SQLITE_OK) {
+    while (sqlite3_step(st) == SQLITE_ROW)
+      out.push_back({sqlite3_column_double(st, 0), reinterpret_cast<const char*>(sqlite3_column_text(st, 1)),
+                     reinterpret_cast<const char*>(sqlite3_column_text(st, 2)),
+                     reinterpret_cast<const char*>(sqlite3_column_text(st, 3))});
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  return out;
+}
+
+int countLines(const std::string& out, const std::string& text) {
+  int n = 0;
+  for (std::size_t p = out.find(text); p != std::string::npos; p = out.find(text, p + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST(GasStack, InspectionRoundPastTwoLeaks) {
+  const std::string script = "expect robots >= 1 within 15\n"
+                             "expect sensor_hz > 50 within 5\n"
+                             "inspect " + srcPath("config/routes/gas_lab_inspection.yaml") + "\n"
+                             "expect mode == NAVIGATING within 2\n"
+                             "expect mode == IDLE within 160\n"
+                             "expect goal_index == 7\n"
+                             "status\n"
+                             "wait 8\n"  // the last alarm clears once the lagging sensor has settled
+                             "alarms all\n"
+                             "ack all\n"
+                             "report 1\n";
+  Stack s("gas");
+  ASSERT_TRUE(s.startServer(script)) << s.logs();
+  auto& robot = s.startRobot("robot1", "gas_lab.yaml", {}, {"--people-wait-motion"},
+                             {"--map", srcPath("config/worlds/gas_lab.yaml"), "--gas-reaction", "continue"});
+  const auto rc = s.server().wait(200);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  // CLOCK_MONOTONIC -> Unix time, for the truth log against the catalog.
+  const double mono_to_unix_s =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() -
+      static_cast<double>(inspect::monoNowNs()) * 1e-9;
+  const std::string out = s.serverOutput();
+  std::printf("%s", out.c_str());
+  EXPECT_EQ(*rc, 0) << s.logs();
+  EXPECT_NE(out.find("robot1: inspect completed"), std::string::npos) << out;
+
+  // The right alarms: CH4 and H2S, LOW and HIGH, each raised and cleared once
+  // (no chattering on the sensor noise); O2 and CO never in gas alarm.
+  for (const std::string gas : {"CH4", "H2S"})
+    for (const std::string level : {"LOW", "HIGH"}) {
+      EXPECT_EQ(countLines(out, "ALARM_RAISED: gas " + gas + " " + level + " alarm raised"), 1) << gas << level;
+      EXPECT_EQ(countLines(out, "ALARM_CLEARED: gas " + gas + " " + level + " alarm cleared"), 1) << gas << level;
+    }
+  EXPECT_EQ(countLines(out, "ALARM_RAISED: gas O2 "), 0);
+  EXPECT_EQ(countLines(out, "ALARM_RAISED: gas CO "), 0);
+  // The scripted stuck CO sensor (from 30 s) is a sensor fault.
+  EXPECT_EQ(countLines(out, "ALARM_RAISED: gas sensor CO fault raised: stuck"), 1) << out;
+
+  // Map peaks and source estimates (world frame: the route names its map).
+  const Truth truth = readTruth(robot.truth);
+  const auto src = sources(truth);
+  ASSERT_EQ(src.size(), 2u);
+  std::map<std::string, std::pair<double, double>> peak, est;
+  std::map<std::string, double> radius;
+  const std::regex re_peak(R"(  (\w+): max .* map peak \(([-0-9.]+), ([-0-9.]+)\))");
+  const std::regex re_est(R"(  (\w+): .*leak source estimate \(([-0-9.]+), ([-0-9.]+)\) \+- ([0-9.]+) m)");
+  std::smatch m;
+  for (auto it = std::sregex_iterator(out.begin(), out.end(), re_peak); it != std::sregex_iterator(); ++it)
+    peak[(*it)[1]] = {std::stod((*it)[2]), std::stod((*it)[3])};
+  for (auto it = std::sregex_iterator(out.begin(), out.end(), re_est); it != std::sregex_iterator(); ++it) {
+    est[(*it)[1]] = {std::stod((*it)[2]), std::stod((*it)[3])};
+    radius[(*it)[1]] = std::stod((*it)[4]);
+  }
+  EXPECT_NE(out.find("[world frame]"), std::string::npos);
+  for (const auto& so : src) {
+    ASSERT_TRUE(peak.count(so.gas)) << so.gas;
+    ASSERT_TRUE(est.count(so.gas)) << so.gas << " has no leak source estimate";
+    const double peak_err = std::hypot(peak[so.gas].first - so.x, peak[so.gas].second - so.y);
+    const double est_err = std::hypot(est[so.gas].first - so.x, est[so.gas].second - so.y);
+    // The closest the route came to the source (truth, sensor inlet).
+    double closest = 1e9;
+    for (const auto& g : truth.gas) closest = std::min(closest, std::hypot(g.x - so.x, g.y - so.y));
+    std::printf("GAS %s (%s) at (%.2f, %.2f): route passed %.2f m away; map peak %.2f m off; estimate (%.2f, %.2f) "
+                "%.2f m off, 95 %% radius %.2f m\n",
+                so.name.c_str(), so.gas.c_str(), so.x, so.y, closest, peak_err, est[so.gas].first,
+                est[so.gas].second, est_err, radius[so.gas]);
+    EXPECT_LT(closest, 2.0);
+    EXPECT_LT(est_err, 1.0) << so.gas;
+    EXPECT_LT(peak_err, 1.5) << so.gas;
+  }
+
+  // Alarm latencies: the inlet's true concentration first reaches the level's
+  // threshold (truth) -> the server receives the raise (catalog time, as the
+  // console prints it). Also the sensor's share: the reading reaching it.
+  const auto cfg = inspect::config::defaultGasConfig();
+  const auto alarms = catalogAlarms(s.dir() / "runs/catalog.sqlite");
+  for (const auto& a : alarms) {
+    if (a.state != "raised" || (a.level != "LOW" && a.level != "HIGH")) continue;
+    const int ch = cfg.find(a.channel);
+    ASSERT_GE(ch, 0);
+    const auto& c = cfg.channels[static_cast<std::size_t>(ch)];
+    const double thr = a.level == "HIGH" ? c.alarm_high : c.alarm_low;
+    double t_true = -1, t_read = -1;
+    for (const auto& g : truth.gas) {
+      const double unix_s = static_cast<double>(g.mono_ns) * 1e-9 + mono_to_unix_s;
+      if (unix_s > a.time_unix) break;
+      if (t_true < 0 && static_cast<std::size_t>(ch) < g.truth.size() && c.beyond(g.truth[ch], thr)) t_true = unix_s;
+      if (t_read < 0 && static_cast<std::size_t>(ch) < g.reading.size() && c.beyond(g.reading[ch], thr))
+        t_read = unix_s;
+    }
+    ASSERT_GE(t_true, 0) << a.channel << " " << a.level << ": raised without the true value reaching " << thr;
+    std::printf("GAS latency %s %s (threshold %g %s): leak reached -> alarm on console %.2f s (sensor reading "
+                "reached it after %.2f s)\n",
+                a.channel.c_str(), a.level.c_str(), thr, c.unit.c_str(), a.time_unix - t_true,
+                t_read < 0 ? -1.0 : t_read - t_true);
+    EXPECT_LT(a.time_unix - t_true, 15.0);
+  }
+}
