@@ -690,7 +690,18 @@ std::vector<GasMapOutcome> gasMaps(const RunReportInput& in, const Frame& frame,
     GasMapOutcome o;
     const auto map = gas::ConcentrationMap::build(gas::compensateLag(raw, ch.tau_s()), bounds, map_options);
     options.falling = ch.falling;
-    o.leak = gas::estimateLeak(raw, ch.tau_s(), ch.background, bounds, options);
+    // A leak worth locating raised the channel to its A1 level at least once;
+    // below it the "plume" is noise, cross-sensitivity or a stuck sensor.
+    const bool reached_a1 = !ch.known || std::isnan(ch.alarm_low) ||
+                            (ch.falling ? ch.min <= ch.alarm_low : ch.max >= ch.alarm_low);
+    if (reached_a1) {
+      o.leak = gas::estimateLeak(raw, ch.tau_s(), ch.background, bounds, options);
+    } else {
+      o.leak.found = false;
+      o.leak.reason = "the readings never reached A1 (" +
+                      ch.withUnit(gasValue(ch.falling ? ch.min : ch.max)) + (ch.falling ? " > " : " < ") +
+                      ch.withUnit(gasValue(ch.alarm_low)) + ")";
+    }
     o.peak = map.peak(ch.falling);
     auto& r = o.result;
     r.channel = ch.name;

@@ -103,6 +103,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   EXPECT_GT(topicCount(counts, "/command"), 20) << counts;     // teleop re-sent at 20 Hz
   EXPECT_GT(topicCount(counts, "/ack"), 20) << counts;
   EXPECT_GE(topicCount(counts, "/server_event"), 2) << counts;
+  EXPECT_EQ(topicCount(counts, "/robot_info"), 1) << counts;  // the robot's Hello at the start
   EXPECT_GT(ffprobeFrames(first + "/video.mp4"), 90);
   // ...and finds exactly the messages the server wrote ("run <id> ended (stopped): N messages" in its log).
   {
@@ -111,7 +112,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
     std::smatch me;
     ASSERT_TRUE(std::regex_search(err, me, re_end)) << err;
     int read_total = 0;
-    for (const char* t : {"/telemetry", "/camera", "/command", "/ack", "/event", "/server_event"})
+    for (const char* t : {"/telemetry", "/camera", "/command", "/ack", "/event", "/server_event", "/robot_info"})
       read_total += std::max(topicCount(counts, t), 0);
     EXPECT_EQ(read_total, std::stoi(me[1])) << counts;
   }
@@ -140,7 +141,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   for (const char* png : {"trajectory.png", "speed_people.png"})
     EXPECT_TRUE(exists(first + "/report/" + png)) << png << "\n" << rout;
   EXPECT_TRUE(exists(first + "/report/summary.md"));
-  EXPECT_NE(rout.find(ids[0] + ": exported 6 CSV files"), std::string::npos) << rout;
+  EXPECT_NE(rout.find(ids[0] + ": exported 7 CSV files"), std::string::npos) << rout;  // + /robot_info
   EXPECT_NE(readFile(first + "/csv/telemetry.csv").find("pose.x_m"), std::string::npos);
   EXPECT_NE(rout.find("replay of " + ids[0] + " done"), std::string::npos) << rout;
   EXPECT_NE(rout.find("| TELEOP |"), std::string::npos) << rout;

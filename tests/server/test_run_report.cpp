@@ -326,8 +326,11 @@ TEST_F(RunReport, GasMapsWithAlarmsWallsAndTheLeakEstimate) {
   EXPECT_GT(ch4->max_value, 10.0);
   const auto* o2 = leakOf(res, "O2");
   ASSERT_NE(o2, nullptr);
-  ASSERT_TRUE(o2->found) << o2->note;  // the deficit, fitted as a falling channel
-  EXPECT_LT(std::hypot(o2->x_m - kLeakX, o2->y_m - kLeakY), 0.7);
+  // O2 dips near the leak (displaced) but never below its A1 (19.5 %vol): no
+  // source is estimated from it (falling channels are fitted as a deficit:
+  // tests/gas LeakEstimator.FallingChannelFitsTheDeficit); its map still shows the dip.
+  EXPECT_FALSE(o2->found);
+  EXPECT_NE(o2->note.find("never reached A1"), std::string::npos) << o2->note;
   EXPECT_LT(std::hypot(o2->peak_x_m - kLeakX, o2->peak_y_m - kLeakY), 1.5);  // the lowest cell
   const auto* h2s = leakOf(res, "H2S");
   ASSERT_NE(h2s, nullptr);
