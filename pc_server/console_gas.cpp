@@ -73,7 +73,9 @@ bool Console::cmdInspect(const Args& args, const std::string&, int) {
   out_ << "inspection '" << r.name << "': " << r.points.size() << " points, " << r.inspectionPoints()
        << " inspection points" << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string())
        << (r.map.empty() ? std::string() : ", map " + r.map) << "\n";
-  return sendAndReport("inspect", std::move(c), true);
+  const bool ok = sendAndReport("inspect", std::move(c), true);
+  if (!ok && recorder_) recorder_->setRunMap(*robot, "");  // refused: no run to attach the map to
+  return ok;
 }
 
 bool Console::cmdAlarms(const Args& args, const std::string&, int) {

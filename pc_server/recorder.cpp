@@ -117,8 +117,16 @@ void Recorder::setHelloSource(std::function<std::optional<v1::Hello>(const std::
 
 void Recorder::setRunMap(const std::string& robot, const std::string& map_path) {
   std::lock_guard lk(mu_);
+  if (map_path.empty()) {  // the command that would have started the run was refused
+    pending_map_.erase(robot);
+    return;
+  }
   if (auto it = runs_.find(robot); it != runs_.end()) {
-    catalog_->addFile(it->second->info.id, "map", map_path, fileBytes(map_path));
+    try {
+      catalog_->addFile(it->second->info.id, "map", map_path, fileBytes(map_path));
+    } catch (const std::exception& e) {
+      log::error(kTag, robot, ": run map not in the catalog: ", e.what());
+    }
     return;
   }
   pending_map_[robot] = map_path;
@@ -139,9 +147,13 @@ void Recorder::noteAlarmAck(const std::string& robot, const v1::GasAlarm& a, con
   std::lock_guard lk(mu_);
   auto it = runs_.find(robot);
   const std::string run_id = it == runs_.end() ? "" : it->second->info.id;
-  if (it != runs_.end()) noteLocked(*it->second, robot, text);
-  catalog_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), alarmLevelName(a.level()),
-                     "acked", a.value(), a.pose().x_m(), a.pose().y_m());
+  try {
+    if (it != runs_.end()) noteLocked(*it->second, robot, text);
+    catalog_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), alarmLevelName(a.level()),
+                       "acked", a.value(), a.pose().x_m(), a.pose().y_m());
+  } catch (const std::exception& e) {
+    log::error(kTag, robot, ": alarm acknowledgement not recorded: ", e.what());
+  }
 }
 
 void Recorder::setVideoFigures(std::function<std::optional<VideoFigures>(const std::string&)> f) {

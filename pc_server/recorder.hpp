@@ -66,7 +66,7 @@ class Recorder {
   void setHelloSource(std::function<std::optional<v1::Hello>(const std::string& robot)> f);
   /// The site map (world file) of the robot's current run, or of its next one
   /// when none is running (`inspect` with a route that names a map); listed
-  /// as the run's "map" file, which reports draw.
+  /// as the run's "map" file, which reports draw. "" forgets a pending one.
   void setRunMap(const std::string& robot, const std::string& map_path);
   /// The operator acknowledged a gas alarm: /server_event and the catalog's alarms.
   void noteAlarmAck(const std::string& robot, const v1::GasAlarm& alarm, const std::string& text);

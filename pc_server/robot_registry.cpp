@@ -4,6 +4,14 @@
 
 namespace inspect::server {
 
+namespace {
+// One occurrence: the robot's id, and its channel and level (ids start over
+// when robot_client restarts).
+bool sameAlarm(const v1::GasAlarm& a, const v1::GasAlarm& b) {
+  return a.id() == b.id() && a.channel() == b.channel() && a.level() == b.level();
+}
+}  // namespace
+
 RobotRegistry::Entry* RobotRegistry::current(const std::string& id, uint64_t serial) {
   const auto it = robots_.find(id);
   if (it == robots_.end() || it->second.serial != serial || !it->second.connected) return nullptr;
@@ -49,18 +57,31 @@ void RobotRegistry::onTelemetry(const std::string& id, uint64_t serial, const v1
   for (const auto& a : t.active_alarms()) {
     bool known = false;
     for (auto& r : alarms_) {
-      if (r.robot_id != id || !r.active() || r.alarm.id() != a.id()) continue;
+      if (r.robot_id != id || !r.active() || !sameAlarm(r.alarm, a)) continue;
       known = true;
       // The reading now and the worst so far; where and when it was raised stay.
       r.alarm.set_value(a.value());
       r.alarm.set_peak(a.peak());
     }
-    if (!known) noteAlarmLocked(id, a, now_ns);
+    if (!known) {
+      noteAlarmLocked(id, a, now_ns);
+      // Its raise event never came (link down, server restarted): say so on the console.
+      v1::Event ev;
+      ev.set_kind(v1::Event::ALARM_RAISED);
+      ev.set_text("gas " + a.channel_name() + " " + (a.level() == v1::GasAlarm::HIGH ? "HIGH" : a.level() == v1::GasAlarm::LOW ? "LOW" : "SENSOR_FAULT " + a.fault()) +
+                  " alarm in force (learnt from telemetry: its raise event was not received)");
+      *ev.mutable_gas_alarm() = a;
+      pending_.push_back({id, ev});
+      if (pending_.size() > kMaxPendingEvents) {
+        pending_.pop_front();
+        ++dropped_events_;
+      }
+    }
   }
   for (auto& r : alarms_) {
     if (r.robot_id != id || !r.active()) continue;
     bool listed = false;
-    for (const auto& a : t.active_alarms()) listed |= a.id() == r.alarm.id();
+    for (const auto& a : t.active_alarms()) listed |= sameAlarm(a, r.alarm);
     if (!listed && now_ns - r.raised_ns > 1'000'000'000) {  // not a raise still in flight
       r.cleared_ns = now_ns;
       r.alarm.set_active(false);
@@ -72,9 +93,15 @@ void RobotRegistry::onTelemetry(const std::string& id, uint64_t serial, const v1
 
 void RobotRegistry::noteAlarmLocked(const std::string& id, const v1::GasAlarm& a, int64_t now_ns) {
   for (auto it = alarms_.rbegin(); it != alarms_.rend(); ++it) {
-    if (it->robot_id != id || !it->active() || it->alarm.id() != a.id()) continue;
+    if (it->robot_id != id || !it->active() || !sameAlarm(it->alarm, a)) continue;
+    // The clear brings the reading then and the worst one; where the alarm was
+    // raised (pose) and its threshold stay those of the raise.
+    const v1::Pose2D raised_at = it->alarm.pose();
     it->alarm = a;
-    if (!a.active()) it->cleared_ns = now_ns;
+    if (!a.active()) {
+      it->cleared_ns = now_ns;
+      *it->alarm.mutable_pose() = raised_at;
+    }
     return;
   }
   if (!a.active()) return;  // the clear of an alarm never seen raised (or already resynced away)

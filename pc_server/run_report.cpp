@@ -692,8 +692,17 @@ std::vector<GasMapOutcome> gasMaps(const RunReportInput& in, const Frame& frame,
     options.falling = ch.falling;
     // A leak worth locating raised the channel to its A1 level at least once;
     // below it the "plume" is noise, cross-sensitivity or a stuck sensor.
+    // With the robot's alarm events in the run: an A1 or A2 alarm raised on
+    // the channel (filtered, minimum duration: not a noise spike, not a stuck
+    // reading). Without any (older runs): the readings' extreme.
+    bool any_alarms = false, raised = false;
+    for (const auto& [t, a] : in.gas_alarms) {
+      any_alarms = true;
+      raised |= static_cast<int>(a.channel()) == ch.index && a.active() &&
+                (a.level() == v1::GasAlarm::LOW || a.level() == v1::GasAlarm::HIGH);
+    }
     const bool reached_a1 = !ch.known || std::isnan(ch.alarm_low) ||
-                            (ch.falling ? ch.min <= ch.alarm_low : ch.max >= ch.alarm_low);
+                            (any_alarms ? raised : (ch.falling ? ch.min <= ch.alarm_low : ch.max >= ch.alarm_low));
     if (reached_a1) {
       o.leak = gas::estimateLeak(raw, ch.tau_s(), ch.background, bounds, options);
     } else {

@@ -178,6 +178,7 @@ int runServer(const CliOptions& options) {
     Console console(registry, link, std::cout, stop, copt);
     console.setVideo(video.get());
     console.setRecorder(recorder.get());
+    console.setAlarmStyle(::isatty(STDOUT_FILENO) == 1);  // red + bell on a terminal, plain text into pipes
     ConsoleRunner runner(console, stop, config.status_refresh_hz);
     switch (mode) {
       case ConsoleMode::kNone:

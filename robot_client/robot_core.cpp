@@ -150,6 +150,7 @@ void RobotCore::startRetreat(const std::string& why) {
   goal_info_.assign(goals_.size(), GoalInfo{});
   goal_index_ = 0;
   dwell_left_s_ = 0.0;
+  final_dwell_ = false;
   gas_hold_ = false;
   retreating_ = true;
   retreat_reason_ = why;
@@ -165,6 +166,7 @@ void RobotCore::arriveAt(std::size_t i) {
   if (g.has_ptz) ptz_out_.push_back(g.ptz);
   if (g.dwell_s > 0.0) {
     dwell_left_s_ = g.dwell_s;
+    dwell_label_ = g.label;
     char buf[160];
     std::snprintf(buf, sizeof buf, "inspection point %zu/%zu%s%s%s: dwelling %.1f s", i + 1, goals_.size(),
                   g.label.empty() ? "" : " '", g.label.c_str(), g.label.empty() ? "" : "'", g.dwell_s);
@@ -306,6 +308,8 @@ void RobotCore::endAutonomy() {
   nav_command_id_ = 0;
   nav_twist_ = {};
   dwell_left_s_ = 0.0;
+  final_dwell_ = false;
+  dwell_label_.clear();
   gas_hold_ = retreating_ = false;
 }
 
@@ -316,6 +320,11 @@ control::Twist RobotCore::navigationTwist(double dt_s) {
     // point (the dwell runs down; the stall clock does not run).
     if (!gas_hold_) dwell_left_s_ = std::max(0.0, dwell_left_s_ - dt_s);
     nav_twist_ = {};
+    if (dwell_left_s_ == 0.0 && final_dwell_ && !gas_hold_) {  // the last point's dwell is over
+      acks_.push_back(ackOf(nav_command_id_, v1::Ack::COMPLETED));
+      endAutonomy();
+      setMode(v1::IDLE, "route completed");
+    }
     return nav_twist_;
   }
   // People are not obstacles to steer round: their echoes get the Eq 9 factor
@@ -365,9 +374,7 @@ control::Twist RobotCore::navigationTwist(double dt_s) {
       }
     } else if (dwell_left_s_ > 0.0) {
       // The last point has a dwell: stay on it (goal_index_ = goal count), then complete.
-      --goal_index_;
-      goal_info_[goal_index_].dwell_s = 0.0;
-      goal_info_[goal_index_].has_ptz = false;
+      final_dwell_ = true;
       nav_twist_ = {};
       return nav_twist_;
     } else {
@@ -663,11 +670,13 @@ serial::WheelCommand RobotCore::commandNow() { return computeCommand(0.0); }
 
 std::optional<serial::WheelCommand> RobotCore::onTimer(double now_s) {
   checkTimeouts(now_s);
-  if (faults_ & v1::FAULT_SENSOR_STALE) {
-    gas_.noFrames(gas_clock_s_ + (now_s - last_frame_s_), gas_out_);  // no frames, no gas readings
+  // No frames (stale, or the serial device closed after frames had come): no
+  // gas readings either - the channels go to no_data after 0.5 s.
+  if ((faults_ & (v1::FAULT_SENSOR_STALE | v1::FAULT_SERIAL_DOWN)) && last_frame_s_ >= 0.0) {
+    gas_.noFrames(gas_clock_s_ + (now_s - last_frame_s_), gas_out_);
     if (!gas_out_.empty()) onGasTransitions(now_s);
-    return computeCommand(0.01);
   }
+  if (faults_ & v1::FAULT_SENSOR_STALE) return computeCommand(0.01);
   return std::nullopt;
 }
 
@@ -751,7 +760,10 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
                  : retreating_     ? "RETREAT"
                                    : navigation::toString(navigator_->output().mode));
   t.set_dwell_remaining_s(nav ? dwell_left_s_ : 0.0);
-  t.set_waypoint_label(nav && goal_index_ < goal_info_.size() ? goal_info_[goal_index_].label : "");
+  t.set_waypoint_label(!nav                ? ""
+                       : dwell_left_s_ > 0.0 ? dwell_label_  // the point it stands at
+                       : goal_index_ < goal_info_.size() ? goal_info_[goal_index_].label
+                                                         : "");
   t.set_goal_distance_m(goal_distance_m_);
   t.set_goal_index(static_cast<uint32_t>(goal_index_));
   t.set_goal_count(static_cast<uint32_t>(goals_.size()));

@@ -183,6 +183,8 @@ class RobotCore {
   bool route_inspection_ = false;
   navigation::Vec2 route_start_;      // where the route began (retreat target)
   double dwell_left_s_ = 0.0;         // > 0: dwelling at the goal just reached
+  std::string dwell_label_;           // its label
+  bool final_dwell_ = false;          // dwelling at the last point: the route completes after it
   bool gas_hold_ = false;             // stopped and holding after a gas HIGH alarm
   bool retreating_ = false;           // going back after a gas HIGH alarm
   std::string retreat_reason_;

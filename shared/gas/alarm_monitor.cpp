@@ -83,7 +83,8 @@ void AlarmMonitor::step(int i, bool have, uint16_t raw, double now_s, std::vecto
         out);
   if (no_data) {
     c.raw_since_s = -1.0;  // stuck detection starts over with the next reading
-    c.filtered = nan;      // and the filter
+    c.filtered = nan;      // and the filter, and the raise/clear timers of the gas alarms
+    c.low.pending_since = c.high.pending_since = -1.0;
     return;                // gas alarms hold their state: no reading, no all-clear
   }
   // First-order low-pass (exact for any frame interval): the thresholds see
@@ -96,8 +97,10 @@ void AlarmMonitor::step(int i, bool have, uint16_t raw, double now_s, std::vecto
   }
   c.filtered_t_s = now_s;
 
-  // Stuck: a live sensor's reading always moves by a count or more within stuck_s.
-  if (c.raw_since_s < 0.0 || raw != c.last_raw) {
+  // Stuck: a live sensor's reading always moves by a count or more within
+  // stuck_s - except at the bottom of its range, where a sensor with zero
+  // suppression reads exactly range_min in clean air.
+  if (c.raw_since_s < 0.0 || raw != c.last_raw || c.value <= cfg.range_min) {
     c.last_raw = raw;
     c.raw_since_s = now_s;
   }
@@ -108,7 +111,10 @@ void AlarmMonitor::step(int i, bool have, uint16_t raw, double now_s, std::vecto
   const bool outside = c.value > cfg.range_max || c.value < cfg.range_min;
   latch(c.range, i, AlarmLevel::SensorFault, "out_of_range", outside, !outside, 0.0, c.value, cfg.min_duration_s,
         now_s, out);
-  if (c.stuck.active) return;  // a frozen reading can neither raise nor clear a gas alarm
+  if (c.stuck.active) {  // a frozen reading can neither raise nor clear a gas alarm
+    c.low.pending_since = c.high.pending_since = -1.0;
+    return;
+  }
 
   // A1 and A2 with hysteresis: raised beyond the threshold, cleared once back past it by `hysteresis`.
   const double back = cfg.direction == config::AlarmDirection::Rising ? -cfg.hysteresis : cfg.hysteresis;

@@ -215,3 +215,30 @@ TEST(AlarmMonitor, OutOfRangeIsAFaultAndStillAlarms) {
   for (const auto& a : r.out) saw |= std::string(a.fault) == "out_of_range";
   EXPECT_TRUE(saw);
 }
+
+TEST(AlarmMonitor, CleanAirAtZeroIsNotStuck) {
+  // A sensor with zero suppression reads exactly 0 in clean air for minutes.
+  AlarmMonitor m(cfg());
+  std::vector<AlarmTransition> out;
+  for (int k = 0; k < 6000; ++k) {
+    const std::array<uint16_t, 4> f{0, 0, 0, static_cast<uint16_t>(2090 + k % 2)};
+    m.update(f, k * kDt, out);
+  }
+  EXPECT_TRUE(out.empty()) << gas::levelName(out.front().level) << " " << out.front().fault;
+}
+
+TEST(AlarmMonitor, ADropoutRestartsTheRaiseTimer) {
+  // 0.8 s above A1, a 0.6 s dropout, then 0.3 s above A1: never 1 s in a row.
+  Feed r;
+  r.feed(1.0, 0.0);
+  r.feed(1.7, 12.0);  // the filter crosses 10 after 0.9 s: 0.8 s of the 1 s counted
+  for (int i = 0; i < 60; ++i, r.t += kDt, ++r.k) {
+    auto f = frame(12.0, r.k);
+    f[0] = config::kGasNoData;
+    r.m.update(f, r.t, r.out);
+  }
+  const auto faults = r.count(AlarmLevel::SensorFault, true);
+  r.feed(0.3, 12.0);
+  EXPECT_EQ(r.count(AlarmLevel::Low, true), 0) << "the timer started over after the dropout";
+  EXPECT_EQ(faults, 1);
+}

@@ -107,7 +107,9 @@ v1::Event alarmEvent(uint64_t id, const std::string& ch, v1::GasAlarm::Level lev
 TEST(RobotRegistryAlarms, RaiseUpdateClearAndAcknowledge) {
   RobotRegistry reg;
   reg.onConnected("r", "a:1", 1, hello("r"), 0);
-  reg.onEvent("r", 1, alarmEvent(7, "H2S", v1::GasAlarm::HIGH, true, 11.0), kSec);
+  auto raise = alarmEvent(7, "H2S", v1::GasAlarm::HIGH, true, 11.0);
+  raise.mutable_gas_alarm()->mutable_pose()->set_x_m(2.5);
+  reg.onEvent("r", 1, raise, kSec);
   auto list = reg.alarms(false);
   ASSERT_EQ(list.size(), 1u);
   EXPECT_EQ(list[0].number, 1);
@@ -126,6 +128,8 @@ TEST(RobotRegistryAlarms, RaiseUpdateClearAndAcknowledge) {
   ASSERT_EQ(list.size(), 1u) << "cleared but unacknowledged: still listed";
   EXPECT_FALSE(list[0].active());
   EXPECT_EQ(list[0].cleared_ns - list[0].raised_ns, 4 * kSec);
+  EXPECT_DOUBLE_EQ(list[0].alarm.pose().x_m(), 2.5) << "where it was raised, not where it cleared";
+  EXPECT_DOUBLE_EQ(list[0].alarm.value(), 8.0) << "the reading at the clear";
   EXPECT_EQ(reg.unackedAlarms(), 0) << "only active ones count";
   const auto acked = reg.ackAlarm(1, 6 * kSec);
   ASSERT_TRUE(acked);
@@ -142,6 +146,11 @@ TEST(RobotRegistryAlarms, TelemetryResyncsMissedRaisesAndClears) {
   *t.add_active_alarms() = alarmEvent(3, "CH4", v1::GasAlarm::LOW, true, 12.0).gas_alarm();
   reg.onTelemetry("r", 1, t, kSec);  // the raise event was lost (e.g. the server restarted)
   ASSERT_EQ(reg.alarms(false).size(), 1u);
+  const auto ev = reg.takeEvents();  // ...and the console still hears of it
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].event.kind(), v1::Event::ALARM_RAISED);
+  EXPECT_NE(ev[0].event.text().find("gas CH4 LOW alarm in force (learnt from telemetry"), std::string::npos)
+      << ev[0].event.text();
   reg.onTelemetry("r", 1, t, kSec + 1000);
   EXPECT_EQ(reg.alarms(true).size(), 1u) << "known by id: not added twice";
   t.clear_active_alarms();
