@@ -12,15 +12,6 @@ namespace inspect::server {
 
 namespace {
 
-const char* levelText(v1::GasAlarm::Level l) {
-  switch (l) {
-    case v1::GasAlarm::LOW: return "LOW";
-    case v1::GasAlarm::HIGH: return "HIGH";
-    case v1::GasAlarm::SENSOR_FAULT: return "SENSOR_FAULT";
-    default: return "?";
-  }
-}
-
 std::string value(double v, const std::string& unit) {
   return (std::isnan(v) ? std::string("--") : fmtShort(v, 2)) + (unit.empty() ? "" : " " + unit);
 }
@@ -28,7 +19,8 @@ std::string value(double v, const std::string& unit) {
 // "#3 robot1 H2S HIGH 12.3 ppm (A2 10 ppm, worst 15.1 ppm) at (2.10, 2.95): raised 14.2 s ago, active, unacknowledged"
 std::string alarmLine(const AlarmRecord& r, int64_t now_ns) {
   const auto& a = r.alarm;
-  std::string s = "#" + std::to_string(r.number) + " " + r.robot_id + " " + a.channel_name() + " " + levelText(a.level());
+  std::string s = "#" + std::to_string(r.number) + " " + r.robot_id + " " + a.channel_name() + " " +
+                  v1::GasAlarm::Level_Name(a.level());
   if (a.level() == v1::GasAlarm::SENSOR_FAULT) {
     s += " " + a.fault() + " (reading " + value(a.value(), a.unit()) + ")";
   } else {
@@ -114,7 +106,7 @@ bool Console::cmdAck(const Args& args, const std::string&, int) {
   }
   for (const auto& r : done) {
     const std::string text = "alarm #" + std::to_string(r.number) + " (" + r.alarm.channel_name() + " " +
-                             levelText(r.alarm.level()) + ") acknowledged by the operator";
+                             v1::GasAlarm::Level_Name(r.alarm.level()) + ") acknowledged by the operator";
     out_ << r.robot_id << ": " << text << "\n";
     if (recorder_) recorder_->noteAlarmAck(r.robot_id, r.alarm, text);
   }

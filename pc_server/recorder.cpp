@@ -132,16 +132,6 @@ void Recorder::setRunMap(const std::string& robot, const std::string& map_path) 
   pending_map_[robot] = map_path;
 }
 
-namespace {
-const char* alarmLevelName(v1::GasAlarm::Level l) {
-  switch (l) {
-    case v1::GasAlarm::LOW: return "LOW";
-    case v1::GasAlarm::HIGH: return "HIGH";
-    case v1::GasAlarm::SENSOR_FAULT: return "SENSOR_FAULT";
-    default: return "?";
-  }
-}
-}  // namespace
 
 void Recorder::noteAlarmAck(const std::string& robot, const v1::GasAlarm& a, const std::string& text) {
   std::lock_guard lk(mu_);
@@ -149,7 +139,7 @@ void Recorder::noteAlarmAck(const std::string& robot, const v1::GasAlarm& a, con
   const std::string run_id = it == runs_.end() ? "" : it->second->info.id;
   try {
     if (it != runs_.end()) noteLocked(*it->second, robot, text);
-    catalog_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), alarmLevelName(a.level()),
+    catalog_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), v1::GasAlarm::Level_Name(a.level()),
                        "acked", a.value(), a.pose().x_m(), a.pose().y_m());
   } catch (const std::exception& e) {
     log::error(kTag, robot, ": alarm acknowledgement not recorded: ", e.what());
@@ -311,7 +301,7 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
     const auto& a = env.event().gas_alarm();
     try {
       catalog_->addAlarm(it == runs_.end() ? "" : it->second->info.id, robot, std::chrono::system_clock::now(),
-                         a.channel_name(), alarmLevelName(a.level()), a.active() ? "raised" : "cleared", a.value(),
+                         a.channel_name(), v1::GasAlarm::Level_Name(a.level()), a.active() ? "raised" : "cleared", a.value(),
                          a.pose().x_m(), a.pose().y_m());
     } catch (const std::exception& e) {
       log::error(kTag, robot, ": alarm not in the catalog: ", e.what());

@@ -68,7 +68,8 @@ void RobotRegistry::onTelemetry(const std::string& id, uint64_t serial, const v1
       // Its raise event never came (link down, server restarted): say so on the console.
       v1::Event ev;
       ev.set_kind(v1::Event::ALARM_RAISED);
-      ev.set_text("gas " + a.channel_name() + " " + (a.level() == v1::GasAlarm::HIGH ? "HIGH" : a.level() == v1::GasAlarm::LOW ? "LOW" : "SENSOR_FAULT " + a.fault()) +
+      ev.set_text("gas " + a.channel_name() + " " + v1::GasAlarm::Level_Name(a.level()) +
+                  (a.fault().empty() ? "" : " " + a.fault()) +
                   " alarm in force (learnt from telemetry: its raise event was not received)");
       *ev.mutable_gas_alarm() = a;
       pending_.push_back({id, ev});
@@ -79,12 +80,14 @@ void RobotRegistry::onTelemetry(const std::string& id, uint64_t serial, const v1
     }
   }
   for (auto& r : alarms_) {
+    if (e->active_alarms == 0) break;
     if (r.robot_id != id || !r.active()) continue;
     bool listed = false;
     for (const auto& a : t.active_alarms()) listed |= sameAlarm(a, r.alarm);
     if (!listed && now_ns - r.raised_ns > 1'000'000'000) {  // not a raise still in flight
       r.cleared_ns = now_ns;
       r.alarm.set_active(false);
+      --e->active_alarms;
     }
   }
   e->rx_times_ns.push_back(now_ns);
@@ -101,6 +104,7 @@ void RobotRegistry::noteAlarmLocked(const std::string& id, const v1::GasAlarm& a
     if (!a.active()) {
       it->cleared_ns = now_ns;
       *it->alarm.mutable_pose() = raised_at;
+      --robots_[id].active_alarms;
     }
     return;
   }
@@ -111,6 +115,7 @@ void RobotRegistry::noteAlarmLocked(const std::string& id, const v1::GasAlarm& a
   r.alarm = a;
   r.raised_ns = now_ns;
   alarms_.push_back(std::move(r));
+  ++robots_[id].active_alarms;
   // Drop the oldest finished ones beyond the bound (active alarms are never dropped).
   while (alarms_.size() > kMaxAlarms) {
     auto it = std::find_if(alarms_.begin(), alarms_.end(), [](const AlarmRecord& x) { return !x.active(); });

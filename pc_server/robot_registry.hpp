@@ -112,6 +112,7 @@ class RobotRegistry {
     std::map<uint64_t, v1::Ack> acks;
     std::deque<v1::Event> events;
     v1::Hello hello;
+    int active_alarms = 0;  // records in alarms_ still active: the 50 Hz resync skips the book when 0
   };
   Entry* current(const std::string& id, uint64_t serial);
   RobotSnapshot makeSnapshot(const std::string& id, const Entry& e, int64_t now_ns) const;

@@ -90,28 +90,33 @@ std::vector<v1::Ptz> RobotCore::takePtz() {
   return out;
 }
 
+void RobotCore::gasAlarmOf(const gas::AlarmTransition& t, double age_s, double now_s, v1::GasAlarm& a) const {
+  const auto& ch = gas_.config().channels[static_cast<std::size_t>(t.channel)];
+  a.set_id(t.id);
+  a.set_channel(static_cast<uint32_t>(t.channel));
+  a.set_channel_name(ch.name);
+  a.set_level(t.level == gas::AlarmLevel::Low    ? v1::GasAlarm::LOW
+              : t.level == gas::AlarmLevel::High ? v1::GasAlarm::HIGH
+                                                 : v1::GasAlarm::SENSOR_FAULT);
+  a.set_active(t.active);
+  a.set_value(t.value);
+  a.set_threshold(t.threshold);
+  a.set_unit(ch.unit);
+  // The monitor's times are on the gas clock; the message's on the robot's.
+  a.set_since_us(static_cast<uint64_t>(std::max(0.0, now_s - age_s) * 1e6));
+  a.set_fault(t.fault);
+  a.set_peak(t.peak);
+}
+
 void RobotCore::onGasTransitions(double now_s) {
   for (const auto& t : gas_out_) {
     const auto& ch = gas_.config().channels[static_cast<std::size_t>(t.channel)];
     v1::GasAlarm a;
-    a.set_id(t.id);
-    a.set_channel(static_cast<uint32_t>(t.channel));
-    a.set_channel_name(ch.name);
-    a.set_level(t.level == gas::AlarmLevel::Low    ? v1::GasAlarm::LOW
-                : t.level == gas::AlarmLevel::High ? v1::GasAlarm::HIGH
-                                                   : v1::GasAlarm::SENSOR_FAULT);
-    a.set_active(t.active);
-    a.set_value(t.value);
-    a.set_threshold(t.threshold);
-    a.set_unit(ch.unit);
+    gasAlarmOf(t, t.t_s - t.since_s, now_s, a);
     a.mutable_pose()->set_x_m(pose_.x_m);
     a.mutable_pose()->set_y_m(pose_.y_m);
     a.mutable_pose()->set_theta_rad(pose_.theta_rad);
-    // The monitor's times are on the gas clock; the message's on the robot's.
-    a.set_since_us(static_cast<uint64_t>(std::max(0.0, now_s - (t.t_s - t.since_s)) * 1e6));
     a.set_robot_time_us(static_cast<uint64_t>(now_s * 1e6));
-    a.set_fault(t.fault);
-    a.set_peak(t.peak);
     char text[200];
     if (t.level == gas::AlarmLevel::SensorFault)
       std::snprintf(text, sizeof text, "gas sensor %s fault %s: %s at (%.2f, %.2f)", ch.name.c_str(),
@@ -701,26 +706,9 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
   t.clear_gas();
   for (int i = 0; i < gas_.channels(); ++i) t.add_gas(gas_.value(i));  // NaN = no data
   t.clear_active_alarms();
-  if (gas_.channels() > 0) {
-    std::vector<gas::AlarmTransition> act;
-    gas_.active(act);
-    for (const auto& a : act) {
-      auto* x = t.add_active_alarms();
-      x->set_id(a.id);
-      x->set_channel(static_cast<uint32_t>(a.channel));
-      x->set_channel_name(gas_.config().channels[static_cast<std::size_t>(a.channel)].name);
-      x->set_level(a.level == gas::AlarmLevel::Low    ? v1::GasAlarm::LOW
-                   : a.level == gas::AlarmLevel::High ? v1::GasAlarm::HIGH
-                                                      : v1::GasAlarm::SENSOR_FAULT);
-      x->set_active(true);
-      x->set_value(a.value);
-      x->set_threshold(a.threshold);
-      x->set_unit(gas_.config().channels[static_cast<std::size_t>(a.channel)].unit);
-      x->set_since_us(static_cast<uint64_t>(std::max(0.0, now_s - (gas_clock_s_ - a.since_s)) * 1e6));
-      x->set_fault(a.fault);
-      x->set_peak(a.peak);
-    }
-  }
+  gas_active_.clear();  // reused: no allocation per telemetry message once grown
+  gas_.active(gas_active_);
+  for (const auto& a : gas_active_) gasAlarmOf(a, gas_clock_s_ - a.since_s, now_s, *t.add_active_alarms());
   t.set_battery_v(last_frame_.battery_mv * 1e-3);
   t.set_mode(mode_);
   t.set_faults(faults_);

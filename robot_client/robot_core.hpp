@@ -100,6 +100,9 @@ class RobotCore {
   void raise(uint32_t fault, const std::string& why);
   void clear(uint32_t fault, const std::string& why);
   void latchFailsafe(const std::string& why);
+  /// The proto form of a monitor transition or alarm in force (`age_s` since
+  /// it was raised; pose and robot_time_us are the caller's).
+  void gasAlarmOf(const gas::AlarmTransition& t, double age_s, double now_s, v1::GasAlarm& a) const;
   /// Announces gas alarm transitions and applies the configured reaction.
   void onGasTransitions(double now_s);
   /// The navigation goal `i` was reached: dwell, PTZ preset.
@@ -194,6 +197,7 @@ class RobotCore {
   gas::AlarmMonitor gas_;
   double gas_clock_s_ = 0.0;  // MCU time since the first frame (the alarm monitor's clock)
   std::vector<gas::AlarmTransition> gas_out_;
+  mutable std::vector<gas::AlarmTransition> gas_active_;  // fillTelemetry's scratch
 
   // Human awareness.
   std::unique_ptr<behavior::HumanAwareness> awareness_;
