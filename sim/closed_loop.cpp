@@ -18,7 +18,8 @@ double convergenceTime(const std::vector<double>& t, const std::vector<double>& 
 ClosedLoopResult runClosedLoop(const ClosedLoopConfig& cfg, std::unique_ptr<control::ReferencePath> path,
                                std::shared_ptr<control::FuzzyGainScheduler> scheduler, bool keep_samples) {
   const World empty{};
-  const RobotPlant plant(cfg.robot, empty);
+  const RobotPlant plant(cfg.robot, empty, cfg.plant ? *cfg.plant : nominalPlant(cfg.robot));
+  control::SetpointDelay delay(plant.motors().left.dead_time_s, plant.motors().right.dead_time_s);
   const double path_time = [&] {
     // Nominal duration: integrate ds / v over the path.
     double t = 0, s = 0;
@@ -61,7 +62,8 @@ ClosedLoopResult runClosedLoop(const ClosedLoopConfig& cfg, std::unique_ptr<cont
   control::WheelSpeeds prev_cmd{};
   for (int k = 0; k < ticks; ++k) {
     const double t = (k + 1) * cfg.control_dt_s;
-    for (int i = 0; i < substeps; ++i) st = plant.step(st, cmd, phys_dt).state;
+    for (int i = 0; i < substeps; ++i)
+      st = plant.step(st, delay.apply((k * substeps + i) * phys_dt, cmd), phys_dt).state;
     // What the MCU reports: noisy wheel speeds and heading, exact travel.
     const double dl = st.wheel_travel_left_m - travel_l, dr = st.wheel_travel_right_m - travel_r;
     travel_l = st.wheel_travel_left_m;

@@ -7,10 +7,12 @@
 // the tuner.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "shared/config/robot_config.hpp"
+#include "shared/control/plant_model.hpp"
 #include "shared/control/trajectory_tracker.hpp"
 
 namespace inspect::sim {
@@ -21,6 +23,7 @@ struct ClosedLoopConfig {
   double control_dt_s = 0.01;     // the paper's sampling time
   double physics_dt_s = 0.001;    // plant integration step
   double extra_time_s = 0.0;      // keep simulating (reference parked) after the path ends
+  std::optional<control::PlantModel> plant;  // the true motors; nominalPlant(robot) when empty
   bool noise = true;
   uint32_t seed = 1;
   double settle_position_m = 0.01;  // convergence bands (see docs/controllers.md)

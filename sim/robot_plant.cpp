@@ -20,23 +20,46 @@ MotorStep motorStep(double w0, double sp, double tau_s, double dt_s) {
 
 }  // namespace
 
+control::PlantModel nominalPlant(const config::RobotConfig& robot) {
+  control::WheelMotorModel m;
+  m.gain = 1.0;
+  m.time_constant_s = robot.motor.time_constant_s;
+  m.dead_time_s = 0.0;
+  m.saturation_rad_s = robot.limits.max_wheel_speed_rad_s;
+  return {m, m};
+}
+
+namespace {
+control::PlantModel worldPlant(const config::RobotConfig& robot, const World& world) {
+  if (!world.plant) return nominalPlant(robot);
+  control::PlantModel p = *world.plant;
+  for (auto* m : {&p.left, &p.right})
+    if (!(m->saturation_rad_s > 0.0)) m->saturation_rad_s = robot.limits.max_wheel_speed_rad_s;
+  return p;
+}
+}  // namespace
+
 RobotPlant::RobotPlant(const config::RobotConfig& robot, const World& world)
+    : RobotPlant(robot, world, worldPlant(robot, world)) {}
+
+RobotPlant::RobotPlant(const config::RobotConfig& robot, const World& world, const control::PlantModel& motors)
     : wheel_radius_m_(robot.geometry.wheel_radius_m),
       track_m_(robot.geometry.track_m),
       body_radius_m_(robot.geometry.body_radius_m),
-      time_constant_s_(robot.motor.time_constant_s),
-      max_wheel_rad_s_(robot.limits.max_wheel_speed_rad_s),
+      motors_(motors),
       world_(world) {}
 
 control::WheelSpeeds RobotPlant::clampSetpoint(const control::WheelSpeeds& sp) const {
-  auto clamp = [&](double v) { return std::isfinite(v) ? std::clamp(v, -max_wheel_rad_s_, max_wheel_rad_s_) : 0.0; };
-  return {clamp(sp.left_rad_s), clamp(sp.right_rad_s)};
+  auto clamp = [](double v, double lim) { return std::isfinite(v) ? std::clamp(v, -lim, lim) : 0.0; };
+  return {clamp(sp.left_rad_s, motors_.left.saturation_rad_s), clamp(sp.right_rad_s, motors_.right.saturation_rad_s)};
 }
 
 PlantStep RobotPlant::step(const PlantState& s, const control::WheelSpeeds& setpoint, double dt_s) const {
   const auto sp = clampSetpoint(setpoint);
-  const MotorStep l = motorStep(s.wheel.left_rad_s, sp.left_rad_s, time_constant_s_, dt_s);
-  const MotorStep r = motorStep(s.wheel.right_rad_s, sp.right_rad_s, time_constant_s_, dt_s);
+  const MotorStep l =
+      motorStep(s.wheel.left_rad_s, motors_.left.gain * sp.left_rad_s, motors_.left.time_constant_s, dt_s);
+  const MotorStep r =
+      motorStep(s.wheel.right_rad_s, motors_.right.gain * sp.right_rad_s, motors_.right.time_constant_s, dt_s);
   const double d_left_m = l.angle_rad * wheel_radius_m_;
   const double d_right_m = r.angle_rad * wheel_radius_m_;
 

@@ -5,9 +5,14 @@
 // next state out.
 #include "shared/config/robot_config.hpp"
 #include "shared/control/diff_drive.hpp"
+#include "shared/control/plant_model.hpp"
 #include "sim/world.hpp"
 
 namespace inspect::sim {
+
+/// The plant robot.yaml describes: both wheels gain 1, its motor time
+/// constant, no dead time, saturation at limits.max_wheel_speed_rad_s.
+control::PlantModel nominalPlant(const config::RobotConfig& robot);
 
 /// Physical state of the robot.
 struct PlantState {
@@ -27,19 +32,23 @@ struct PlantStep {
 /// Steps the robot's physics; holds only parameters and the (static) world.
 class RobotPlant {
  public:
+  /// The motors of `world.plant` when the world gives one, else the nominal
+  /// plant of the robot config (nominalPlant()).
   RobotPlant(const config::RobotConfig& robot, const World& world);
+  RobotPlant(const config::RobotConfig& robot, const World& world, const control::PlantModel& motors);
 
-  /// Advances `s` by dt_s toward the wheel set-points (clamped to +-max wheel speed).
+  /// Advances `s` by dt_s toward gain x the wheel set-points (clamped to
+  /// +-saturation). Dead time is the caller's (control::SetpointDelay).
   PlantStep step(const PlantState& s, const control::WheelSpeeds& setpoint, double dt_s) const;
   /// Set-point after the plant's speed limit.
   control::WheelSpeeds clampSetpoint(const control::WheelSpeeds& sp) const;
+  const control::PlantModel& motors() const { return motors_; }
 
  private:
   double wheel_radius_m_;
   double track_m_;
   double body_radius_m_;
-  double time_constant_s_;
-  double max_wheel_rad_s_;
+  control::PlantModel motors_;
   const World& world_;
 };
 

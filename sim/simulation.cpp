@@ -53,6 +53,7 @@ std::string fmtSeconds(double s) {
 Simulation::Simulation(const config::RobotConfig& robot, World world, uint64_t seed, SimObserver* observer)
     : world_(std::move(world)),
       plant_(robot, world_),
+      motor_delay_(plant_.motors().left.dead_time_s, plant_.motors().right.dead_time_s),
       ultrasonic_(robot.ultrasonic, subSeed(seed, 1)),
       mcu_(robot, subSeed(seed, 2), observer),
       observer_(observer),
@@ -222,7 +223,7 @@ void Simulation::step() {
     }
   }
   if (!people_wait_ || people_started_) crowd_.step(timeS() - people_t0_s_, dt_s, robotBody());
-  const auto r = plant_.step(state_, mcu_.setpoints(), dt_s);
+  const auto r = plant_.step(state_, motor_delay_.apply(timeS(), mcu_.setpoints()), dt_s);
   state_ = r.state;
   checkPersonContacts();
   if (r.blocked && !in_contact_) {

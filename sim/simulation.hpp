@@ -96,6 +96,7 @@ class Simulation {
 
   World world_;
   RobotPlant plant_;
+  control::SetpointDelay motor_delay_;  // the plant's dead time (world `plant:`)
   UltrasonicModel ultrasonic_;
   McuEmulator mcu_;
   SimObserver* observer_;

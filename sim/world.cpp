@@ -177,6 +177,24 @@ World loadWorld(const ConfigNode& root) {
   w.pedestrians = readPedestrianScripts(root, w);
   w.social_force = behavior::readSocialForceParams(root.optChild("social_force"));
   w.gas = readGasSpec(root, w);
+  if (root.has("plant")) {
+    // The robot's true hub motors; each wheel's keys default to the nominal
+    // motor (gain 1, no dead time); saturation 0 = the robot's wheel limit.
+    const auto p = root.child("plant");
+    control::PlantModel pm;
+    const double tau = p.number("time_constant_s", 0.20, 0.001, 5.0);
+    const double dead = p.number("dead_time_s", 0.0, 0.0, 1.0);
+    auto wheel = [&](const char* key, control::WheelMotorModel& m) {
+      const auto n = p.optChild(key);
+      m.gain = n.number("gain", 1.0, 0.2, 5.0);
+      m.time_constant_s = n.number("time_constant_s", tau, 0.001, 5.0);
+      m.dead_time_s = n.number("dead_time_s", dead, 0.0, 1.0);
+      m.saturation_rad_s = n.number("saturation_rad_s", 0.0, 0.0, 100.0);
+    };
+    wheel("left", pm.left);
+    wheel("right", pm.right);
+    w.plant = pm;
+  }
   return w;
 }
 

@@ -9,6 +9,7 @@
 #include "shared/behavior/social_force.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/control/diff_drive.hpp"
+#include "shared/control/plant_model.hpp"
 #include "sim/gas_spec.hpp"
 #include "sim/geometry.hpp"
 #include "sim/pedestrian_script.hpp"
@@ -39,6 +40,7 @@ struct World {
   std::vector<PedestrianScript> pedestrians;  // moved by the social force model
   behavior::SocialForceParams social_force;   // the `social_force` section (defaults when absent)
   GasSpec gas;                                // the `gas` section: leaks, dispersion, sensor faults
+  std::optional<control::PlantModel> plant;   // the `plant` section: the robot's true hub motors
 };
 
 /// An axis-aligned box, lo <= hi.
