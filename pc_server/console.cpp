@@ -98,14 +98,18 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  example: goto 2 0\n"
        "  example: goto 3.5 -1 0.3\n",
        &Console::cmdGoto},
-      {"route", "route <file>", "navigate through the waypoints of a route file, in order",
+      {"route", "route <file|name>", "navigate through the waypoints of a route file, or play its wheel test",
        "  The file is YAML (example: config/routes/warehouse_tour.yaml):\n"
        "    name: tour                          # optional, default: the file name\n"
        "    speed_m_s: 0.4                      # optional, default: the robot's (0.5 m/s)\n"
        "    waypoints_m: [x0, y0, x1, y1, ...]  # odometry frame, 1 to 100 points\n"
        "  A bad file is an error naming the file and the key. Acked like goto; COMPLETED after the\n"
        "  last point ('robot1: route completed'); goal_index counts the points reached.\n"
-       "  example: route config/routes/warehouse_tour.yaml\n",
+       "  A name without '/' is looked up as config/routes/<name>.yaml.\n"
+       "  A route with `wheel_test:` instead of points plays open-loop wheel steps and chirps for\n"
+       "  plant identification (mode WHEEL_TEST; recorded as a run; then `identify <run>`).\n"
+       "  example: route config/routes/warehouse_tour.yaml\n"
+       "  example: route identification\n",
        &Console::cmdRoute},
       {"inspect", "inspect <route> [speed_m_s]", "run a gas inspection route as a recorded run",
        "  <route> is a file or a name in config/routes/ (config/routes/<name>.yaml). The route's\n"
@@ -130,6 +134,39 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  that the operator has seen it (catalog and run).\n"
        "  example: ack 3\n",
        &Console::cmdAck},
+      {"identify", "identify <run-id>|last", "fit the hub-motor model to a recorded run (for tune)",
+       "  Fits each wheel's gain, time constant, dead time and saturation to the commanded and\n"
+       "  measured wheel speeds of the run's telemetry (an output-error fit), prints the model and\n"
+       "  its fit (100 % = perfect), saves <run>/plant.yaml and makes it the plant tune uses.\n"
+       "  'last' = the newest identification run. Record one with `route identification`.\n"
+       "  example: identify last\n",
+       &Console::cmdIdentify},
+      {"tune", "tune [key=value ...]", "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
+       "  Closed-loop simulations of the robot's own tracker on the plant (nominal, or the last\n"
+       "  `identify`), each candidate over plant variations x noise seeds; cost = weighted max/RMS\n"
+       "  position and angle error, convergence time, effort and saturation (docs/tuning.md).\n"
+       "  Options: ref=circle|line|waypoints radius=3.5 speed=0.5 laps=1 length=10\n"
+       "           params=kp,ki,kd,ke,kec,k1,k2,k3 (or all, adds a1,a2,a3) evals=1000\n"
+       "           plant=current|nominal|<run-id>|<plant.yaml> variations=4 seeds=2 threads=0 seed=1\n"
+       "           start=working|paper|tuned\n"
+       "  Shows a progress bar and the best cost; Ctrl-C stops and keeps the best so far. Then\n"
+       "  prints PID vs fuzzy-PID (paper gains) vs tuned, writes plots and summary.md into\n"
+       "  runs/tuning/<session>/, books the session in the catalog and makes the tuned set the\n"
+       "  working set (gains push sends it).\n"
+       "  example: tune evals=300 speed=0.5\n",
+       &Console::cmdTune},
+      {"gains", "gains show [robot] | gains set <name>=<value>...|paper|tuned|robot | gains push [robot] | "
+                "gains revert [robot] | gains export <file.yaml> | gains import <file.yaml>",
+       "the tracking gains: working set, push to a robot, revert, files",
+       "  show: working set, the robot's set in force (with its version), the paper's, the tuned.\n"
+       "  set: edit the working set (kp ki kd ke kec k1 k2 k3 a1 a2 a3; bounds are checked).\n"
+       "  push: send the working set; the robot checks it, applies it at its next control tick\n"
+       "    (also to a path being tracked) and answers with the version now in force, or why not.\n"
+       "  revert: push the set the robot had in force before its current one.\n"
+       "  export/import: a YAML file of the gains plus the .fis fuzzy system beside it; an\n"
+       "    imported .fis that differs from the loaded one is pushed with the gains.\n"
+       "  example: gains set kp=12 ki=3\n  example: gains push\n",
+       &Console::cmdGains},
       {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
        "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
        "  'robot1: no ack within 1 s' (the last two are errors).\n",
@@ -669,14 +706,24 @@ bool Console::cmdGoto(const Args& args, const std::string&, int) {
 }
 
 bool Console::cmdRoute(const Args& args, const std::string&, int) {
-  if (args.size() != 1) return fail("route", "needs one file: route <file>");
+  if (args.size() != 1) return fail("route", "needs one route: route <file|name>");
   Route r;
   try {
-    r = loadRouteFile(args[0]);
+    // A path is read as given (its own errors); a bare name is looked up in config/routes/.
+    const bool path = args[0].find('/') != std::string::npos || args[0].ends_with(".yaml");
+    r = loadRouteFile(path ? args[0] : resolveRoute(args[0]));
   } catch (const config::ConfigError& e) {
     return fail("route", e.what());
   }
   v1::Command c;
+  if (r.isWheelTest()) {
+    *c.mutable_wheel_test() = wheelTestOf(r);
+    double total = 0.0;
+    for (const auto& g : r.wheel_test) total += g.duration_s;
+    out_ << "wheel test '" << r.name << "': " << r.wheel_test.size() << " segments, " << fmtShort(total, 1)
+         << " s of open-loop steps and chirps (identify <run> fits the plant afterwards)\n";
+    return sendAndReport("route", std::move(c), true);
+  }
   *c.mutable_go_to() = goToOf(r);
   out_ << "route '" << r.name << "': " << r.points.size() << " points"
        << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string()) << "\n";

@@ -4,6 +4,7 @@
 // are reached through the registry (state) and a CommandSink (commands).
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -14,6 +15,7 @@
 #include "pc_server/robot_registry.hpp"
 #include "pc_server/stop_flag.hpp"
 #include "shared/catalog/catalog.hpp"
+#include "shared/control/gain_set.hpp"
 
 namespace inspect::server {
 
@@ -74,6 +76,9 @@ class Console {
   /// The robot's status line with the video figures and the recording mark ("| REC <run-id>").
   std::string statusText(const std::string& robot) const;
   CommandSink& sink() { return sink_; }
+  /// Where the tuning host reads the robot and control configs and writes
+  /// its sessions (defaults: config/robot.yaml, config/control.yaml, runs/tuning).
+  void setTuningPaths(std::string robot_config, std::string control_config, std::string dir);
 
   /// The text of `help` (all commands) or `help <command>`; empty for an unknown command.
   static std::string helpText(const std::string& command = "");
@@ -115,6 +120,15 @@ class Console {
   bool cmdInspect(const Args& args, const std::string& rest, int line_no);
   bool cmdAlarms(const Args& args, const std::string& rest, int line_no);
   bool cmdAck(const Args& args, const std::string& rest, int line_no);
+  bool cmdIdentify(const Args& args, const std::string& rest, int line_no);
+  bool cmdTune(const Args& args, const std::string& rest, int line_no);
+  bool cmdGains(const Args& args, const std::string& rest, int line_no);
+  struct TuningState;
+  /// The tuning host's state, loaded on first use; prints why (as `cmd`) and returns null on failure.
+  TuningState* tuning(const std::string& cmd);
+  /// Sends gains to a robot, reports its Ack and books the push in the catalog.
+  bool pushGains(const std::string& robot, const control::GainSet& g, const std::string& source,
+                 const std::string& session);
   /// A run of the catalog and its directory; prints why not (as `cmd`) when there is none.
   std::optional<std::pair<catalog::RunDetail, std::string>> findRun(const std::string& cmd, const std::string& id);
   bool cmdWait(const Args& args, const std::string& rest, int line_no);
@@ -156,6 +170,10 @@ class Console {
     std::string name;
   };
   std::vector<Run> runs_;
+  std::shared_ptr<TuningState> tuning_;
+  std::string tuning_robot_config_ = "config/robot.yaml";
+  std::string tuning_control_config_ = "config/control.yaml";
+  std::string tuning_dir_ = "runs/tuning";
 };
 
 }  // namespace inspect::server

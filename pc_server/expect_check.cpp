@@ -95,6 +95,8 @@ const std::vector<FieldDef>& fieldDefs() {
       {"goal_count", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.goal_count()); }},
       {"nav_switches", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.nav_switches()); }},
       {"dwell", false, true, true, [](const S& s) { return s.telemetry.dwell_remaining_s(); }},
+      {"gains_version", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.gains_version()); }},
+      {"wheel_test_progress", false, true, true, [](const S& s) { return s.telemetry.wheel_test_progress(); }},
       {"alarms", true, true, true, [](const S& s) { return alarmCount(s, false); }},
       {"alarms_high", true, true, true, [](const S& s) { return alarmCount(s, true); }},
       {"gas0", false, true, true, [](const S& s) { return gasValue(s, 0); }},
@@ -171,7 +173,7 @@ std::variant<ExpectSpec, std::string> parseExpect(const std::vector<std::string>
     s.value = static_cast<double>(*i);  // e.g. faults == 0x4
   } else {
     return "expect: '" + args[2] + "' is not a number" +
-           (s.field == "mode" ? " or a mode (IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING)"
+           (s.field == "mode" ? " or a mode (IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING, WHEEL_TEST)"
             : s.field == "nav_mode" ? " or a navigation mode (NONE, GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL, DWELL, GAS_HOLD, RETREAT)"
                                     : "");
   }

@@ -1,5 +1,7 @@
 #include "pc_server/recorder.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -45,6 +47,23 @@ std::string gainsJson(const v1::Telemetry& t) {
   return json;
 }
 
+std::string runGainsJson(const v1::Gains& g, uint32_t version) {
+  nlohmann::json j;
+  j["version"] = version;
+  j["kp"] = g.kp();
+  j["ki"] = g.ki();
+  j["kd"] = g.kd();
+  j["ke"] = g.ke();
+  j["kec"] = g.kec();
+  j["k1"] = g.k1();
+  j["k2"] = g.k2();
+  j["k3"] = g.k3();
+  j["a1"] = g.a1();
+  j["a2"] = g.a2();
+  j["a3"] = g.a3();
+  return j.dump();
+}
+
 struct Recorder::Run {
   catalog::RunInfo info;
   record::McapWriter mcap;
@@ -55,7 +74,8 @@ struct Recorder::Run {
   uint64_t command_id = 0;   // the track/goto command that started it (ends it on COMPLETED/FAILED)
   std::string address;       // robot's link address, to notice reconnects
   uint64_t video_frames = 0;
-  bool gains_known = false;  // gains_json holds a tracking controller's gains
+  bool gains_known = false;  // gains_json names the tracking controller
+  nlohmann::json gains = nlohmann::json::object();  // the run's gains_json
 
   explicit Run(record::McapWriterOptions o) : mcap(std::move(o)) {}
 };
@@ -200,7 +220,9 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
     throw std::runtime_error("run " + run->info.id + ": " + e.what());
   }
   run->command_id = command_id;
-  run->gains_known = gains_known;
+  run->gains_known = gains_known && rs.gains_json.find("\"controller\"") != std::string::npos;
+  run->gains = nlohmann::json::parse(rs.gains_json, nullptr, false);
+  if (!run->gains.is_object()) run->gains = nlohmann::json::object();
   const std::string id = run->info.id;
   noteLocked(*run, robot, "run " + id + " started" + (name.empty() ? "" : " (" + name + ")"));
   catalog_->addFile(id, "mcap", run->info.dir + "/run.mcap", 0);
@@ -284,12 +306,14 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
     const auto& c = env.command();
     std::string name;
     if (c.has_track()) name = "track";
+    if (c.has_wheel_test()) name = "identification " + c.wheel_test().name();
     if (c.has_go_to())
       name = c.go_to().name().empty() ? "goto"
                                       : (c.go_to().inspection() ? "inspection " : "route ") + c.go_to().name();
     if (!name.empty()) {
       try {
-        startLocked(robot, name, c.has_go_to() ? c.go_to().name() : "", c.id());
+        startLocked(robot, name,
+                    c.has_go_to() ? c.go_to().name() : c.has_wheel_test() ? c.wheel_test().name() : "", c.id());
         it = runs_.find(robot);
       } catch (const std::exception& e) {
         log::error(kTag, robot, ": cannot start a run: ", e.what());
@@ -323,7 +347,13 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
         // The gains in force, as soon as the robot tracks with them.
         if (!r.gains_known && env.telemetry().mode() == v1::TRACKING && !env.telemetry().track_controller().empty()) {
           const auto& t = env.telemetry();
-          catalog_->setGains(r.info.id, gainsJson(t));
+          // The full set (from Hello / GAINS_APPLIED) keeps its values; the
+          // controller, and kp/ki/kd for robots that announce no set, come from telemetry.
+          const auto from_t = nlohmann::json::parse(gainsJson(t), nullptr, false);
+          if (from_t.is_object())
+            for (const auto& [k, v] : from_t.items())
+              if (!r.gains.contains(k)) r.gains[k] = v;
+          catalog_->setGains(r.info.id, r.gains.dump());
           r.gains_known = true;
         }
         r.mcap.write(r.ch_telemetry, log_ns, publish_ns, env.telemetry());
@@ -332,6 +362,15 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
       case v1::Envelope::kAck: r.mcap.write(r.ch_ack, log_ns, publish_ns, env.ack()); break;
       case v1::Envelope::kEvent:
         r.mcap.write(r.ch_event, log_ns, publish_ns, env.event());
+        if (env.event().kind() == v1::Event::GAINS_APPLIED && env.event().has_gains()) {
+          // New gains during the run: the catalog keeps the latest set and counts the changes.
+          const std::string controller = r.gains.value("controller", "");
+          const int changes = r.gains.value("changes_in_run", 0) + 1;
+          r.gains = nlohmann::json::parse(runGainsJson(env.event().gains(), env.event().gains_version()));
+          if (!controller.empty()) r.gains["controller"] = controller;
+          r.gains["changes_in_run"] = changes;
+          catalog_->setGains(r.info.id, r.gains.dump());
+        }
         catalog_->addEvent(r.info.id, robot, std::chrono::system_clock::now(),
                            v1::Event::Kind_Name(env.event().kind()), env.event().text());
         break;

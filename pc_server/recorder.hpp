@@ -35,6 +35,8 @@ struct VideoFigures {
 /// The wheel PID gains a telemetry message reports while tracking, as JSON
 /// ({"controller":"fuzzy_pid","kp":..,"ki":..,"kd":..}); "{}" when not tracking.
 std::string gainsJson(const v1::Telemetry& t);
+/// The full gain set a robot announced (Hello, GAINS_APPLIED) with its version, as JSON.
+std::string runGainsJson(const v1::Gains& g, uint32_t version);
 
 class Recorder {
  public:

@@ -32,6 +32,20 @@ void RobotRegistry::onConnected(const std::string& id, const std::string& addres
   e.close_reason.clear();
   e.rx_times_ns.clear();
   e.hello = hello;
+  if (hello.has_gains()) noteGainsLocked(e, hello.gains(), hello.gains_version());
+}
+
+void RobotRegistry::noteGainsLocked(Entry& e, const v1::Gains& g, uint32_t version) {
+  if (e.gains_known && e.gains_version == version &&
+      e.gains.SerializeAsString() == g.SerializeAsString())
+    return;  // the same set again (a reconnect)
+  if (e.gains_known) {
+    e.gains_history.emplace_back(e.gains_version, e.gains);
+    if (e.gains_history.size() > kMaxGainsHistory) e.gains_history.erase(e.gains_history.begin());
+  }
+  e.gains_known = true;
+  e.gains = g;
+  e.gains_version = version;
 }
 
 void RobotRegistry::onDisconnected(const std::string& id, uint64_t serial, const std::string& reason,
@@ -169,6 +183,7 @@ void RobotRegistry::onEvent(const std::string& id, uint64_t serial, const v1::Ev
   Entry* e = current(id, serial);
   if (!e) return;
   if (ev.has_gas_alarm()) noteAlarmLocked(id, ev.gas_alarm(), now_ns);
+  if (ev.kind() == v1::Event::GAINS_APPLIED && ev.has_gains()) noteGainsLocked(*e, ev.gains(), ev.gains_version());
   e->events.push_back(ev);
   if (e->events.size() > kMaxEventsPerRobot) e->events.pop_front();
   pending_.push_back({id, ev});
@@ -208,6 +223,10 @@ RobotSnapshot RobotRegistry::makeSnapshot(const std::string& id, const Entry& e,
   s.telemetry_hz = e.connected || n > 0 ? static_cast<double>(n) / (e.connected ? span_s : 1.0) : 0.0;
   s.state_age_s = static_cast<double>(now_ns - e.state_change_ns) * 1e-9;
   s.close_reason = e.close_reason;
+  s.gains_known = e.gains_known;
+  s.gains = e.gains;
+  s.gains_version = e.gains_version;
+  s.gains_history = e.gains_history;
   s.hello = e.hello;
   return s;
 }

@@ -29,6 +29,12 @@ struct RobotSnapshot {
   double state_age_s = 0;        // since the robot connected / disconnected
   std::string close_reason;      // why the last connection ended
   v1::Hello hello;               // the last Hello (gas channels, capabilities)
+  // Tracking gains: those in force (from Hello, then GAINS_APPLIED events)
+  // and the sets the robot had in force before, oldest first (for `gains revert`).
+  bool gains_known = false;
+  v1::Gains gains;
+  uint32_t gains_version = 0;
+  std::vector<std::pair<uint32_t, v1::Gains>> gains_history;
 };
 
 /// A gas alarm or gas sensor fault as the operator sees it (docs/gas.md):
@@ -58,6 +64,7 @@ class RobotRegistry {
   static constexpr std::size_t kMaxAcksPerRobot = 256;
   static constexpr std::size_t kMaxEventsPerRobot = 100;
   static constexpr std::size_t kMaxPendingEvents = 1000;
+  static constexpr std::size_t kMaxGainsHistory = 32;
   static constexpr int64_t kRateWindowNs = 1'000'000'000;
 
   void onConnected(const std::string& id, const std::string& address, uint64_t serial, const v1::Hello& hello,
@@ -112,9 +119,15 @@ class RobotRegistry {
     std::map<uint64_t, v1::Ack> acks;
     std::deque<v1::Event> events;
     v1::Hello hello;
+    bool gains_known = false;
+    v1::Gains gains;
+    uint32_t gains_version = 0;
+    std::vector<std::pair<uint32_t, v1::Gains>> gains_history;  // sets in force before, oldest first
     int active_alarms = 0;  // records in alarms_ still active: the 50 Hz resync skips the book when 0
   };
   Entry* current(const std::string& id, uint64_t serial);
+  /// A set of gains is in force on the robot now; mu_ held.
+  static void noteGainsLocked(Entry& e, const v1::Gains& g, uint32_t version);
   RobotSnapshot makeSnapshot(const std::string& id, const Entry& e, int64_t now_ns) const;
 
   mutable std::mutex mu_;

@@ -38,6 +38,42 @@ std::string resolveMap(const config::ConfigNode& root, const std::string& map) {
   root.fail("map", "'" + map + "' does not exist (tried the working directory and beside the route file)");
 }
 
+// `wheel_test: {standard: <amplitude_rad_s>}` or `wheel_test: {segments: [{kind, duration_s, left_rad_s,
+// right_rad_s, f0_hz, f1_hz}, ...]}`; the profile is checked against a 30 rad/s ceiling here (the robot
+// checks its own wheel limit).
+void readWheelTest(const config::ConfigNode& root, Route& r) {
+  using K = control::WheelProfileSegment::Kind;
+  constexpr double kCeiling_rad_s = 30.0;
+  const auto w = root.child("wheel_test");
+  if (w.has("standard") == w.has("segments")) root.fail("wheel_test", "give either `standard: <amplitude_rad_s>` or `segments`");
+  if (w.has("standard")) {
+    const double a = w.number("standard", 2.0, 0.1, kCeiling_rad_s);
+    const double max = w.number("max_wheel_rad_s", 5.0, 0.1, kCeiling_rad_s);
+    if (a > max) w.fail("standard", "amplitude above max_wheel_rad_s");
+    r.wheel_test = control::WheelProfile::standardIdentification(a, max).segments();
+  } else {
+    for (const auto& n : w.children("segments")) {
+      control::WheelProfileSegment g;
+      const std::string kind = n.oneOf("kind", "step", {"hold", "step", "chirp"});
+      g.kind = kind == "hold" ? K::kHold : kind == "chirp" ? K::kChirp : K::kStep;
+      g.duration_s = n.requireNumber("duration_s", 0.001, 600.0);
+      g.left_rad_s = n.number("left_rad_s", 0.0, -kCeiling_rad_s, kCeiling_rad_s);
+      g.right_rad_s = n.number("right_rad_s", 0.0, -kCeiling_rad_s, kCeiling_rad_s);
+      if (g.kind == K::kChirp) {
+        g.f0_hz = n.requireNumber("f0_hz", 0.001, 20.0);
+        g.f1_hz = n.requireNumber("f1_hz", 0.001, 20.0);
+      }
+      r.wheel_test.push_back(g);
+    }
+    if (r.wheel_test.empty()) w.fail("segments", "needs at least one segment");
+    try {
+      control::WheelProfile check(r.wheel_test, kCeiling_rad_s);
+    } catch (const std::invalid_argument& e) {
+      w.fail("segments", e.what());
+    }
+  }
+}
+
 Route readRoute(const config::ConfigNode& root) {
   Route r;
   r.file = root.file();
@@ -46,6 +82,13 @@ Route readRoute(const config::ConfigNode& root) {
   r.speed_m_s = root.number("speed_m_s", r.speed_m_s, 0.0, kMaxRouteSpeed_m_s);
   if (root.has("speed_m_s") && r.speed_m_s <= 0.0) root.fail("speed_m_s", "must be > 0 m/s (leave it out for the robot's default)");
   const std::string map = root.string("map", "");
+  if (root.has("wheel_test")) {
+    if (root.has("waypoints_m") || root.has("points")) root.fail("wheel_test", "a wheel test has no points");
+    readWheelTest(root, r);
+    r.map = resolveMap(root, map);
+    root.checkKnown();
+    return r;
+  }
   const bool flat = root.has("waypoints_m"), listed = root.has("points");
   if (!flat && !listed)
     root.fail("waypoints_m", "required list [x0, y0, x1, y1, ...] is missing (or give `points`)");
@@ -126,6 +169,21 @@ std::string resolveRoute(const std::string& name_or_path) {
   }
   throw config::ConfigError("no route '" + name_or_path + "': neither a file nor config/routes/" + name_or_path +
                             ".yaml");
+}
+
+v1::WheelTest wheelTestOf(const Route& r) {
+  v1::WheelTest w;
+  w.set_name(r.name);
+  for (const auto& g : r.wheel_test) {
+    auto* s = w.add_segments();
+    s->set_kind(control::toString(g.kind));
+    s->set_duration_s(g.duration_s);
+    s->set_left_rad_s(g.left_rad_s);
+    s->set_right_rad_s(g.right_rad_s);
+    s->set_f0_hz(g.f0_hz);
+    s->set_f1_hz(g.f1_hz);
+  }
+  return w;
 }
 
 v1::GoTo goToOf(const Route& r, bool inspection) {

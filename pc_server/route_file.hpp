@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "inspect/v1/link.pb.h"
+#include "shared/control/wheel_profile.hpp"
 
 namespace inspect::server {
 
@@ -28,6 +29,10 @@ struct Route {
   double speed_m_s = 0.0;           // 0 = the robot's default
   std::string map;                  // world file of the site (resolved path; "" = none)
   std::vector<RoutePoint> points;
+  /// A wheel test instead of points (`wheel_test:`): open-loop steps and chirps
+  /// for plant identification (docs/tuning.md).
+  std::vector<control::WheelProfileSegment> wheel_test;
+  bool isWheelTest() const { return !wheel_test.empty(); }
   /// x0, y0, x1, y1, ... (the points' coordinates)
   std::vector<double> waypointsM() const;
   /// Points with a dwell time.
@@ -50,6 +55,9 @@ Route loadRouteText(const std::string& yaml, const std::string& name);
 /// `inspect`'s argument: a file path, or a name looked up as config/routes/<name>.yaml
 /// (relative to the working directory). Returns the path; throws config::ConfigError when none exists.
 std::string resolveRoute(const std::string& name_or_path);
+
+/// The WheelTest command body of a wheel-test route.
+v1::WheelTest wheelTestOf(const Route& r);
 
 /// The GoTo command body of a route (inspection: the gas reaction and dwell apply).
 v1::GoTo goToOf(const Route& r, bool inspection = false);

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <functional>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -110,10 +111,12 @@ int runServer(const CliOptions& options) {
                                                     const v1::Envelope& env, bool inbound, uint64_t time_us) {
       rec->onEnvelope(id, address, env, inbound, time_us);
     });
-    // The gains the robot reports in its latest telemetry, when it is tracking
-    // (otherwise the recorder fills them in at the run's first tracking telemetry).
+    // The gain set the robot announced (Hello, GAINS_APPLIED events) with its
+    // version; else what its latest telemetry shows while tracking (the
+    // recorder adds the controller at the run's first tracking telemetry).
     recorder->setGainsSource([&registry](const std::string& robot) {
       const auto snap = registry.snapshot(robot, monoNowNs());
+      if (snap && snap->gains_known) return runGainsJson(snap->gains, snap->gains_version);
       return snap && snap->has_telemetry ? gainsJson(snap->telemetry) : std::string("{}");
     });
     recorder->setHelloSource([&registry](const std::string& robot) -> std::optional<v1::Hello> {
@@ -151,11 +154,21 @@ int runServer(const CliOptions& options) {
 
   StopFlag stop;
   asio::signal_set signals(ioc, SIGINT, SIGTERM);
-  signals.async_wait([&stop](const boost::system::error_code& ec, int sig) {
-    if (ec) return;
-    log::info(kTag, "signal ", sig == SIGINT ? "SIGINT" : "SIGTERM", ": shutting down");
-    stop.request();
-  });
+  std::function<void()> wait_signal = [&] {
+    signals.async_wait([&](const boost::system::error_code& ec, int sig) {
+      if (ec) return;
+      if (sig == SIGINT && stop.interrupt()) {
+        // A console job (tune) takes Ctrl-C as "cancel, keep the best so far".
+        log::info(kTag, "SIGINT: cancelling the running console job (Ctrl-C again to shut down)");
+        stop.setInterruptTarget(nullptr);
+        wait_signal();
+        return;
+      }
+      log::info(kTag, "signal ", sig == SIGINT ? "SIGINT" : "SIGTERM", ": shutting down");
+      stop.request();
+    });
+  };
+  wait_signal();
 
   // MCAP chunks of quiet recordings reach the disk within a second.
   asio::steady_timer record_timer(ioc);
@@ -178,6 +191,15 @@ int runServer(const CliOptions& options) {
     Console console(registry, link, std::cout, stop, copt);
     console.setVideo(video.get());
     console.setRecorder(recorder.get());
+    {
+      // The tuning host reads the robot and control configs beside the server's
+      // (config/robot.yaml, config/control.yaml) and writes sessions under the runs.
+      const std::filesystem::path cfg_dir =
+          options.config_path ? std::filesystem::path(*options.config_path).parent_path() : std::filesystem::path("config");
+      const auto beside = [&](const char* name) { return (cfg_dir.empty() ? std::filesystem::path(".") : cfg_dir) / name; };
+      console.setTuningPaths(beside("robot.yaml").string(), beside("control.yaml").string(),
+                             (recorder ? recorder->config().dir : config.recording.dir) + "/tuning");
+    }
     console.setAlarmStyle(::isatty(STDOUT_FILENO) == 1);  // red + bell on a terminal, plain text into pipes
     ConsoleRunner runner(console, stop, config.status_refresh_hz);
     switch (mode) {

@@ -23,11 +23,23 @@ class StopFlag {
   bool sleepFor(std::chrono::steady_clock::duration d);
   /// Blocks until the stop request.
   void wait();
+  /// While set, an interrupt (Ctrl-C) sets *target instead of stopping the
+  /// server: a long console job (tune) is cancelled and keeps its result.
+  /// nullptr clears it.
+  void setInterruptTarget(std::atomic<bool>* target) { interrupt_target_.store(target); }
+  /// SIGINT: true when an interrupt target took it (the server goes on).
+  bool interrupt() {
+    std::atomic<bool>* t = interrupt_target_.load();
+    if (!t) return false;
+    t->store(true);
+    return true;
+  }
   /// A descriptor that becomes readable once the stop is requested (for poll()).
   int wakeFd() const { return pipe_[0]; }
 
  private:
   std::atomic<bool> requested_{false};
+  std::atomic<std::atomic<bool>*> interrupt_target_{nullptr};
   std::mutex mu_;
   std::condition_variable cv_;
   int pipe_[2] = {-1, -1};

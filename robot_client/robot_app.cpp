@@ -1,6 +1,9 @@
 #include "robot_client/robot_app.hpp"
 
+#include "shared/net/gains_proto.hpp"
+
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 
 #include "shared/config/config_node.hpp"
@@ -52,6 +55,7 @@ RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::
     : io_(io), cfg_(cfg), core_(robot, cfg.safety, control, std::move(scheduler)),
       serial_(io, cfg.serial_device, cfg.baud, cfg.serial_reopen_period_s), link_(io, cfg), tick_timer_(io),
       telemetry_timer_(io), mcu_hb_timer_(io), t0_ns_(monoNowNs()) {
+  core_.setFisName(std::filesystem::path(control.fis_path).stem().string());
   if (!cmd_log_path.empty()) {
     cmd_log_ = std::fopen(cmd_log_path.c_str(), "w");
     if (!cmd_log_) throw config::ConfigError("--cmd-log: cannot write " + cmd_log_path);
@@ -74,6 +78,12 @@ double RobotApp::now() const { return static_cast<double>(monoNowNs() - t0_ns_) 
 void RobotApp::start() {
   link_.setGasChannels(core_.gasChannels(), core_.gasMonitor().config().inlet_x_m,
                        core_.gasMonitor().config().inlet_y_m);
+  // Each Hello (also after a reconnect) announces the gains in force then.
+  link_.setHelloFiller([this](v1::Hello& h) {
+    net::toProto(core_.gains(), *h.mutable_gains());
+    h.set_gains_version(core_.gainsVersion());
+    h.set_fis_name(core_.fisName());
+  });
   serial_.start([this](const serial::Message& m, uint8_t) { onSerialMessage(m); },
                 [this](bool open, const std::string&) {
                   core_.onSerialState(open, now());
@@ -227,6 +237,10 @@ void RobotApp::flushEvents() {
     ev->set_kind(e.kind);
     ev->set_text(e.text);
     if (e.gas_alarm) *ev->mutable_gas_alarm() = *e.gas_alarm;
+    if (e.gains) {
+      *ev->mutable_gains() = *e.gains;
+      ev->set_gains_version(e.gains_version);
+    }
     ev->set_robot_time_us(static_cast<uint64_t>(now() * 1e6));
     link_.send(env);
   }

@@ -5,6 +5,9 @@
 #include <limits>
 #include <cstdio>
 
+#include "shared/fuzzy/fis_reader.hpp"
+#include "shared/net/gains_proto.hpp"
+
 namespace inspect::client {
 namespace {
 
@@ -60,6 +63,8 @@ RobotCore::RobotCore(const config::RobotConfig& robot, const SafetyParams& safet
                      const config::ControlConfig& control, std::shared_ptr<control::FuzzyGainScheduler> scheduler)
     : robot_(robot), safety_(safety), control_(control), scheduler_(std::move(scheduler)), gas_(robot.gas) {
   config::applyRobot(control_, robot_);
+  gains_.fuzzy = control_.tracker.fuzzy;
+  gains_.aux = control_.tracker.aux;
   events_.reserve(16);
   gas_out_.reserve(16);
 }
@@ -188,7 +193,10 @@ void RobotCore::arriveAt(std::size_t i) {
 v1::Ack RobotCore::startTrack(const v1::Command& cmd) {
   const auto reject = [&](const std::string& why) { return ackOf(cmd.id(), v1::Ack::REJECTED, why); };
   const auto& t = cmd.track();
+  applyPendingGains();
   control::TrackerParams params = control_.tracker;
+  params.fuzzy = gains_.fuzzy;
+  params.aux = gains_.aux;
   const std::string& c = t.controller();
   if (c == "fuzzy_pid") params.wheel_control = control::WheelControl::kFuzzyPid;
   else if (c == "pid") params.wheel_control = control::WheelControl::kPid;
@@ -229,6 +237,146 @@ v1::Ack RobotCore::startTrack(const v1::Command& cmd) {
   setpoint_time_s_ = -1.0;
   setMode(v1::TRACKING, "tracking " + what + " with " + track_controller_);
   return ackOf(cmd.id(), v1::Ack::ACCEPTED);
+}
+
+v1::Ack RobotCore::stageGains(const v1::Command& cmd) {
+  const auto& u = cmd.gains();
+  v1::Ack ack = ackOf(cmd.id(), v1::Ack::REJECTED);
+  ack.set_gains_version(pending_gains_ ? pending_gains_->version : gains_version_);
+  if (!u.has_gains()) {
+    ack.set_reason("gains update without gains");
+    return ack;
+  }
+  PendingGains p;
+  p.gains = net::fromProto(u.gains());
+  if (const std::string why = control::validateGains(p.gains); !why.empty()) {
+    ack.set_reason("gains refused: " + why);
+    return ack;
+  }
+  if (!u.fis().empty()) {
+    if (u.fis().size() > 256 * 1024) {
+      ack.set_reason("fuzzy system refused: larger than 256 KiB");
+      return ack;
+    }
+    try {
+      const fuzzy::Fis fis = fuzzy::parseFis(u.fis(), "pushed fuzzy system");
+      p.scheduler = std::make_shared<control::FuzzyGainScheduler>(fis, control_.use_lookup);
+      p.fis_name = fis.name;
+    } catch (const std::exception& e) {
+      ack.set_reason(std::string("fuzzy system refused: ") + e.what());
+      return ack;
+    }
+  }
+  p.source = u.source();
+  p.version = (pending_gains_ ? pending_gains_->version : gains_version_) + 1;
+  // A second update before the next tick replaces the first (keeping a new
+  // fuzzy system the first one brought, unless this one brings its own).
+  if (pending_gains_ && !p.scheduler && pending_gains_->scheduler) {
+    p.scheduler = pending_gains_->scheduler;
+    p.fis_name = pending_gains_->fis_name;
+  }
+  pending_gains_ = std::move(p);
+  ack.set_status(v1::Ack::ACCEPTED);
+  ack.set_gains_version(pending_gains_->version);
+  ack.set_reason("in force from the next control tick");
+  return ack;
+}
+
+void RobotCore::applyPendingGains() {
+  if (!pending_gains_) return;
+  PendingGains p = std::move(*pending_gains_);
+  pending_gains_.reset();
+  gains_ = p.gains;
+  gains_version_ = p.version;
+  if (p.scheduler) {
+    scheduler_ = p.scheduler;
+    fis_name_ = p.fis_name;
+  }
+  if (tracker_) tracker_->setGains(gains_.fuzzy, gains_.aux, p.scheduler);
+  CoreEvent e;
+  e.kind = v1::Event::GAINS_APPLIED;
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "gains v%u in force%s: kp' %.4g ki' %.4g kd' %.4g ke %.4g kec %.4g k1 %.4g k2 %.4g k3 %.4g a1 %.4g "
+                "a2 %.4g a3 %.4g",
+                gains_version_, tracker_ ? " (also on the path being tracked)" : "", gains_.fuzzy.base.kp,
+                gains_.fuzzy.base.ki, gains_.fuzzy.base.kd, gains_.fuzzy.ke, gains_.fuzzy.kec, gains_.fuzzy.k1,
+                gains_.fuzzy.k2, gains_.fuzzy.k3, gains_.aux.a1, gains_.aux.a2, gains_.aux.a3);
+  e.text = buf;
+  if (!p.source.empty()) e.text += " from " + p.source;
+  if (p.scheduler) e.text += ", fuzzy system '" + fis_name_ + "'";
+  v1::Gains g;
+  net::toProto(gains_, g);
+  e.gains = g;
+  e.gains_version = gains_version_;
+  events_.push_back(std::move(e));
+}
+
+v1::Ack RobotCore::startWheelTest(const v1::Command& cmd) {
+  const auto& w = cmd.wheel_test();
+  std::vector<control::WheelProfileSegment> segs;
+  for (int i = 0; i < w.segments_size(); ++i) {
+    const auto& s = w.segments(i);
+    control::WheelProfileSegment g;
+    if (s.kind() == "hold") g.kind = control::WheelProfileSegment::Kind::kHold;
+    else if (s.kind() == "step") g.kind = control::WheelProfileSegment::Kind::kStep;
+    else if (s.kind() == "chirp") g.kind = control::WheelProfileSegment::Kind::kChirp;
+    else
+      return ackOf(cmd.id(), v1::Ack::REJECTED,
+                   "segment " + std::to_string(i + 1) + ": unknown kind '" + s.kind() + "' (hold, step or chirp)");
+    g.duration_s = s.duration_s();
+    g.left_rad_s = s.left_rad_s();
+    g.right_rad_s = s.right_rad_s();
+    g.f0_hz = s.f0_hz();
+    g.f1_hz = s.f1_hz();
+    segs.push_back(g);
+  }
+  try {
+    auto profile = std::make_unique<control::WheelProfile>(std::move(segs), robot_.limits.max_wheel_speed_rad_s);
+    endAutonomy();
+    wheel_test_ = std::move(profile);
+  } catch (const std::invalid_argument& e) {
+    return ackOf(cmd.id(), v1::Ack::REJECTED, e.what());
+  }
+  wheel_test_id_ = cmd.id();
+  wheel_test_t_s_ = 0.0;
+  wheel_test_progress_ = 0.0;
+  wheel_test_name_ = w.name().empty() ? "wheel test" : w.name();
+  setpoint_ = {};
+  setpoint_time_s_ = -1.0;
+  char buf[64];
+  std::snprintf(buf, sizeof buf, " (%.1f s, %d segments)", wheel_test_->duration_s(), w.segments_size());
+  setMode(v1::WHEEL_TEST, wheel_test_name_ + buf);
+  return ackOf(cmd.id(), v1::Ack::ACCEPTED);
+}
+
+void RobotCore::wheelTestStep(double dt_s) {
+  if (!wheel_test_ || dt_s <= 0.0) return;
+  // Anything inside the stop distance of a front sonar ends the test: the
+  // profile is open loop and cannot steer round it.
+  for (std::size_t i = 0; i < 2; ++i) {
+    const uint16_t mm = last_frame_.ultrasonic_mm[i];
+    if (mm != serial::kNoEcho && mm * 1e-3 < safety_.obstacle_stop_m) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s stopped: obstacle %.2f m ahead", wheel_test_name_.c_str(), mm * 1e-3);
+      acks_.push_back(ackOf(wheel_test_id_, v1::Ack::FAILED, buf));
+      endAutonomy();
+      cmd_wheels_ = {};
+      setMode(v1::IDLE, buf);
+      return;
+    }
+  }
+  wheel_test_t_s_ += dt_s;
+  wheel_test_progress_ = std::min(1.0, wheel_test_t_s_ / wheel_test_->duration_s());
+  if (wheel_test_t_s_ >= wheel_test_->duration_s()) {
+    acks_.push_back(ackOf(wheel_test_id_, v1::Ack::COMPLETED));
+    const std::string name = wheel_test_name_;
+    endAutonomy();
+    cmd_wheels_ = {};
+    setMode(v1::IDLE, name + " completed");
+    return;
+  }
+  cmd_wheels_ = wheel_test_->at(wheel_test_t_s_);
 }
 
 std::string RobotCore::autonomyRefusal() const {
@@ -307,6 +455,8 @@ v1::Ack RobotCore::startGoTo(const v1::Command& cmd) {
 
 void RobotCore::endAutonomy() {
   tracker_.reset();
+  wheel_test_.reset();
+  wheel_test_id_ = 0;
   track_command_id_ = 0;
   if (navigator_) nav_switches_done_ += navigator_->output().switch_count;
   navigator_.reset();
@@ -500,6 +650,10 @@ v1::Ack RobotCore::onCommand(const v1::Command& cmd, double now_s) {
     case v1::Command::kGoTo:
       if (const std::string why = autonomyRefusal(); !why.empty()) return reject(why);
       return startGoTo(cmd);
+    case v1::Command::kWheelTest:
+      if (const std::string why = autonomyRefusal(); !why.empty()) return reject(why);
+      return startWheelTest(cmd);
+    case v1::Command::kGains: return stageGains(cmd);
     case v1::Command::kStop:
       setpoint_ = {};
       setpoint_time_s_ = -1.0;
@@ -574,6 +728,17 @@ double RobotCore::obstacleFactor() {
 
 serial::WheelCommand RobotCore::computeCommand(double dt_s) {
   const bool latched = mode_ == v1::ESTOP || mode_ == v1::FAILSAFE;
+  if (mode_ == v1::WHEEL_TEST && !latched && !(faults_ & v1::FAULT_SENSOR_STALE)) {
+    // Open loop: the profile's set-points go to the MCU unslewed (the steps
+    // are the point); the MCU clamps to its wheel limit.
+    wheelTestStep(dt_s);
+    cmd_twist_ = control::twistFromWheels(cmd_wheels_, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
+    serial::WheelCommand c;
+    c.left_mrad_s = toMrad(cmd_wheels_.left_rad_s);
+    c.right_mrad_s = toMrad(cmd_wheels_.right_rad_s);
+    c.flags = serial::WheelCommand::kEnable;
+    return c;
+  }
   if (mode_ == v1::TRACKING && tracker_ && !latched && !(faults_ & v1::FAULT_SENSOR_STALE)) {
     if (dt_s > 0.0) {
       // Eq 9: people slow the robot down on its path; anything close ahead stops it.
@@ -630,6 +795,7 @@ serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, doub
     last_disp_ = f.wheel_disp_0p1mm;
   } else {
     dt_s = static_cast<double>(static_cast<uint32_t>(f.mcu_time_ms - last_mcu_ms_)) / 1000.0;
+    mcu_time_us_ += static_cast<uint64_t>(static_cast<uint32_t>(f.mcu_time_ms - last_mcu_ms_)) * 1000u;
     const double dl = static_cast<int32_t>(static_cast<uint32_t>(f.wheel_disp_0p1mm[0]) -
                                            static_cast<uint32_t>(last_disp_[0])) * 1e-4;
     const double dr = static_cast<int32_t>(static_cast<uint32_t>(f.wheel_disp_0p1mm[1]) -
@@ -668,6 +834,7 @@ serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, doub
     rate_count_ = 0;
   }
   checkTimeouts(now_s);
+  applyPendingGains();  // the tick boundary: staged gains go into force together
   return computeCommand(dt_s);
 }
 
@@ -691,6 +858,9 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
   p->set_x_m(pose_.x_m);
   p->set_y_m(pose_.y_m);
   p->set_theta_rad(pose_.theta_rad);
+  t.set_gains_version(gains_version_);
+  t.set_mcu_time_us(mcu_time_us_);
+  t.set_wheel_test_progress(wheel_test_progress_);
   t.set_wheel_left_rad_s(measured_.left_rad_s);
   t.set_wheel_right_rad_s(measured_.right_rad_s);
   t.set_cmd_wheel_left_rad_s(cmd_wheels_.left_rad_s);

@@ -15,7 +15,9 @@
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
+#include "shared/control/gain_set.hpp"
 #include "shared/control/trajectory_tracker.hpp"
+#include "shared/control/wheel_profile.hpp"
 #include "shared/control/diff_drive.hpp"
 #include "shared/gas/alarm_monitor.hpp"
 #include "shared/navigation/navigator.hpp"
@@ -28,6 +30,8 @@ struct CoreEvent {
   v1::Event::Kind kind = v1::Event::INFO;
   std::string text;
   std::optional<v1::GasAlarm> gas_alarm;  // ALARM_RAISED / ALARM_CLEARED
+  std::optional<v1::Gains> gains;         // GAINS_APPLIED (with gains_version)
+  uint32_t gains_version = 0;
 };
 
 class RobotCore {
@@ -74,6 +78,13 @@ class RobotCore {
   std::vector<v1::GasChannelInfo> gasChannels() const;
   const gas::AlarmMonitor& gasMonitor() const { return gas_; }
 
+  /// Tracking gains in force and their version (0 = the control config's;
+  /// +1 per applied GainsUpdate), and the fuzzy system's name.
+  const control::GainSet& gains() const { return gains_; }
+  uint32_t gainsVersion() const { return gains_version_; }
+  const std::string& fisName() const { return fis_name_; }
+  void setFisName(std::string name) { fis_name_ = std::move(name); }
+
   v1::Mode mode() const { return mode_; }
   uint32_t faults() const { return faults_; }
   const control::Pose2& pose() const { return pose_; }
@@ -87,8 +98,17 @@ class RobotCore {
   static constexpr double kDefaultNavSpeed_m_s = 0.5;
 
  private:
-  bool moving() const { return mode_ == v1::TELEOP || mode_ == v1::TRACKING || mode_ == v1::NAVIGATING; }
+  bool moving() const {
+    return mode_ == v1::TELEOP || mode_ == v1::TRACKING || mode_ == v1::NAVIGATING || mode_ == v1::WHEEL_TEST;
+  }
   v1::Ack startTrack(const v1::Command& cmd);
+  v1::Ack startWheelTest(const v1::Command& cmd);
+  /// Checks a GainsUpdate and stages it for the next tick.
+  v1::Ack stageGains(const v1::Command& cmd);
+  /// Puts staged gains in force (start of a tick, or of a track run).
+  void applyPendingGains();
+  /// One wheel-test tick: the profile's set-point, or its end.
+  void wheelTestStep(double dt_s);
   v1::Ack startGoTo(const v1::Command& cmd);
   /// Why a track or go_to command cannot start now ("" when it can).
   std::string autonomyRefusal() const;
@@ -137,6 +157,7 @@ class RobotCore {
   std::array<int32_t, 2> last_disp_{};
   int16_t heading0_ = 0;
   uint32_t last_mcu_ms_ = 0;
+  uint64_t mcu_time_us_ = 0;  // MCU clock since the first frame (telemetry mcu_time_us)
   control::Pose2 pose_;
   control::WheelSpeeds measured_;
   double rate_window_start_s_ = 0.0;
@@ -163,6 +184,26 @@ class RobotCore {
   double track_max_pos_m_ = 0.0;
   double track_max_ang_rad_ = 0.0;
   control::PidGains track_gains_;
+
+  // Tracking gains (Command.gains).
+  control::GainSet gains_;
+  uint32_t gains_version_ = 0;
+  std::string fis_name_;
+  struct PendingGains {
+    control::GainSet gains;
+    uint32_t version = 0;
+    std::shared_ptr<control::FuzzyGainScheduler> scheduler;  // null = keep the fuzzy system
+    std::string fis_name;
+    std::string source;
+  };
+  std::optional<PendingGains> pending_gains_;
+
+  // Wheel test (Command.wheel_test).
+  std::unique_ptr<control::WheelProfile> wheel_test_;
+  uint64_t wheel_test_id_ = 0;
+  double wheel_test_t_s_ = 0.0;
+  double wheel_test_progress_ = 0.0;
+  std::string wheel_test_name_;
 
   // Navigation (Command.go_to).
   std::unique_ptr<navigation::Navigator> navigator_;

@@ -80,6 +80,7 @@ void ServerLink::onConnected() {
   h->set_gas_inlet_x_m(gas_inlet_x_m_);
   h->set_gas_inlet_y_m(gas_inlet_y_m_);
   h->set_software_version(INSPECT_VERSION);
+  if (hello_filler_) hello_filler_(*h);
   send(hello);
   const uint64_t gen = generation_;
   handshake_timer_.expires_after(secs(cfg_.handshake_timeout_s));

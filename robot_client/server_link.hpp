@@ -33,6 +33,8 @@ class ServerLink {
     gas_inlet_x_m_ = inlet_x_m;
     gas_inlet_y_m_ = inlet_y_m;
   }
+  /// Called to complete every Hello just before it is sent.
+  void setHelloFiller(std::function<void(v1::Hello&)> f) { hello_filler_ = std::move(f); }
   void stop();
 
   /// Queues an envelope (seq and send time are filled in). Dropped when the
@@ -56,6 +58,7 @@ class ServerLink {
   ClientConfig cfg_;
   std::vector<v1::GasChannelInfo> gas_channels_;
   double gas_inlet_x_m_ = 0.0, gas_inlet_y_m_ = 0.0;
+  std::function<void(v1::Hello&)> hello_filler_;
   Handlers h_;
   boost::asio::ip::tcp::resolver resolver_;
   boost::asio::ip::tcp::socket socket_;

@@ -4,7 +4,12 @@
 # pc_server on loopback running scripts/demo/gas_inspection.console (a
 # recorded gas inspection round, alarms, report), then prints what happened.
 #
-#   scripts/run_demo.sh [--interactive|--batch] [--port N]
+#   scripts/run_demo.sh [--interactive|--batch] [--port N] [--tuning]
+#
+# --tuning runs the fuzzy-PID tuning job instead (scripts/demo/tuning.console
+# on config/worlds/tuning_floor.yaml, whose robot has worn, slower motors):
+# identification wheel test, identify, circle with the paper's gains, tune,
+# push the tuned gains, circle again (docs/tuning.md).
 #
 # --interactive (default when stdin is a terminal) leaves you in the console
 # after the script; --batch exits when the script ends. --port 0 picks a free
@@ -14,12 +19,14 @@ cd "$(dirname "$0")/.."
 BIN=${BUILD_DIR:-build}/bin
 PORT=7600
 MODE=auto
+JOB=gas
 while [ $# -gt 0 ]; do
   case "$1" in
     --interactive) MODE=interactive ;;
     --batch) MODE=batch ;;
     --port) PORT=$2; shift ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    --tuning) JOB=tuning ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "run_demo: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -37,7 +44,12 @@ cleanup() {
 trap cleanup EXIT
 
 echo "demo: logs and ground truth in $OUT"
-"$BIN/mcu_sim" --world config/worlds/gas_lab.yaml --robot config/robot.yaml --people-wait-motion \
+if [ "$JOB" = tuning ]; then
+  WORLD=config/worlds/tuning_floor.yaml; SCRIPT=scripts/demo/tuning.console; SIM_ARGS=()
+else
+  WORLD=config/worlds/gas_lab.yaml; SCRIPT=scripts/demo/gas_inspection.console; SIM_ARGS=(--people-wait-motion)
+fi
+"$BIN/mcu_sim" --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" \
   --pty-link "$OUT/mcu" --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
 SIM=$!
 PIDS+=("$SIM")
@@ -50,7 +62,7 @@ head -n 1 "$OUT/mcu_sim.out"
   for _ in $(seq 200); do [ -s "$OUT/port" ] && [ -s "$OUT/video_port" ] && break; sleep 0.05; done
   exec "$BIN/robot_client" --config config/client.yaml --robot-config config/robot.yaml \
     --serial "$OUT/mcu" --server "127.0.0.1:$(cat "$OUT/port")" --video-port "$(cat "$OUT/video_port")" \
-    --map config/worlds/gas_lab.yaml --id robot1 2>"$OUT/robot_client.err"
+    --map "$WORLD" --id robot1 2>"$OUT/robot_client.err"
 ) &
 CLIENT=$!
 PIDS+=("$CLIENT")
@@ -58,7 +70,7 @@ PIDS+=("$CLIENT")
 # Video on an ephemeral UDP port (5600 may be taken); SDP and snapshots in $OUT/video.
 ARGS=(--config config/server.yaml --bind 127.0.0.1 --port "$PORT" --port-file "$OUT/port"
       --video-port 0 --video-port-file "$OUT/video_port" --video-dir "$OUT/video" --runs-dir "$OUT/runs"
-      --script scripts/demo/gas_inspection.console)
+      --script "$SCRIPT")
 echo "demo: camera: $OUT/video/robot1.sdp (play it while the console runs:"
 echo "        ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay $OUT/video/robot1.sdp)"
 echo "      snapshots: $OUT/video/robot1_latest.png (refreshed every 5 s), 'snapshot' at the console" 

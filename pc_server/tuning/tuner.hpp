@@ -38,6 +38,19 @@ struct TuneReference {
 
 /// Weights of the cost terms; every term is normalised by its scale (see
 /// costOf()), so a weight of 1 means "one scale unit is worth 1".
+///
+/// Cost of one run (costOf), with E_ref the reference's own effort:
+///   c = max_pos  * max_pos_err_m / 0.05      + rms_pos * rms_pos_err_m / 0.01
+///     + max_ang  * max_ang_err_rad / 0.05    + rms_ang * rms_ang_err_rad / 0.01
+///     + convergence * (converge_pos_s + converge_ang_s) / 2 / 10
+///     + effort * max(0, effort / E_ref - 1)             (0 when E_ref <= 0)
+///     + saturation * 10 * saturated_s / duration_s
+///     + 50 for each of position and angle not converged (still outside its band
+///       at the end of the run: converge_*_s >= duration_s - 0.005 s)
+/// A diverged run (a non-finite metric, or max position error > 1 m) costs
+/// 1e4 + min(max_pos_err_m, 1000) (or 2e4 when not finite): large, finite, and
+/// still larger the further it went. The cost never decreases when a metric grows.
+/// Evaluation cost over the S scenarios: mean(c_i) + max(c_i).
 struct CostWeights {
   double max_pos = 1.0;      // max position error / 0.05 m
   double rms_pos = 1.0;      // RMS position error / 0.01 m
@@ -57,15 +70,20 @@ struct TuneSetup {
   std::vector<std::string> params{"kp", "ki", "kd", "ke", "kec", "k1", "k2", "k3"};  // names of control::kGainNames
   std::map<std::string, std::pair<double, double>> bounds;  // per-name overrides of defaultTuneBounds()
   CostWeights weights;
-  int plant_variations = 4;   // 1 = the plant only; more: gain, time constant and dead time spread around it
-  double gain_spread = 0.10;  // +- fraction
-  double tau_spread = 0.30;   // +- fraction
-  double dead_spread_s = 0.02;
-  int seeds = 2;              // noise seeds per plant variation
+  // Variation 0 is the plant; the others put each wheel's gain (x 1 +- gain_spread), time constant
+  // (x 1 +- tau_spread) and dead time (+ 0 .. dead_spread_s) on a Latin hypercube that includes the
+  // extremes, permuted by `seed`.
+  int plant_variations = 4;   // 1 = the plant only
+  double gain_spread = 0.10;  // +- fraction, [0, 1)
+  double tau_spread = 0.30;   // +- fraction, [0, 1)
+  double dead_spread_s = 0.02;  // added dead time, [0, 1] s
+  int seeds = 2;              // noise seeds per plant variation: seed, seed + 1, ...
   int max_evals = 1000;
   int threads = 0;            // 0 = std::thread::hardware_concurrency()
   double global_fraction = 0.7;  // share of max_evals for the global phase; the rest polishes locally
-  uint32_t seed = 1;
+  std::string global_algorithm = "GN_CRS2_LM";  // or GN_ISRES, GN_DIRECT_L, GN_ESCH (NLopt names)
+  std::string local_algorithm = "LN_SBPLX";     // or LN_BOBYQA, LN_NELDERMEAD, LN_COBYLA
+  uint32_t seed = 1;          // plant variations (Latin hypercube), noise seeds (seed + j), NLopt's random numbers
 };
 
 /// Search range the tuner uses for a gain unless TuneSetup::bounds overrides it.
@@ -99,7 +117,7 @@ struct TuneResult {
   int evals = 0;
   bool cancelled = false;
   double wall_s = 0.0;
-  std::string algorithm;  // e.g. "GN_CRS2_LM + LN_BOBYQA"
+  std::string algorithm;  // e.g. "GN_CRS2_LM + LN_SBPLX"
   std::vector<double> best_cost_history;  // best cost after each evaluation
 };
 

@@ -3,6 +3,7 @@
 #include <sqlite3.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <mutex>
@@ -114,12 +115,55 @@ SELECT r.id, r.run_id, r.robot_id, r.name, r.route, r.start_time, r.end_time,
        (SELECT count(*) FROM alarms a WHERE a.run_id = r.run_id) AS alarms
 FROM runs r LEFT JOIN run_summary s ON s.run_id = r.run_id;
 )sql",
+    // 4: fuzzy-PID tuning sessions and gains pushed to robots.
+    R"sql(
+CREATE TABLE tuning_sessions (
+  id                 INTEGER PRIMARY KEY,
+  session_id         TEXT NOT NULL UNIQUE,
+  created_time       TEXT NOT NULL,
+  created_unix       REAL NOT NULL,
+  robot_id           TEXT,
+  reference          TEXT NOT NULL DEFAULT '',
+  plant_json         TEXT NOT NULL DEFAULT '{}',
+  params             TEXT NOT NULL DEFAULT '',
+  algorithm          TEXT NOT NULL DEFAULT '',
+  evals              INTEGER NOT NULL DEFAULT 0,
+  wall_s             REAL NOT NULL DEFAULT 0,
+  cancelled          INTEGER NOT NULL DEFAULT 0 CHECK (cancelled IN (0, 1)),
+  initial_cost       REAL,
+  best_cost          REAL,
+  initial_gains_json TEXT NOT NULL DEFAULT '{}',
+  best_gains_json    TEXT NOT NULL DEFAULT '{}',
+  dir                TEXT NOT NULL DEFAULT ''
+);
+CREATE INDEX tuning_sessions_by_created ON tuning_sessions(created_unix);
+CREATE TABLE gains_pushes (
+  id         INTEGER PRIMARY KEY,
+  robot_id   TEXT NOT NULL,
+  time       TEXT NOT NULL,
+  time_unix  REAL NOT NULL,
+  version    INTEGER NOT NULL,
+  gains_json TEXT NOT NULL DEFAULT '{}',
+  status     TEXT NOT NULL CHECK (status IN ('accepted', 'rejected')),
+  reason     TEXT NOT NULL DEFAULT '',
+  session_id TEXT
+);
+CREATE INDEX gains_pushes_by_robot ON gains_pushes(robot_id, time_unix);
+)sql",
 };
 
 // Adds a robot (id, software_version, time), completed by what to do if it exists.
 #define INSERT_ROBOT                                                                                   \
   "INSERT INTO robots (id, software_version, first_seen, first_seen_unix, last_seen, last_seen_unix)" \
   " VALUES (?1, ?2, ?3, ?4, ?3, ?4) ON CONFLICT (id) DO "
+
+// Columns read into a TuningSession by readTuningSession(), in this order.
+#define TUNING_COLUMNS                                                                                          \
+  "id, session_id, created_unix, COALESCE(robot_id, ''), reference, plant_json, params, algorithm, evals,"     \
+  " wall_s, cancelled, initial_cost, best_cost, initial_gains_json, best_gains_json, dir"
+
+// Columns read into a GainsPush by readGainsPush(), in this order.
+#define PUSH_COLUMNS "id, robot_id, time_unix, version, gains_json, status, reason, COALESCE(session_id, '')"
 
 // Columns read into a RunInfo by readRun(), in this order.
 #define RUN_COLUMNS \
@@ -175,6 +219,13 @@ std::string sanitizeRobotId(const std::string& robot) {
 bool isOutcome(std::string_view s) {
   return std::find(std::begin(kOutcomes), std::end(kOutcomes), s) != std::end(kOutcomes);
 }
+
+bool isPushStatus(std::string_view s) {
+  return std::find(std::begin(kPushStatuses), std::end(kPushStatuses), s) != std::end(kPushStatuses);
+}
+
+// Costs that are not finite (no evaluation finished) are stored as NULL and read back as NaN.
+std::optional<double> finiteOrNull(double v) { return std::isfinite(v) ? std::optional<double>(v) : std::nullopt; }
 
 bool allDigits(const std::string& s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
@@ -429,6 +480,24 @@ struct Catalog::Impl {
     return readRun(q);
   }
 
+  TuningSession readTuningSession(const Query& q) const {
+    TuningSession s;
+    int64_t cancelled = 0;
+    std::optional<double> initial_cost, best_cost;
+    q.read(s.rowid, s.id, s.created, s.robot, s.reference, s.plant_json, s.params, s.algorithm, s.evals, s.wall_s,
+           cancelled, initial_cost, best_cost, s.initial_gains_json, s.best_gains_json, s.dir);
+    s.cancelled = cancelled != 0;
+    s.initial_cost = initial_cost.value_or(std::nan(""));
+    s.best_cost = best_cost.value_or(std::nan(""));
+    return s;
+  }
+
+  GainsPush readGainsPush(const Query& q) const {
+    GainsPush p;
+    q.read(p.rowid, p.robot, p.time, p.version, p.gains_json, p.status, p.reason, p.session_id);
+    return p;
+  }
+
   std::optional<Summary> readSummary(const std::string& run_id) {
     auto q = query(
         "SELECT duration_s, distance_m, min_person_m, track_max_pos_err_m, track_rms_pos_err_m,"
@@ -665,6 +734,61 @@ std::optional<RunDetail> Catalog::run(const std::string& run_id) {
   }
   tx.commit();
   return d;
+}
+
+void Catalog::addTuningSession(const TuningSession& s) {
+  if (s.id.empty()) impl_->failPlain("a tuning session needs an id");
+  std::lock_guard lk(impl_->mu);
+  {
+    auto q = impl_->query("SELECT 1 FROM tuning_sessions WHERE session_id = ?");
+    if (q.bind(s.id).step()) impl_->failPlain("tuning session '" + s.id + "' is already recorded");
+  }
+  impl_->query(
+           "INSERT INTO tuning_sessions (session_id, created_time, created_unix, robot_id, reference, plant_json,"
+           " params, algorithm, evals, wall_s, cancelled, initial_cost, best_cost, initial_gains_json,"
+           " best_gains_json, dir) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
+      .bind(s.id, s.created, nullIfEmpty(s.robot), s.reference, s.plant_json, s.params, s.algorithm, s.evals,
+            s.wall_s, int64_t{s.cancelled ? 1 : 0}, finiteOrNull(s.initial_cost), finiteOrNull(s.best_cost),
+            s.initial_gains_json, s.best_gains_json, s.dir)
+      .run();
+}
+
+std::vector<TuningSession> Catalog::listTuningSessions(int limit) {
+  std::lock_guard lk(impl_->mu);
+  auto q = impl_->query("SELECT " TUNING_COLUMNS " FROM tuning_sessions ORDER BY created_unix DESC, id DESC LIMIT ?");
+  q.bind(limit > 0 ? limit : -1);
+  std::vector<TuningSession> out;
+  while (q.step()) out.push_back(impl_->readTuningSession(q));
+  return out;
+}
+
+std::optional<TuningSession> Catalog::tuningSession(const std::string& id) {
+  std::lock_guard lk(impl_->mu);
+  auto q = impl_->query("SELECT " TUNING_COLUMNS " FROM tuning_sessions WHERE session_id = ?");
+  if (!q.bind(id).step()) return std::nullopt;
+  return impl_->readTuningSession(q);
+}
+
+void Catalog::addGainsPush(const GainsPush& p) {
+  if (p.robot.empty()) impl_->failPlain("a gains push needs a robot id");
+  if (!isPushStatus(p.status)) impl_->failPlain("unknown gains push status '" + p.status + "' (accepted, rejected)");
+  std::lock_guard lk(impl_->mu);
+  impl_->query(
+           "INSERT INTO gains_pushes (robot_id, time, time_unix, version, gains_json, status, reason, session_id)"
+           " VALUES (?, ?, ?, ?, ?, ?, ?, ?)")
+      .bind(p.robot, p.time, p.version, p.gains_json, p.status, p.reason, nullIfEmpty(p.session_id))
+      .run();
+}
+
+std::vector<GainsPush> Catalog::listGainsPushes(const std::string& robot, int limit) {
+  std::lock_guard lk(impl_->mu);
+  auto q = impl_->query("SELECT " PUSH_COLUMNS
+                        " FROM gains_pushes WHERE (?1 IS NULL OR robot_id = ?1)"
+                        " ORDER BY time_unix DESC, id DESC LIMIT ?2");
+  q.bind(nullIfEmpty(robot), limit > 0 ? limit : -1);
+  std::vector<GainsPush> out;
+  while (q.step()) out.push_back(impl_->readGainsPush(q));
+  return out;
 }
 
 std::string Catalog::integrityCheck() {

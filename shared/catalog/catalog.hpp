@@ -85,6 +85,38 @@ struct RunFilter {
   int limit = 100;            // newest first; <= 0: no limit
 };
 
+/// A tuning session of the fuzzy-PID tuner (docs/tuning.md), as one row.
+struct TuningSession {
+  int64_t rowid = 0;             // tuning_sessions.id (set by the catalog)
+  std::string id;                // session_id, unique, e.g. "20261122-083015-tune-robot1"
+  Time created{};
+  std::string robot;             // the robot it was tuned for; "" = none (NULL)
+  std::string reference;         // e.g. "circle r=3.5 m v=0.5 m/s laps=1"
+  std::string plant_json = "{}"; // the plant tuned for (per wheel gain, time constant, dead time, saturation)
+  std::string params;            // tuned gains, comma list, e.g. "kp,ki,kd,ke,kec,k1,k2,k3"
+  std::string algorithm;         // e.g. "GN_CRS2_LM + LN_BOBYQA"
+  int64_t evals = 0;
+  double wall_s = 0;
+  bool cancelled = false;
+  double initial_cost = 0, best_cost = 0;  // NaN (stored as NULL): no evaluation finished
+  std::string initial_gains_json = "{}", best_gains_json = "{}";
+  std::string dir;               // the session directory (summary.md, results.json, ...)
+};
+
+/// Gains sent to a robot and its answer.
+inline constexpr std::string_view kPushStatuses[] = {"accepted", "rejected"};
+
+struct GainsPush {
+  int64_t rowid = 0;             // gains_pushes.id (set by the catalog)
+  std::string robot;             // robot id (required; not checked against robots)
+  Time time{};
+  int64_t version = 0;           // the gains version the robot answered with
+  std::string gains_json = "{}"; // the gains pushed
+  std::string status;            // one of kPushStatuses
+  std::string reason;            // why rejected; "" when accepted
+  std::string session_id;        // the tuning session the gains came from; "" = none (NULL)
+};
+
 /// The built-in schema migrations, oldest first. PRAGMA user_version is the
 /// number applied. Append only: a released migration is never edited.
 std::span<const std::string_view> schemaMigrations();
@@ -141,6 +173,18 @@ class Catalog {
   std::vector<RunInfo> listRuns(const RunFilter& f = {});
   /// By run id, or by rowid when `run_id` is all digits.
   std::optional<RunDetail> run(const std::string& run_id);
+
+  /// Records a tuning session; throws for an empty or already recorded id.
+  void addTuningSession(const TuningSession& s);
+  /// Newest first; `limit` <= 0: all.
+  std::vector<TuningSession> listTuningSessions(int limit = 100);
+  /// By session id.
+  std::optional<TuningSession> tuningSession(const std::string& id);
+
+  /// Records a gains push and the robot's answer; throws for an empty robot or an unknown status.
+  void addGainsPush(const GainsPush& p);
+  /// Newest first; `robot` "" = every robot; `limit` <= 0: all.
+  std::vector<GainsPush> listGainsPushes(const std::string& robot, int limit = 100);
 
   /// "ok", or SQLite's messages one per line.
   std::string integrityCheck();

@@ -24,6 +24,13 @@ TrajectoryTracker::TrajectoryTracker(std::unique_ptr<ReferencePath> path, const 
   p_.pid.output_max = p_.max_wheel_speed_rad_s;
 }
 
+void TrajectoryTracker::setGains(const FuzzyPidParams& fuzzy, const AuxiliaryGains& aux,
+                                 std::shared_ptr<FuzzyGainScheduler> scheduler) {
+  p_.fuzzy = fuzzy;
+  p_.aux = aux;
+  if (scheduler) sched_ = std::move(scheduler);
+}
+
 PidGains TrajectoryTracker::lastGains(int wheel) const {
   return p_.wheel_control == WheelControl::kFuzzyPid ? wheel_[wheel].gains : p_.fuzzy.base;
 }

@@ -53,6 +53,12 @@ class TrajectoryTracker {
   /// speed_factor in [0, 1] slows progress along the path (fuzzy speed strategy).
   TrackerOutput step(const Pose2& pose, const WheelSpeeds& measured, double speed_factor, double dt_s);
 
+  /// New gains (and, when not null, a new fuzzy system) from the next step on.
+  /// The wheel loops keep their state: the integral is stored as a term
+  /// (ki * integral of e), so a change of ki does not bump the output.
+  void setGains(const FuzzyPidParams& fuzzy, const AuxiliaryGains& aux,
+                std::shared_ptr<FuzzyGainScheduler> scheduler = nullptr);
+
   const ReferencePath& path() const { return *path_; }
   const PathProgress& progress() const { return progress_; }
   /// Gains in force on each wheel in the last step (fuzzy-scheduled or base).

@@ -1,6 +1,6 @@
 // Run catalog (SQLite) on real files in a temporary directory: creation and
-// migrations (v1 -> latest, refusing a newer schema), runs, events, alarms,
-// summaries, files, filters, a SIGKILL during a run, the sqlite3 shell, bad
+// migrations (v1 -> latest, v3 -> latest, refusing a newer schema), runs,
+// events, alarms, summaries, files, filters, tuning sessions, gains pushes, a SIGKILL during a run, the sqlite3 shell, bad
 // files, concurrent writers, and the time format.
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -90,8 +91,8 @@ TEST_F(CatalogTest, CreatesWalDatabaseAtLatestVersion) {
   EXPECT_EQ(cat.integrityCheck(), "ok");
   EXPECT_EQ(rawQuery(path_, "PRAGMA journal_mode"), std::vector<std::string>{"wal"});
   EXPECT_EQ(rawQuery(path_, "SELECT name FROM sqlite_master WHERE type IN ('table', 'view') ORDER BY name"),
-            (std::vector<std::string>{"alarms", "events", "robots", "run_files", "run_gas", "run_overview",
-                                      "run_summary", "runs"}));
+            (std::vector<std::string>{"alarms", "events", "gains_pushes", "robots", "run_files", "run_gas",
+                                      "run_overview", "run_summary", "runs", "tuning_sessions"}));
 }
 
 TEST_F(CatalogTest, ReopeningKeepsDataAndVersion) {
@@ -132,6 +133,31 @@ TEST_F(CatalogTest, UpgradesVersion1ToLatest) {
   EXPECT_EQ(d->event_count, 1);
   ASSERT_TRUE(d->summary);
   ASSERT_EQ(d->summary->gas.size(), 1u);
+  EXPECT_EQ(cat.integrityCheck(), "ok");
+}
+
+TEST_F(CatalogTest, UpgradesVersion3ToLatestWithTheTuningTables) {
+  std::string id;
+  {
+    auto v3 = Catalog::open(path_, schemaMigrations().first(3));
+    EXPECT_EQ(v3.schemaVersion(), 3);
+    id = v3.startRun(runOf("robot1", "before tuning", t0_)).id;
+  }
+  EXPECT_EQ(rawQuery(path_, "SELECT count(*) FROM sqlite_master WHERE name IN ('tuning_sessions', 'gains_pushes')"),
+            std::vector<std::string>{"0"});
+
+  auto cat = Catalog::open(path_);
+  EXPECT_EQ(cat.schemaVersion(), static_cast<int>(schemaMigrations().size()));
+  EXPECT_EQ(rawQuery(path_, "SELECT count(*) FROM sqlite_master WHERE name IN ('tuning_sessions', 'gains_pushes')"),
+            std::vector<std::string>{"2"});
+  EXPECT_EQ(cat.run(id).value().info.name, "before tuning");
+  EXPECT_TRUE(cat.listTuningSessions().empty());
+  EXPECT_TRUE(cat.listGainsPushes("").empty());
+  TuningSession s;
+  s.id = "after-upgrade";
+  s.created = t0_;
+  cat.addTuningSession(s);
+  EXPECT_TRUE(cat.tuningSession("after-upgrade"));
   EXPECT_EQ(cat.integrityCheck(), "ok");
 }
 
@@ -295,6 +321,124 @@ TEST_F(CatalogTest, ListRunsFilters) {
   f = {};
   f.outcome = "bogus";
   EXPECT_NE(errorOf([&] { cat.listRuns(f); }).find("unknown outcome 'bogus'"), std::string::npos);
+}
+
+TuningSession sessionOf(const std::string& id, const std::string& robot, Time created) {
+  TuningSession s;
+  s.id = id;
+  s.created = created;
+  s.robot = robot;
+  s.reference = "circle r=3.5 m v=0.5 m/s laps=1";
+  s.plant_json = R"({"left":{"gain":1,"time_constant_s":0.2},"right":{"gain":1,"time_constant_s":0.2}})";
+  s.params = "kp,ki,kd,ke,kec,k1,k2,k3";
+  s.algorithm = "GN_CRS2_LM + LN_BOBYQA";
+  s.evals = 800;
+  s.wall_s = 61.5;
+  s.initial_cost = 12.25;
+  s.best_cost = 7.125;
+  s.initial_gains_json = R"({"kp":9.0})";
+  s.best_gains_json = R"({"kp":13.5})";
+  s.dir = "tuning/" + id;
+  return s;
+}
+
+TEST_F(CatalogTest, TuningSessionsRoundTrip) {
+  auto cat = Catalog::open(path_);
+  cat.addTuningSession(sessionOf("tune-a", "robot1", t0_));
+  auto b = sessionOf("tune-b", "", t0_ + milliseconds(60000));  // for no robot in particular
+  b.cancelled = true;
+  b.best_cost = std::nan("");  // cancelled before an evaluation finished
+  cat.addTuningSession(b);
+  cat.addTuningSession(sessionOf("tune-c", "robot2", t0_ - milliseconds(60000)));
+
+  const auto all = cat.listTuningSessions();
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].id, "tune-b");  // newest first
+  EXPECT_EQ(all[1].id, "tune-a");
+  EXPECT_EQ(all[2].id, "tune-c");
+  EXPECT_EQ(cat.listTuningSessions(1).size(), 1u);
+  EXPECT_EQ(cat.listTuningSessions(0).size(), 3u);
+
+  const auto a = cat.tuningSession("tune-a").value();
+  const auto want = sessionOf("tune-a", "robot1", t0_);
+  EXPECT_GT(a.rowid, 0);
+  EXPECT_EQ(a.created, t0_);
+  EXPECT_EQ(a.robot, "robot1");
+  EXPECT_EQ(a.reference, want.reference);
+  EXPECT_EQ(a.plant_json, want.plant_json);
+  EXPECT_EQ(a.params, want.params);
+  EXPECT_EQ(a.algorithm, want.algorithm);
+  EXPECT_EQ(a.evals, 800);
+  EXPECT_EQ(a.wall_s, 61.5);
+  EXPECT_FALSE(a.cancelled);
+  EXPECT_EQ(a.initial_cost, 12.25);
+  EXPECT_EQ(a.best_cost, 7.125);
+  EXPECT_EQ(a.initial_gains_json, want.initial_gains_json);
+  EXPECT_EQ(a.best_gains_json, want.best_gains_json);
+  EXPECT_EQ(a.dir, "tuning/tune-a");
+  const auto rb = cat.tuningSession("tune-b").value();
+  EXPECT_EQ(rb.robot, "");
+  EXPECT_TRUE(rb.cancelled);
+  EXPECT_TRUE(std::isnan(rb.best_cost));
+  EXPECT_FALSE(cat.tuningSession("tune-z"));
+
+  EXPECT_EQ(rawQuery(path_, "SELECT session_id || ' ' || created_time FROM tuning_sessions WHERE robot_id IS NULL"),
+            std::vector<std::string>{"tune-b 2026-11-22T08:31:15.250Z"});
+  EXPECT_EQ(rawQuery(path_, "SELECT count(*) FROM tuning_sessions WHERE best_cost IS NULL AND cancelled = 1"),
+            std::vector<std::string>{"1"});
+
+  EXPECT_EQ(errorOf([&] { cat.addTuningSession(sessionOf("tune-a", "robot1", t0_)); }),
+            "catalog " + path_ + ": tuning session 'tune-a' is already recorded");
+  EXPECT_EQ(errorOf([&] { cat.addTuningSession(sessionOf("", "robot1", t0_)); }),
+            "catalog " + path_ + ": a tuning session needs an id");
+  EXPECT_EQ(cat.listTuningSessions().size(), 3u);
+}
+
+TEST_F(CatalogTest, GainsPushesRoundTrip) {
+  auto cat = Catalog::open(path_);
+  cat.addTuningSession(sessionOf("tune-a", "robot1", t0_));
+  const auto push = [](const std::string& robot, Time t, int64_t version, const std::string& status,
+                       const std::string& reason, const std::string& session) {
+    GainsPush p;
+    p.robot = robot;
+    p.time = t;
+    p.version = version;
+    p.gains_json = R"({"kp":13.5})";
+    p.status = status;
+    p.reason = reason;
+    p.session_id = session;
+    return p;
+  };
+  cat.addGainsPush(push("robot1", t0_ + milliseconds(1000), 2, "accepted", "", "tune-a"));
+  cat.addGainsPush(push("robot1", t0_ + milliseconds(2000), 2, "rejected", "robot is tracking a path", ""));
+  cat.addGainsPush(push("robot2", t0_ + milliseconds(1500), 7, "accepted", "", "from-another-pc"));
+
+  const auto r1 = cat.listGainsPushes("robot1");
+  ASSERT_EQ(r1.size(), 2u);
+  EXPECT_EQ(r1[0].status, "rejected");  // newest first
+  EXPECT_EQ(r1[0].reason, "robot is tracking a path");
+  EXPECT_EQ(r1[0].session_id, "");
+  EXPECT_EQ(r1[0].time, t0_ + milliseconds(2000));
+  EXPECT_EQ(r1[1].status, "accepted");
+  EXPECT_EQ(r1[1].version, 2);
+  EXPECT_EQ(r1[1].session_id, "tune-a");
+  EXPECT_EQ(r1[1].gains_json, R"({"kp":13.5})");
+  EXPECT_GT(r1[0].rowid, r1[1].rowid);
+
+  const auto all = cat.listGainsPushes("");
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[1].robot, "robot2");
+  EXPECT_EQ(all[1].session_id, "from-another-pc");  // a session this catalog does not know is kept as given
+  EXPECT_EQ(cat.listGainsPushes("", 1).size(), 1u);
+  EXPECT_TRUE(cat.listGainsPushes("robot9").empty());
+  EXPECT_EQ(rawQuery(path_, "SELECT count(*) FROM gains_pushes WHERE session_id IS NULL"),
+            std::vector<std::string>{"1"});
+
+  EXPECT_EQ(errorOf([&] { cat.addGainsPush(push("robot1", t0_, 3, "maybe", "", "")); }),
+            "catalog " + path_ + ": unknown gains push status 'maybe' (accepted, rejected)");
+  EXPECT_EQ(errorOf([&] { cat.addGainsPush(push("", t0_, 3, "accepted", "", "")); }),
+            "catalog " + path_ + ": a gains push needs a robot id");
+  EXPECT_EQ(cat.listGainsPushes("").size(), 3u);
 }
 
 TEST_F(CatalogTest, MarkIncompleteRunsEndsThemAtTheirLastRecord) {

@@ -517,7 +517,9 @@ TEST_F(ConsoleTest, BadRouteFileIsOneLineNamingFileAndKey) {
   EXPECT_FALSE(ok);
   EXPECT_EQ(out, "route: /nonexistent/route.yaml: cannot open file\n");
   std::tie(ok, out) = run("route");
-  EXPECT_EQ(out, "route: needs one file: route <file>\n");
+  EXPECT_EQ(out, "route: needs one route: route <file|name>\n");
+  std::tie(ok, out) = run("route no_such_route");
+  EXPECT_EQ(out, "route: no route 'no_such_route': neither a file nor config/routes/no_such_route.yaml\n");
   EXPECT_TRUE(sink_.sent.empty());
 }
 
