@@ -732,12 +732,7 @@ serial::WheelCommand RobotCore::computeCommand(double dt_s) {
     // Open loop: the profile's set-points go to the MCU unslewed (the steps
     // are the point); the MCU clamps to its wheel limit.
     wheelTestStep(dt_s);
-    cmd_twist_ = control::twistFromWheels(cmd_wheels_, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
-    serial::WheelCommand c;
-    c.left_mrad_s = toMrad(cmd_wheels_.left_rad_s);
-    c.right_mrad_s = toMrad(cmd_wheels_.right_rad_s);
-    c.flags = serial::WheelCommand::kEnable;
-    return c;
+    return wheelCommand(true);
   }
   if (mode_ == v1::TRACKING && tracker_ && !latched && !(faults_ & v1::FAULT_SENSOR_STALE)) {
     if (dt_s > 0.0) {
@@ -755,12 +750,7 @@ serial::WheelCommand RobotCore::computeCommand(double dt_s) {
         setMode(v1::IDLE, "path completed");
       }
     }
-    cmd_twist_ = control::twistFromWheels(cmd_wheels_, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
-    serial::WheelCommand c;
-    c.left_mrad_s = toMrad(cmd_wheels_.left_rad_s);
-    c.right_mrad_s = toMrad(cmd_wheels_.right_rad_s);
-    c.flags = serial::WheelCommand::kEnable;
-    return c;
+    return wheelCommand(true);
   }
   control::Twist target;
   if (mode_ == v1::TELEOP) target = setpoint_;
@@ -778,11 +768,15 @@ serial::WheelCommand RobotCore::computeCommand(double dt_s) {
     cmd_wheels_.left_rad_s = slew(cmd_wheels_.left_rad_s, want.left_rad_s, step);
     cmd_wheels_.right_rad_s = slew(cmd_wheels_.right_rad_s, want.right_rad_s, step);
   }
+  return wheelCommand(!latched);
+}
+
+serial::WheelCommand RobotCore::wheelCommand(bool enable) {
   cmd_twist_ = control::twistFromWheels(cmd_wheels_, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
   serial::WheelCommand c;
   c.left_mrad_s = toMrad(cmd_wheels_.left_rad_s);
   c.right_mrad_s = toMrad(cmd_wheels_.right_rad_s);
-  c.flags = latched ? 0 : serial::WheelCommand::kEnable;
+  c.flags = enable ? serial::WheelCommand::kEnable : 0;
   return c;
 }
 

@@ -131,6 +131,8 @@ class RobotCore {
   void startRetreat(const std::string& why);
   void checkTimeouts(double now_s);
   serial::WheelCommand computeCommand(double dt_s);
+  /// cmd_wheels_ as the MCU command (and cmd_twist_ from it).
+  serial::WheelCommand wheelCommand(bool enable);
   /// Tracking: 1 when nothing is close ahead, down to 0 at safety.obstacle_stop_m (front sonars).
   double obstacleFactor();
 

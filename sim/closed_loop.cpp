@@ -2,12 +2,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "sim/robot_plant.hpp"
 #include "sim/world.hpp"
 
 namespace inspect::sim {
+
+std::vector<double> distanceFromPath(const std::vector<double>& px, const std::vector<double>& py,
+                                     const std::vector<ClosedLoopSample>& samples) {
+  std::vector<double> out;
+  out.reserve(samples.size());
+  const std::size_t n = px.size();
+  if (n < 2) return std::vector<double>(samples.size(), std::numeric_limits<double>::quiet_NaN());
+  std::size_t j = 0;
+  for (const auto& s : samples) {
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t best_j = j;
+    const std::size_t lo = j > 200 ? j - 200 : 0, hi = std::min(n - 1, j + 400);
+    for (std::size_t k = lo; k < hi; ++k) {
+      const double ax = px[k], ay = py[k], bx = px[k + 1] - ax, by = py[k + 1] - ay;
+      const double len2 = bx * bx + by * by;
+      const double u = len2 > 0 ? std::clamp(((s.pose.x_m - ax) * bx + (s.pose.y_m - ay) * by) / len2, 0.0, 1.0) : 0.0;
+      const double d = std::hypot(s.pose.x_m - ax - u * bx, s.pose.y_m - ay - u * by);
+      if (d < best) {
+        best = d;
+        best_j = k;
+      }
+    }
+    j = best_j;
+    out.push_back(best);
+  }
+  return out;
+}
 
 double convergenceTime(const std::vector<double>& t, const std::vector<double>& value, double band) {
   for (std::size_t i = std::min(t.size(), value.size()); i-- > 0;)

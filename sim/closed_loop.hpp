@@ -66,6 +66,13 @@ struct ClosedLoopResult {
 ClosedLoopResult runClosedLoop(const ClosedLoopConfig& cfg, std::unique_ptr<control::ReferencePath> path,
                                std::shared_ptr<control::FuzzyGainScheduler> scheduler, bool keep_samples);
 
+/// Distance of each sample's true position from the reference polyline
+/// (px, py): the shape error of Fig 18, without the along-track lag. Progress
+/// along the path is monotone, so the search runs in a window around the last
+/// match. NaN for every sample when the polyline has fewer than 2 points.
+std::vector<double> distanceFromPath(const std::vector<double>& px, const std::vector<double>& py,
+                                     const std::vector<ClosedLoopSample>& samples);
+
 /// Convergence time of a series: the time after which |value| stays <= band.
 double convergenceTime(const std::vector<double>& t, const std::vector<double>& value, double band);
 

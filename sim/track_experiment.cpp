@@ -209,18 +209,7 @@ std::unique_ptr<control::ReferencePath> makePath(const Options& o) {
   switch (o.trajectory) {
     case Trajectory::kCircle: return control::makeCircle(start, o.radius_m, o.speed_m_s, o.laps);
     case Trajectory::kLine: return control::makeLine(start, o.length_m, o.speed_m_s);
-    case Trajectory::kWaypoints: {
-      // A length x length/2 rectangle, counter-clockwise, corners timed at the speed.
-      const double a = o.length_m, b = o.length_m / 2.0;
-      const double corners[5][2] = {{0, 0}, {a, 0}, {a, b}, {0, b}, {0, 0}};
-      std::vector<control::TimedWaypoint> wps;
-      double t = 0;
-      for (int k = 0; k < 5; ++k) {
-        if (k) t += std::hypot(corners[k][0] - corners[k - 1][0], corners[k][1] - corners[k - 1][1]) / o.speed_m_s;
-        wps.push_back({t, corners[k][0], corners[k][1]});
-      }
-      return control::makeTimedWaypoints(wps);
-    }
+    case Trajectory::kWaypoints: return control::makeRectangleWaypoints(o.length_m, o.speed_m_s);
   }
   throw std::logic_error("unknown trajectory");
 }
@@ -415,35 +404,6 @@ plot::Panel panel(const std::string& title, const std::string& xlabel, const std
   return p;
 }
 
-/// Distance of each actual position from the reference polyline (the shape
-/// error Fig 18 shows, without the along-track lag). Progress along the
-/// path is monotone, so the search runs in a window around the last match.
-std::vector<double> distanceFromPath(const std::vector<double>& px, const std::vector<double>& py,
-                                     const std::vector<sim::ClosedLoopSample>& samples) {
-  std::vector<double> out;
-  out.reserve(samples.size());
-  std::size_t j = 0;
-  const std::size_t n = px.size();
-  for (const auto& s : samples) {
-    double best = std::numeric_limits<double>::infinity();
-    std::size_t best_j = j;
-    const std::size_t lo = j > 200 ? j - 200 : 0, hi = std::min(n - 1, j + 400);
-    for (std::size_t k = lo; k < hi; ++k) {
-      const double ax = px[k], ay = py[k], bx = px[k + 1] - ax, by = py[k + 1] - ay;
-      const double len2 = bx * bx + by * by;
-      const double u = len2 > 0 ? std::clamp(((s.pose.x_m - ax) * bx + (s.pose.y_m - ay) * by) / len2, 0.0, 1.0) : 0.0;
-      const double d = std::hypot(s.pose.x_m - ax - u * bx, s.pose.y_m - ay - u * by);
-      if (d < best) {
-        best = d;
-        best_j = k;
-      }
-    }
-    j = best_j;
-    out.push_back(best);
-  }
-  return out;
-}
-
 std::string writePlots(const Options& o, const std::vector<const Run*>& runs, const control::PidGains& base,
                        std::vector<std::string>& written) {
   namespace fs = std::filesystem;
@@ -471,7 +431,7 @@ std::string writePlots(const Options& o, const std::vector<const Run*>& runs, co
     for (const Run* r : runs) {
       auto actual = series(label(r->controller), colorOf(r->controller));
       auto d = series(label(r->controller), colorOf(r->controller), 1);
-      d.y = distanceFromPath(ref.x, ref.y, r->result.samples);
+      d.y = sim::distanceFromPath(ref.x, ref.y, r->result.samples);
       for (const auto& smp : r->result.samples) {
         actual.x.push_back(smp.pose.x_m);
         actual.y.push_back(smp.pose.y_m);

@@ -24,18 +24,7 @@ std::unique_ptr<control::ReferencePath> TuneReference::makePath() const {
   switch (kind) {
     case Kind::kCircle: return control::makeCircle(start, radius_m, speed_m_s, laps);
     case Kind::kLine: return control::makeLine(start, length_m, speed_m_s);
-    case Kind::kWaypoints: {
-      if (!(speed_m_s > 0)) throw std::invalid_argument("speed must be positive");
-      const double a = length_m, b = length_m / 2.0;
-      const double corners[5][2] = {{0, 0}, {a, 0}, {a, b}, {0, b}, {0, 0}};
-      std::vector<control::TimedWaypoint> wps;
-      double t = 0;
-      for (int k = 0; k < 5; ++k) {
-        if (k) t += std::hypot(corners[k][0] - corners[k - 1][0], corners[k][1] - corners[k - 1][1]) / speed_m_s;
-        wps.push_back({t, corners[k][0], corners[k][1]});
-      }
-      return control::makeTimedWaypoints(wps);
-    }
+    case Kind::kWaypoints: return control::makeRectangleWaypoints(length_m, speed_m_s);
   }
   throw std::invalid_argument("unknown reference kind");
 }
@@ -44,9 +33,9 @@ std::pair<double, double> defaultTuneBounds(const std::string& name) {
   // Ranges a robot engineer would search around the paper's values
   // (kp' 9, ki' 2, kd' 3, ke 0.9, kec 0.1, k1 3, k2 1, k3 1, a1 -1, a2 -1.2, a3 -0.5).
   if (name == "kp") return {0.5, 30.0};
-  if (name == "ki") return {0.0, 20.0};
+  if (name == "ki") return {0.0, 50.0};
   if (name == "kd") return {0.0, 10.0};
-  if (name == "ke") return {0.05, 5.0};
+  if (name == "ke") return {0.01, 10.0};
   if (name == "kec") return {0.005, 1.0};
   if (name == "k1") return {0.0, 10.0};
   if (name == "k2") return {0.0, 5.0};

@@ -157,7 +157,7 @@ plot::Panel panel(const std::string& title, const std::string& xlabel, const std
 plot::Panel errorPanel(const Comparison& c, bool position) {
   const double band = position ? kLoopDefaults.settle_position_m : kLoopDefaults.settle_angle_rad;
   auto p = panel(std::string(position ? "Fig 20a: position error" : "Fig 20b: angle error") + " vs time, " +
-                     c.reference + ", nominal plant (grey: band " + fmtG(band) + (position ? " m" : " rad") +
+                     c.reference + ", the tuning plant (grey: band " + fmtG(band) + (position ? " m" : " rad") +
                      "; dotted: convergence time)",
                  "t (s)", position ? "position error (m)" : "angle error (rad)");
   p.bands.push_back({0.0, band, "#bbbbbb", "band"});
@@ -186,40 +186,10 @@ plot::Panel errorPanel(const Comparison& c, bool position) {
   return p;
 }
 
-/// Distance of each actual position from the reference polyline (the shape
-/// error, without the along-track lag; as track_experiment's Fig 18 panel).
-/// Progress along the path is monotone, so the search runs in a window around the last match.
-std::vector<double> distanceFromPath(const std::vector<double>& px, const std::vector<double>& py,
-                                     const std::vector<sim::ClosedLoopSample>& samples) {
-  std::vector<double> out;
-  out.reserve(samples.size());
-  const std::size_t n = px.size();
-  if (n < 2) return std::vector<double>(samples.size(), kNaN);
-  std::size_t j = 0;
-  for (const auto& s : samples) {
-    double best = std::numeric_limits<double>::infinity();
-    std::size_t best_j = j;
-    const std::size_t lo = j > 200 ? j - 200 : 0, hi = std::min(n - 1, j + 400);
-    for (std::size_t k = lo; k < hi; ++k) {
-      const double ax = px[k], ay = py[k], bx = px[k + 1] - ax, by = py[k + 1] - ay;
-      const double len2 = bx * bx + by * by;
-      const double u = len2 > 0 ? std::clamp(((s.pose.x_m - ax) * bx + (s.pose.y_m - ay) * by) / len2, 0.0, 1.0) : 0.0;
-      const double d = std::hypot(s.pose.x_m - ax - u * bx, s.pose.y_m - ay - u * by);
-      if (d < best) {
-        best = d;
-        best_j = k;
-      }
-    }
-    j = best_j;
-    out.push_back(best);
-  }
-  return out;
-}
-
 /// The x-y paths with the reference, and their distance from the reference
 /// path over time (the paths differ by centimetres on metres of path).
 std::vector<plot::Panel> trajectoryPanels(const Comparison& c, const TuneReference& ref) {
-  auto xy = panel("Reference and actual trajectories (" + c.reference + ", nominal plant, seed 1)", "x (m)", "y (m)");
+  auto xy = panel("Reference and actual trajectories (" + c.reference + ", the tuning plant, seed 1)", "x (m)", "y (m)");
   xy.equal_axes = true;
   xy.key = "outside right top";
   auto dist = panel("Distance of each trajectory from the reference path (the top panel magnified; along-track lag "
@@ -238,7 +208,7 @@ std::vector<plot::Panel> trajectoryPanels(const Comparison& c, const TuneReferen
   for (std::size_t i = 0; i < c.rows.size(); ++i) {
     auto s = series(c.rows[i].label, colorOf(i));
     auto d = series(c.rows[i].label, colorOf(i), 1);
-    d.y = distanceFromPath(r.x, r.y, c.rows[i].trace.samples);
+    d.y = sim::distanceFromPath(r.x, r.y, c.rows[i].trace.samples);
     for (const auto& smp : c.rows[i].trace.samples) {
       s.x.push_back(smp.pose.x_m);
       s.y.push_back(smp.pose.y_m);
@@ -404,7 +374,7 @@ std::string comparisonTable(const Comparison& c) {
   };
   os << "Reference: " << c.reference << "\nPlant: " << c.plant_description << "\n";
   line("metric", [&](std::size_t i) { return c.rows[i].label; });
-  os << "-- nominal plant, noise seed 1 --\n";
+  os << "-- the plant tuned for, noise seed 1 --\n";
   for (const auto& r : kRows) line(r.label, [&](std::size_t i) { return fmt(r.value(c.rows[i]), r.decimals); });
   os << "-- over " << scenarios << " scenario(s) (plant variations x noise seeds) --\n";
   for (const auto& r : kRobustRows)

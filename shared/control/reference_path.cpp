@@ -117,6 +117,20 @@ std::unique_ptr<ReferencePath> makeTimedWaypoints(const std::vector<TimedWaypoin
   return std::make_unique<WaypointPath>(wps);
 }
 
+std::unique_ptr<ReferencePath> makeRectangleWaypoints(double length_m, double speed_m_s) {
+  if (!(length_m > 0) || !std::isfinite(length_m)) throw std::invalid_argument("rectangle length must be positive");
+  if (!(speed_m_s > 0) || !std::isfinite(speed_m_s)) throw std::invalid_argument("speed must be positive");
+  const double a = length_m, b = length_m / 2.0;
+  const double corners[5][2] = {{0, 0}, {a, 0}, {a, b}, {0, b}, {0, 0}};
+  std::vector<TimedWaypoint> wps;
+  double t = 0;
+  for (int k = 0; k < 5; ++k) {
+    if (k) t += std::hypot(corners[k][0] - corners[k - 1][0], corners[k][1] - corners[k - 1][1]) / speed_m_s;
+    wps.push_back({t, corners[k][0], corners[k][1]});
+  }
+  return makeTimedWaypoints(wps);
+}
+
 ReferenceState advance(const ReferencePath& path, PathProgress& p, double speed_factor, double dt_s) {
   const double f = std::isfinite(speed_factor) ? std::clamp(speed_factor, 0.0, 1.0) : 0.0;
   const PathSample here = path.at(p.s_m);

@@ -44,6 +44,9 @@ struct TimedWaypoint {
 /// A polyline through timed waypoints (times strictly increasing); the speed
 /// on each segment is its length over its duration. Throws std::invalid_argument.
 std::unique_ptr<ReferencePath> makeTimedWaypoints(const std::vector<TimedWaypoint>& wps);
+/// Waypoints of a length x length/2 rectangle from the origin, counter-clockwise,
+/// corners timed at speed_m_s (the experiments' and the tuner's "waypoints").
+std::unique_ptr<ReferencePath> makeRectangleWaypoints(double length_m, double speed_m_s);
 
 /// Moves along a path: s advances by speed * factor * dt. Pure state + step.
 struct PathProgress {

@@ -236,3 +236,27 @@ TEST(Program, SigintInterruptsAScript) {
   EXPECT_LT(Clock::now() - t0, 2s);
   EXPECT_HAS(p.out(), "interrupted");
 }
+
+TEST(Program, SigintDuringTuneCancelsItKeepingTheBestAndTheScriptGoesOn) {
+  Program p("sigint_tune");
+  // 100000 evaluations would take an hour: only Ctrl-C ends it.
+  const auto script = p.file("s.txt", "tune evals=100000 variations=1 seeds=1 threads=1\necho after the tune\ngains show\n");
+  const auto port_file = p.path("port");
+  p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--port-file", port_file.string(), "--script",
+           script.string(), "--runs-dir", p.path("runs").string()});
+  ASSERT_GT(p.waitPort(port_file), 0);
+  // Wait for the progress bar (a few evaluations), then Ctrl-C.
+  const auto deadline = Clock::now() + 20s;
+  while (Clock::now() < deadline && p.out().find("evals  best cost") == std::string::npos)
+    std::this_thread::sleep_for(50ms);
+
+  ASSERT_NE(p.out().find("evals  best cost"), std::string::npos) << p.out() << p.err();
+  p.signal(SIGINT);
+  EXPECT_EQ(p.wait(30000ms), 0) << p.out() << p.err();
+  const std::string out = p.out();
+  EXPECT_HAS(out, "tune: cancelled after ");
+  EXPECT_HAS(out, "fuzzy-PID (tuned)");   // the comparison with the best so far
+  EXPECT_HAS(out, "after the tune");      // the server went on
+  EXPECT_HAS(out, "tuned");               // gains show has the tuned column
+  EXPECT_TRUE(fs::exists(p.path("runs") / "tuning"));
+}
