@@ -141,7 +141,7 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  'last' = the newest identification run. Record one with `route identification`.\n"
        "  example: identify last\n",
        &Console::cmdIdentify},
-      {"tune", "tune [key=value ...]", "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
+      {"tune", "tune [key=value ...] | tune list", "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
        "  Closed-loop simulations of the robot's own tracker on the plant (nominal, or the last\n"
        "  `identify`), each candidate over plant variations x noise seeds; cost = weighted max/RMS\n"
        "  position and angle error, convergence time, effort and saturation (docs/tuning.md).\n"
@@ -152,7 +152,7 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  Shows a progress bar and the best cost; Ctrl-C stops and keeps the best so far. Then\n"
        "  prints PID vs fuzzy-PID (paper gains) vs tuned, writes plots and summary.md into\n"
        "  runs/tuning/<session>/, books the session in the catalog and makes the tuned set the\n"
-       "  working set (gains push sends it).\n"
+       "  working set (gains push sends it). `tune list`: the sessions in the catalog.\n"
        "  example: tune evals=300 speed=0.5\n",
        &Console::cmdTune},
       {"gains", "gains show [robot] | gains set <name>=<value>...|paper|tuned|robot | gains push [robot] | "
@@ -233,8 +233,9 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "      speed_factor people\n"
        "    navigation: nav_mode goal_dist goal_index goal_count nav_switches dwell\n"
        "    gas: gas0 gas1 gas2 gas3 (channel values) alarms alarms_high (active on the robot)\n"
+       "    tuning: gains_version wheel_test_progress\n"
        "  and: robots (number of connected robots).\n"
-       "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING; nav_mode takes NONE,\n"
+       "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING, WHEEL_TEST; nav_mode takes NONE,\n"
        "  GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL; integer fields take 0x.. too.\n"
        "  examples: expect robots >= 1 within 5\n"
        "            expect x ~ 2.0 0.05 within 10\n"

@@ -2,6 +2,7 @@
 // The operator console's commands: parsing, dispatch and output. It holds no
 // terminal and no socket: lines in, text out (tested on strings); the robots
 // are reached through the registry (state) and a CommandSink (commands).
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -171,6 +172,7 @@ class Console {
   };
   std::vector<Run> runs_;
   std::shared_ptr<TuningState> tuning_;
+  std::atomic<bool> tune_cancel_{false};  // Ctrl-C during tune (StopFlag's interrupt target)
   std::string tuning_robot_config_ = "config/robot.yaml";
   std::string tuning_control_config_ = "config/control.yaml";
   std::string tuning_dir_ = "runs/tuning";

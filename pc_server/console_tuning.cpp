@@ -75,6 +75,8 @@ std::string plantJson(const control::PlantModel& p) {
   return buf;
 }
 
+constexpr double kMaxTuneReference_s = 300.0;
+
 std::string sessionStamp() {
   const auto now = std::chrono::system_clock::now();
   const std::time_t t = std::chrono::system_clock::to_time_t(now);
@@ -187,6 +189,23 @@ bool Console::cmdIdentify(const Args& args, const std::string&, int) {
 // ---------------------------------------------------------------------- tune
 
 bool Console::cmdTune(const Args& args, const std::string&, int) {
+  if (args.size() == 1 && args[0] == "list") {
+    // The tuning sessions in the catalog, newest first.
+    if (!recorder_) return fail("tune", "the server records nothing (--no-record): no catalog of sessions");
+    const auto list = recorder_->catalog().listTuningSessions(20);
+    if (list.empty()) {
+      out_ << "no tuning sessions in the catalog\n";
+      return true;
+    }
+    for (const auto& t : list) {
+      char line[512];
+      std::snprintf(line, sizeof line, "%-34s %-8s %-36s %5lld evals %7.1f s  cost %.4g -> %.4g%s  %s\n", t.id.c_str(),
+                    t.robot.empty() ? "-" : t.robot.c_str(), t.reference.c_str(), static_cast<long long>(t.evals),
+                    t.wall_s, t.initial_cost, t.best_cost, t.cancelled ? " (cancelled)" : "", t.dir.c_str());
+      out_ << line;
+    }
+    return true;
+  }
   TuningState* ts = tuning("tune");
   if (!ts) return false;
   tuning::TuneSetup s;
@@ -241,7 +260,7 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
       if (!x) return false;
       s.seeds = static_cast<int>(*x);
     } else if (k == "threads") {
-      const auto x = number(0, 256);
+      const auto x = number(0, 64);
       if (!x) return false;
       s.threads = static_cast<int>(*x);
     } else if (k == "seed") {
@@ -288,6 +307,18 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
     }
   }
   const control::GainSet start_gains = start == "paper" ? ts->paper : start == "tuned" ? *ts->tuned : ts->working;
+  // Each run's samples are held in memory: a reference longer than 5 minutes
+  // (a slow, many-lap circle) would cost gigabytes and minutes per evaluation.
+  try {
+    const auto path = s.reference.makePath();
+    double t = 0.0;
+    for (double d = 0.0; d < path->length_m(); d += 0.05) t += 0.05 / std::max(1e-3, path->at(d).speed_m_s);
+    if (t > kMaxTuneReference_s)
+      return fail("tune", s.reference.describe() + " lasts " + fmtShort(t, 0) + " s: at most " +
+                              fmtShort(kMaxTuneReference_s, 0) + " s (fewer laps, a smaller radius or a higher speed)");
+  } catch (const std::exception& e) {
+    return fail("tune", e.what());
+  }
   std::unique_ptr<tuning::Tuner> tuner;
   try {
     tuner = std::make_unique<tuning::Tuner>(s);
@@ -304,7 +335,8 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
        << setup.seeds << " noise seeds); Ctrl-C stops and keeps the best so far\n";
   out_.flush();
 
-  std::atomic<bool> cancel{false};
+  std::atomic<bool>& cancel = tune_cancel_;  // outlives the command: the signal handler may still hold it
+  cancel.store(false);
   stop_.setInterruptTarget(&cancel);
   const bool tty = alarm_style_;  // an interactive terminal: one redrawn progress line
   int last_decile = -1;
@@ -360,7 +392,9 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
   }
   out_ << tuning::comparisonTable(cmp);
   const std::string robot = selected_;
-  const std::string session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot);
+  std::string session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot);
+  for (int n = 2; fs::exists(tuning_dir_ + "/" + session) && n < 1000; ++n)  // two sessions in one second
+    session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot) + "-" + std::to_string(n);
   const std::string dir = tuning_dir_ + "/" + session;
   try {
     const auto files = tuning::writeTuningSession(dir, setup, result, cmp, ts->fis);

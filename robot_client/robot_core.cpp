@@ -242,7 +242,7 @@ v1::Ack RobotCore::startTrack(const v1::Command& cmd) {
 v1::Ack RobotCore::stageGains(const v1::Command& cmd) {
   const auto& u = cmd.gains();
   v1::Ack ack = ackOf(cmd.id(), v1::Ack::REJECTED);
-  ack.set_gains_version(pending_gains_ ? pending_gains_->version : gains_version_);
+  ack.set_gains_version(gains_version_);  // the version in force now
   if (!u.has_gains()) {
     ack.set_reason("gains update without gains");
     return ack;
@@ -254,8 +254,15 @@ v1::Ack RobotCore::stageGains(const v1::Command& cmd) {
     return ack;
   }
   if (!u.fis().empty()) {
-    if (u.fis().size() > 256 * 1024) {
-      ack.set_reason("fuzzy system refused: larger than 256 KiB");
+    if (u.fis().size() > 64 * 1024) {
+      ack.set_reason("fuzzy system refused: larger than 64 KiB");
+      return ack;
+    }
+    // Compiling a fuzzy system (its lookup surface) takes this thread tens of
+    // milliseconds: not while the wheels depend on every tick.
+    if (moving()) {
+      ack.set_reason("fuzzy system refused: the robot is moving (" + std::string(v1::Mode_Name(mode_)) +
+                     "); push it while it stands still");
       return ack;
     }
     try {
@@ -331,6 +338,19 @@ v1::Ack RobotCore::startWheelTest(const v1::Command& cmd) {
     g.f1_hz = s.f1_hz();
     segs.push_back(g);
   }
+  // The robot's speed and turn-rate limits hold for open-loop tests too.
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    const auto tw = control::twistFromWheels({segs[i].left_rad_s, segs[i].right_rad_s}, robot_.geometry.wheel_radius_m,
+                                             robot_.geometry.track_m);
+    if (std::abs(tw.v_m_s) > robot_.limits.max_v_m_s + 1e-9 || std::abs(tw.w_rad_s) > robot_.limits.max_w_rad_s + 1e-9) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "segment %zu (%s): %.2f m/s and %.2f rad/s exceed the robot's limits (%.2f m/s, %.2f rad/s)", i + 1,
+                    control::toString(segs[i].kind), tw.v_m_s, tw.w_rad_s, robot_.limits.max_v_m_s,
+                    robot_.limits.max_w_rad_s);
+      return ackOf(cmd.id(), v1::Ack::REJECTED, buf);
+    }
+  }
   try {
     auto profile = std::make_unique<control::WheelProfile>(std::move(segs), robot_.limits.max_wheel_speed_rad_s);
     endAutonomy();
@@ -339,6 +359,7 @@ v1::Ack RobotCore::startWheelTest(const v1::Command& cmd) {
     return ackOf(cmd.id(), v1::Ack::REJECTED, e.what());
   }
   wheel_test_id_ = cmd.id();
+  wheel_test_start_ = pose_;
   wheel_test_t_s_ = 0.0;
   wheel_test_progress_ = 0.0;
   wheel_test_name_ = w.name().empty() ? "wheel test" : w.name();
@@ -352,19 +373,32 @@ v1::Ack RobotCore::startWheelTest(const v1::Command& cmd) {
 
 void RobotCore::wheelTestStep(double dt_s) {
   if (!wheel_test_ || dt_s <= 0.0) return;
-  // Anything inside the stop distance of a front sonar ends the test: the
-  // profile is open loop and cannot steer round it.
-  for (std::size_t i = 0; i < 2; ++i) {
+  // The profile is open loop and cannot steer round anything: it ends for
+  // anything inside the stop distance of a front sonar, for a person close
+  // enough to slow the robot (Eq 9), and once the robot is more than
+  // kWheelTestRadius_m from where the test began.
+  char buf[128] = "";
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < robot_.ultrasonic.mounts.size() && i < serial::kUltrasonicCount; ++i) {
     const uint16_t mm = last_frame_.ultrasonic_mm[i];
-    if (mm != serial::kNoEcho && mm * 1e-3 < safety_.obstacle_stop_m) {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "%s stopped: obstacle %.2f m ahead", wheel_test_name_.c_str(), mm * 1e-3);
-      acks_.push_back(ackOf(wheel_test_id_, v1::Ack::FAILED, buf));
-      endAutonomy();
-      cmd_wheels_ = {};
-      setMode(v1::IDLE, buf);
-      return;
-    }
+    if (std::abs(robot_.ultrasonic.mounts[i].yaw_rad) < 0.3 && mm != serial::kNoEcho)
+      nearest = std::min(nearest, mm * 1e-3);
+  }
+  const double moved = std::hypot(pose_.x_m - wheel_test_start_.x_m, pose_.y_m - wheel_test_start_.y_m);
+  if (nearest < safety_.obstacle_stop_m)
+    std::snprintf(buf, sizeof buf, "%s stopped: obstacle %.2f m ahead", wheel_test_name_.c_str(), nearest);
+  else if (awareness_ && awareness_->last().speed_factor < 0.999)
+    std::snprintf(buf, sizeof buf, "%s stopped: a person %.2f m away", wheel_test_name_.c_str(),
+                  awareness_->last().distance_m);
+  else if (moved > kWheelTestRadius_m)
+    std::snprintf(buf, sizeof buf, "%s stopped: %.2f m from where it began (at most %.1f m)", wheel_test_name_.c_str(),
+                  moved, kWheelTestRadius_m);
+  if (buf[0]) {
+    acks_.push_back(ackOf(wheel_test_id_, v1::Ack::FAILED, buf));
+    endAutonomy();
+    cmd_wheels_ = {};
+    setMode(v1::IDLE, buf);
+    return;
   }
   wheel_test_t_s_ += dt_s;
   wheel_test_progress_ = std::min(1.0, wheel_test_t_s_ / wheel_test_->duration_s());
@@ -787,6 +821,9 @@ serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, doub
     // displacement; the heading reference is taken once per process.
     if (last_frame_s_ < 0) heading0_ = f.heading_0p1mrad;
     last_disp_ = f.wheel_disp_0p1mm;
+    // After an outage the MCU clock restarts the count: carry the outage's
+    // length over, so a series sampled on mcu_time_us shows the gap.
+    if (last_frame_s_ >= 0) mcu_time_us_ += static_cast<uint64_t>(std::max(0.0, now_s - last_frame_s_) * 1e6);
   } else {
     dt_s = static_cast<double>(static_cast<uint32_t>(f.mcu_time_ms - last_mcu_ms_)) / 1000.0;
     mcu_time_us_ += static_cast<uint64_t>(static_cast<uint32_t>(f.mcu_time_ms - last_mcu_ms_)) * 1000u;

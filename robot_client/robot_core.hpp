@@ -94,6 +94,8 @@ class RobotCore {
 
   /// Most goals one go_to command may carry.
   static constexpr int kMaxGoals = 100;
+  /// A wheel test ends (FAILED) once the robot is this far from where it began.
+  static constexpr double kWheelTestRadius_m = 1.0;
   /// Cruise speed of a go_to command that gives none (clamped to the robot's limit).
   static constexpr double kDefaultNavSpeed_m_s = 0.5;
 
@@ -204,6 +206,7 @@ class RobotCore {
   std::unique_ptr<control::WheelProfile> wheel_test_;
   uint64_t wheel_test_id_ = 0;
   double wheel_test_t_s_ = 0.0;
+  control::Pose2 wheel_test_start_;
   double wheel_test_progress_ = 0.0;
   std::string wheel_test_name_;
 

@@ -61,8 +61,8 @@ class WorkerPool {
   /// while); throws what the first failing one threw (fuzzy::FisError).
   WorkerPool(int threads, const fuzzy::Fis& fis, bool use_lookup)
       : scheds_(static_cast<std::size_t>(threads)), errors_(static_cast<std::size_t>(threads)) {
-    for (int i = 0; i < threads; ++i)
-      threads_.emplace_back([this, i, &fis, use_lookup] {
+    try {
+      for (int i = 0; i < threads; ++i) threads_.emplace_back([this, i, &fis, use_lookup] {
         const auto k = static_cast<std::size_t>(i);
         try {
           scheds_[k] = std::make_shared<control::FuzzyGainScheduler>(fis, use_lookup);
@@ -76,6 +76,10 @@ class WorkerPool {
         done_cv_.notify_all();
         loop(i);
       });
+    } catch (...) {
+      stop();  // a thread could not start (a resource limit): join those that did
+      throw;
+    }
     std::unique_lock<std::mutex> lk(m_);
     done_cv_.wait(lk, [&] { return done_ == threads; });
     for (const auto& e : errors_)

@@ -83,7 +83,7 @@ TEST(TuningStack, IdentifyTunePushAndTheCircleIsTrackedBetter) {
          << "identify last\n"
          << "track circle 3.5 0.5 1 fuzzy_pid\nexpect mode == TRACKING within 2\nexpect mode == IDLE within 40\n"
          << "expect max_pos_err > 0\nexpect max_ang_err > 0\n"
-         << "tune evals=150 threads=1\n"
+         << "tune evals=400\n"
          << "gains push\nexpect gains_version == 1 within 2\n"
          << "track circle 3.5 0.5 1 fuzzy_pid\nexpect mode == TRACKING within 2\nexpect mode == IDLE within 40\n"
          << "expect max_pos_err > 0\nexpect max_ang_err > 0\n"

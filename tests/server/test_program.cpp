@@ -240,7 +240,7 @@ TEST(Program, SigintInterruptsAScript) {
 TEST(Program, SigintDuringTuneCancelsItKeepingTheBestAndTheScriptGoesOn) {
   Program p("sigint_tune");
   // 100000 evaluations would take an hour: only Ctrl-C ends it.
-  const auto script = p.file("s.txt", "tune evals=100000 variations=1 seeds=1 threads=1\necho after the tune\ngains show\n");
+  const auto script = p.file("s.txt", "tune evals=100000 variations=1 seeds=1 threads=1\necho after the tune\ngains show\ntune list\n");
   const auto port_file = p.path("port");
   p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--port-file", port_file.string(), "--script",
            script.string(), "--runs-dir", p.path("runs").string()});
@@ -258,5 +258,6 @@ TEST(Program, SigintDuringTuneCancelsItKeepingTheBestAndTheScriptGoesOn) {
   EXPECT_HAS(out, "fuzzy-PID (tuned)");   // the comparison with the best so far
   EXPECT_HAS(out, "after the tune");      // the server went on
   EXPECT_HAS(out, "tuned");               // gains show has the tuned column
+  EXPECT_HAS(out, "(cancelled)");         // tune list: the session is in the catalog
   EXPECT_TRUE(fs::exists(p.path("runs") / "tuning"));
 }

@@ -245,3 +245,42 @@ TEST(RobotCoreWheelTest, BadProfilesAreRejectedAndSafetyStopsIt) {
   EXPECT_EQ(h.last.left_mrad_s, 0);
   EXPECT_EQ(h.last.flags, 0);
 }
+
+TEST(RobotCoreWheelTest, SpeedLimitsHoldAndTheTestStaysNearItsStart) {
+  Harness h;
+  h.run(0.05);
+  // 2.5 rad/s on both wheels is 0.5 m/s: fine; spinning at +-5 rad/s is 4.6 rad/s of yaw, above 2 rad/s.
+  auto ack = h.core->onCommand(wheelTest(1, {{"step", 1, -5.0, 5.0}}), h.t);
+  EXPECT_EQ(ack.status(), v1::Ack::REJECTED);
+  EXPECT_NE(ack.reason().find("exceed the robot's limits"), std::string::npos) << ack.reason();
+  // Driving straight on: stopped once 1 m from the start (0.5 m/s: after ~2 s).
+  ASSERT_EQ(h.core->onCommand(wheelTest(2, {{"step", 10, 2.5, 2.5}}), h.t).status(), v1::Ack::ACCEPTED);
+  std::vector<v1::Ack> acks;
+  for (int i = 0; i < 500 && acks.empty(); ++i) {
+    h.step();
+    acks = h.core->takeAcks();
+  }
+  ASSERT_EQ(acks.size(), 1u);
+  EXPECT_EQ(acks[0].status(), v1::Ack::FAILED);
+  EXPECT_NE(acks[0].reason().find("m from where it began (at most 1.0 m)"), std::string::npos) << acks[0].reason();
+  EXPECT_LT(h.core->pose().x_m, 1.1);
+  EXPECT_EQ(h.core->mode(), v1::IDLE);
+}
+
+TEST(RobotCoreGains, AFuzzySystemIsNotSwappedWhileMovingAndARejectionQuotesTheVersionInForce) {
+  Harness h;
+  h.run(0.05);
+  ASSERT_EQ(h.core->onCommand(wheelTest(1, {{"step", 5, -1, 1}}), h.t).status(), v1::Ack::ACCEPTED);
+  h.run(0.1);
+  control::GainSet g = h.core->gains();
+  // A good update is staged (v1), then a bad fuzzy system comes before the tick: refused, v0 still in force.
+  ASSERT_EQ(h.core->onCommand(gainsCmd(2, g), h.t).gains_version(), 1u);
+  const std::string fis = readFile(std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/fuzzy_pid.fis");
+  const auto ack = h.core->onCommand(gainsCmd(3, g, fis), h.t);
+  EXPECT_EQ(ack.status(), v1::Ack::REJECTED);
+  EXPECT_NE(ack.reason().find("the robot is moving (WHEEL_TEST)"), std::string::npos) << ack.reason();
+  EXPECT_EQ(ack.gains_version(), 0u);
+  h.step();
+  EXPECT_EQ(h.core->gainsVersion(), 1u);
+  EXPECT_EQ(h.core->mode(), v1::WHEEL_TEST) << "gains without a fuzzy system are fine while moving";
+}
