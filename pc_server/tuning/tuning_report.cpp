@@ -319,7 +319,7 @@ std::string describeScenarios(const TuneSetup& s, int count) {
   os << count << " = " << s.plant_variations << " plant variation(s) x " << s.seeds << " noise seed(s)";
   if (s.plant_variations > 1)
     os << "; variations spread around the plant by +-" << fmtG(s.gain_spread * 100) << " % gain, +-"
-       << fmtG(s.tau_spread * 100) << " % time constant, +-" << fmtG(s.dead_spread_s) << " s dead time";
+       << fmtG(s.tau_spread * 100) << " % time constant, +0 to " << fmtG(s.dead_spread_s) << " s more dead time";
   return os.str();
 }
 

@@ -2,23 +2,33 @@
 // robot_client + pc_server console) against the same experiment in-process.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <string>
 #include <sstream>
 
 #include "shared/config/control_config.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/robot_plant.hpp"
 #include "tests/integration/stack.hpp"
 
 using namespace inspect;
 using namespace inspect::test;
 
 namespace {
-sim::ClosedLoopMetrics inProcess(control::WheelControl wc) {
+// The in-process loop with the full stack's own latency as plant dead time:
+// a wheel command is computed from a sensor frame and reaches the motors
+// about one frame later (serial transmission, the client's tick, the MCU's
+// next step). The paper's gains are sensitive to delay (docs/tuning.md).
+sim::ClosedLoopMetrics inProcess(control::WheelControl wc, double dead_time_s, uint32_t seed) {
   const auto robot = config::loadRobotConfigFile(srcPath("config/robot.yaml"));
   auto ctl = config::loadControlConfigFile(srcPath("config/control.yaml"));
   config::applyRobot(ctl, robot);
   sim::ClosedLoopConfig cfg;
   cfg.robot = robot;
+  cfg.plant = sim::nominalPlant(robot);
+  cfg.plant->left.dead_time_s = cfg.plant->right.dead_time_s = dead_time_s;
+  cfg.seed = seed;
   cfg.tracker = ctl.tracker;
   cfg.tracker.wheel_control = wc;
   return sim::runClosedLoop(cfg, control::makeCircle({0, 0, 0}, 3.5, 0.5), config::loadScheduler(ctl), false)
@@ -26,22 +36,37 @@ sim::ClosedLoopMetrics inProcess(control::WheelControl wc) {
 }
 }  // namespace
 
-TEST(TrackingStack, CircleMatchesTheInProcessExperimentWithin20Percent) {
-  const auto ref = inProcess(control::WheelControl::kFuzzyPid);
+TEST(TrackingStack, CircleMatchesTheInProcessExperimentSpreadWithin20Percent) {
+  // The maxima are peaks of a lightly damped oscillation: they move with the
+  // noise and with the link's latency (0-20 ms). The full stack must land
+  // within 20 % of the in-process spread over 5 noise seeds x those latencies.
+  double pos_lo = 1e9, pos_hi = 0, ang_lo = 1e9, ang_hi = 0;
+  for (uint32_t seed = 1; seed <= 5; ++seed)
+    for (double d : {0.0, 0.01, 0.02}) {
+      const auto m = inProcess(control::WheelControl::kFuzzyPid, d, seed);
+      pos_lo = std::min(pos_lo, m.max_pos_err_m);
+      pos_hi = std::max(pos_hi, m.max_pos_err_m);
+      ang_lo = std::min(ang_lo, m.max_ang_err_rad);
+      ang_hi = std::max(ang_hi, m.max_ang_err_rad);
+    }
+  const auto band = [](double lo, double hi) {
+    const double a = 0.8 * lo, b = 1.2 * hi;
+    return std::to_string((a + b) / 2) + " " + std::to_string((b - a) / 2);
+  };
   std::ostringstream script;
   script << "expect robots >= 1 within 15\nexpect sensor_hz > 50 within 5\n"
          << "track circle 3.5 0.5 1 fuzzy_pid\nexpect mode == TRACKING within 1\n"
          << "expect mode == IDLE within 40\nexpect progress ~ 1 0.001\nstatus\n"
-         << "expect max_pos_err ~ " << ref.max_pos_err_m << " " << 0.2 * ref.max_pos_err_m << "\n"
-         << "expect max_ang_err ~ " << ref.max_ang_err_rad << " " << 0.2 * ref.max_ang_err_rad << "\n";
+         << "expect max_pos_err ~ " << band(pos_lo, pos_hi) << "\n"
+         << "expect max_ang_err ~ " << band(ang_lo, ang_hi) << "\n";
   Stack s("track");
   ASSERT_TRUE(s.startServer(script.str())) << s.logs();
-  // 4x faster than real time: the client's loop runs on the MCU's clock (dt
+  // 2x faster than real time: the client's loop runs on the MCU's clock (dt
   // from the frames), so the control is the same; only wall time shrinks.
-  s.startRobot("robot1", "empty.yaml", {}, {"--rate", "4"});
+  s.startRobot("robot1", "empty.yaml", {}, {"--rate", "2"});
   const auto rc = s.server().wait(90);
   ASSERT_TRUE(rc.has_value()) << s.logs();
-  std::printf("TRACK in-process max position error %.4f m, max angle error %.4f rad\n%s", ref.max_pos_err_m,
-              ref.max_ang_err_rad, s.serverOutput().c_str());
+  std::printf("TRACK in-process max position error %.4f-%.4f m, max angle error %.4f-%.4f rad\n%s", pos_lo, pos_hi,
+              ang_lo, ang_hi, s.serverOutput().c_str());
   EXPECT_EQ(*rc, 0) << s.logs();
 }
