@@ -65,16 +65,6 @@ std::string wheelLine(const char* name, const control::WheelMotorModel& m) {
   return buf;
 }
 
-std::string plantJson(const control::PlantModel& p) {
-  char buf[320];
-  std::snprintf(buf, sizeof buf,
-                R"({"left":{"gain":%.6g,"time_constant_s":%.6g,"dead_time_s":%.6g,"saturation_rad_s":%.6g},)"
-                R"("right":{"gain":%.6g,"time_constant_s":%.6g,"dead_time_s":%.6g,"saturation_rad_s":%.6g}})",
-                p.left.gain, p.left.time_constant_s, p.left.dead_time_s, p.left.saturation_rad_s, p.right.gain,
-                p.right.time_constant_s, p.right.dead_time_s, p.right.saturation_rad_s);
-  return buf;
-}
-
 constexpr double kMaxTuneReference_s = 300.0;
 
 std::string sessionStamp() {
@@ -409,7 +399,7 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
     cs.created = std::chrono::system_clock::now();
     cs.robot = robot;
     cs.reference = setup.reference.describe();
-    cs.plant_json = plantJson(setup.plant);
+    cs.plant_json = tuning::plantJson(setup.plant);
     cs.params = params;
     cs.algorithm = result.algorithm;
     cs.evals = result.evals;

@@ -36,6 +36,8 @@ namespace {
 using namespace inspect;
 using control::WheelControl;
 using Clock = std::chrono::steady_clock;
+using plot::panel;
+using plot::series;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 constexpr const char* kUsage = R"(usage: track_experiment [options]
@@ -385,23 +387,6 @@ const char* colorOf(WheelControl c) {
     case WheelControl::kDirect: return "#2ca02c";
   }
   return "#000000";
-}
-
-plot::Series series(const std::string& title, const std::string& color, int width = 2, bool dashed = false) {
-  plot::Series s;
-  s.title = title;
-  s.color = color;
-  s.width = width;
-  s.dashed = dashed;
-  return s;
-}
-
-plot::Panel panel(const std::string& title, const std::string& xlabel, const std::string& ylabel) {
-  plot::Panel p;
-  p.title = title;
-  p.xlabel = xlabel;
-  p.ylabel = ylabel;
-  return p;
 }
 
 std::string writePlots(const Options& o, const std::vector<const Run*>& runs, const control::PidGains& base,

@@ -21,6 +21,8 @@ namespace inspect::tuning {
 namespace {
 
 namespace fs = std::filesystem;
+using plot::panel;
+using plot::series;
 using Json = nlohmann::ordered_json;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -135,23 +137,6 @@ Json metricsJson(const sim::ClosedLoopMetrics& m) {
 }
 
 // ---------------------------------------------------------------- plots
-
-plot::Series series(const std::string& title, const std::string& color, int width = 2, bool dashed = false) {
-  plot::Series s;
-  s.title = title;
-  s.color = color;
-  s.width = width;
-  s.dashed = dashed;
-  return s;
-}
-
-plot::Panel panel(const std::string& title, const std::string& xlabel, const std::string& ylabel) {
-  plot::Panel p;
-  p.title = title;
-  p.xlabel = xlabel;
-  p.ylabel = ylabel;
-  return p;
-}
 
 /// Fig 20-style error vs time, one curve per case, band shaded, convergence dotted.
 plot::Panel errorPanel(const Comparison& c, bool position) {
@@ -336,6 +321,10 @@ bool isTuned(const TuneSetup& s, const std::string& name) {
 }  // namespace
 
 // ---------------------------------------------------------------- API
+
+std::string plantJson(const control::PlantModel& p) {
+  return Json{{"left", wheelJson(p.left)}, {"right", wheelJson(p.right)}}.dump();
+}
 
 Comparison compareControllers(const Tuner& tuner, const std::vector<ControllerCase>& cases) {
   Comparison c;

@@ -38,6 +38,10 @@ struct Comparison {
 };
 
 /// Evaluates and traces every case with the tuner (its reference, plant and scenarios).
+/// The plant as compact JSON ({"left": {gain, time_constant_s, dead_time_s,
+/// saturation_rad_s}, "right": {...}}), as results.json and the catalog keep it.
+std::string plantJson(const control::PlantModel& p);
+
 Comparison compareControllers(const Tuner& tuner, const std::vector<ControllerCase>& cases);
 
 /// Fixed-width text table for the console, one column per case: max / RMS

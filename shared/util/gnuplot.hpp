@@ -45,6 +45,25 @@ struct Panel {
   std::string yrange;       // gnuplot range, e.g. "[0:*]"; empty = automatic
 };
 
+/// A series with its legend title and look (points filled in by the caller).
+inline Series series(const std::string& title, const std::string& color, int width = 2, bool dashed = false) {
+  Series s;
+  s.title = title;
+  s.color = color;
+  s.width = width;
+  s.dashed = dashed;
+  return s;
+}
+
+/// A panel with its title and axis labels.
+inline Panel panel(const std::string& title, const std::string& xlabel, const std::string& ylabel) {
+  Panel p;
+  p.title = title;
+  p.xlabel = xlabel;
+  p.ylabel = ylabel;
+  return p;
+}
+
 /// Writes `png_path` with the panels stacked vertically. Returns an empty
 /// string on success, else what went wrong (gnuplot missing, its error).
 std::string renderPng(const std::string& png_path, const std::vector<Panel>& panels, int width_px = 900,
