@@ -43,6 +43,10 @@ const std::map<std::string, FlagSpec>& flags() {
       {"--no-video", {false, [](CliOptions& o, const std::string&) { o.no_video = true; }}},
       {"--runs-dir", {true, [](CliOptions& o, const std::string& v) { o.runs_dir = v; }}},
       {"--no-record", {false, [](CliOptions& o, const std::string&) { o.no_record = true; }}},
+      {"--certs", {true, [](CliOptions& o, const std::string& v) { o.certs_dir = v; }}},
+      {"--operator-socket", {true, [](CliOptions& o, const std::string& v) { o.operator_socket = v; }}},
+      {"--attach", {true, [](CliOptions& o, const std::string& v) { o.attach = v; }}},
+      {"--plaintext", {false, [](CliOptions& o, const std::string&) { o.plaintext = true; }}},
       {"--port-file", {true, [](CliOptions& o, const std::string& v) { o.port_file = v; }}},
       {"--script", {true, [](CliOptions& o, const std::string& v) { o.script_path = v; }}},
       {"--interactive", {false, [](CliOptions& o, const std::string&) { o.interactive = true; }}},
@@ -80,6 +84,9 @@ CliOptions parseCli(const std::vector<std::string>& args) {
     }
     it->second.apply(o, value.value_or(""));
   }
+  if (o.attach && args.size() != 2)
+    throw UsageError("--attach PATH takes no other flags (it only connects to a running server's operator socket)");
+  if (o.plaintext && o.certs_dir) throw UsageError("--plaintext cannot be combined with --certs");
   if (o.no_console && (o.script_path || o.interactive))
     throw UsageError("--no-console cannot be combined with --script or --interactive");
   return o;
@@ -99,6 +106,13 @@ std::string usageText() {
          "  --no-video        do not receive video (overrides video.enabled)\n"
          "  --runs-dir DIR    recorded runs and catalog.sqlite (overrides recording.dir; default runs)\n"
          "  --no-record       keep no catalog and record nothing (overrides recording.enabled)\n"
+         "  --certs DIR       TLS files DIR/ca.pem, DIR/server.pem, DIR/server.key (overrides tls.*; default certs;\n"
+         "                    make them with scripts/make_certs.sh)\n"
+         "  --plaintext       no TLS: the robot link is neither encrypted nor authenticated (test benches only;\n"
+         "                    warns at start and for every robot; robots must use --plaintext too)\n"
+         "  --operator-socket PATH  more operator consoles: `pc_server --attach PATH` connects one (Unix socket,\n"
+         "                    mode 0660; overrides operator_socket; each is a session, see 'help control')\n"
+         "  --attach PATH     be an operator console of the server listening on PATH, then exit\n"
          "  --script FILE     run the console commands in FILE, then exit (0 = all expects passed, 1 = not)\n"
          "  --interactive     after --script, stay in the interactive console; alone, force the interactive console\n"
          "  --no-console      serve until SIGINT/SIGTERM without reading stdin (service mode)\n"

@@ -28,6 +28,10 @@ struct CliOptions {
   bool no_video = false;
   std::optional<std::string> runs_dir;
   bool no_record = false;
+  std::optional<std::string> certs_dir;  // --certs DIR: DIR/ca.pem, DIR/server.pem, DIR/server.key
+  bool plaintext = false;
+  std::optional<std::string> operator_socket;  // more operator consoles on this Unix socket
+  std::optional<std::string> attach;           // --attach PATH: be a console of a running server
   bool interactive = false;
   bool no_console = false;
   bool help = false;

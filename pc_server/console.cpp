@@ -167,6 +167,16 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "    imported .fis that differs from the loaded one is pushed with the gains.\n"
        "  example: gains set kp=12 ki=3\n  example: gains push\n",
        &Console::cmdGains},
+      {"control", "control [take [force] | release]", "who controls each robot; take or release the selected robot",
+       "  One session (console) at a time controls a robot: only its motion commands (drive, teleop,\n"
+       "  track, goto, route, inspect, resume, ptz, gains push) reach the robot; the first such command\n"
+       "  takes a free robot. Other sessions observe: status, events and runs; stop and estop always work.\n"
+       "  control               this session's name and every robot's controlling session\n"
+       "  control take          take the selected robot (refused while another session holds it)\n"
+       "  control take force    take it over from another session: the robot is stopped first and\n"
+       "                        the other session is told\n"
+       "  control release       let go of the selected robot (its teleop set-point is cleared)\n",
+       &Console::cmdControl},
       {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
        "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
        "  'robot1: no ack within 1 s' (the last two are errors).\n",
@@ -323,7 +333,12 @@ std::string Console::background() {
       s += "selected " + first + " (the first robot to connect)\n";
     }
   }
-  for (const auto& e : registry_.takeEvents()) {
+  if (control_)
+    for (const auto& note : control_->takeNotes(session_)) s += note + "\n";
+  uint64_t missed = 0;
+  const auto events = registry_.eventsSince(event_cursor_, &missed);
+  if (missed > 0) s += "(" + std::to_string(missed) + " robot events missed: this console fell behind)\n";
+  for (const auto& e : events) {
     const std::string line = "[" + e.robot_id + "] " + v1::Event::Kind_Name(e.event.kind()) + ": " + e.event.text();
     if (e.event.kind() == v1::Event::ALARM_RAISED && alarm_style_)
       s += "\a\x1b[1;31m" + line + "\x1b[0m\n";  // red, with the terminal bell
@@ -360,6 +375,58 @@ bool Console::sleepPumping(double s) {
     const auto step = std::min<std::chrono::steady_clock::duration>(deadline - now, seconds(options_.poll_period_s));
     if (!stop_.sleepFor(step)) return false;
   }
+}
+
+bool Console::mayMove(const std::string& robot, const std::string& cmd) {
+  if (!control_) return true;
+  const auto d = control_->authorizeMotion(robot, session_, monoNowNs());
+  if (d.taken_now) out_ << robot << ": control taken by " << control_->sessionName(session_) << "\n";
+  if (d.allowed) return true;
+  out_ << robot << ": " << cmd << " refused: " << d.reason << "\n";
+  ++tally_.errors;
+  return false;
+}
+
+bool Console::cmdControl(const Args& args, const std::string&, int) {
+  if (!control_) return fail("control", "this console has no sessions (no control arbiter)");
+  if (args.empty()) {
+    out_ << "this session: " << control_->sessionName(session_) << "\n";
+    const auto holders = control_->holders();
+    for (const auto& snap : registry_.snapshots(monoNowNs())) {
+      const auto it = holders.find(snap.id);
+      out_ << "  " << snap.id << (snap.connected ? "" : " (not connected)") << ": "
+           << (it == holders.end() ? std::string("free")
+                                   : it->second.name + (it->second.session == session_ ? " <- this session" : ""))
+           << "\n";
+    }
+    return true;
+  }
+  const bool take = args[0] == "take", release = args[0] == "release";
+  const bool force = take && args.size() == 2 && args[1] == "force";
+  if ((!take && !release) || (release && args.size() != 1) || (take && args.size() > 1 && !force))
+    return fail("control", "syntax: control | control take [force] | control release");
+  if (selected_.empty()) return fail("control", "no robot selected");
+  const std::string robot = selected_;
+  if (release) {
+    std::string why;
+    if (!control_->release(robot, session_, &why)) return fail("control", why);
+    sink_.clearTeleop(robot);
+    out_ << robot << ": control released; the robot is free\n";
+    return true;
+  }
+  const auto r = control_->take(robot, session_, force, monoNowNs());
+  if (!r.ok) return fail("control", r.reason);
+  if (r.previous) {
+    // The new operator starts from standstill: nothing of the old one's commands goes on.
+    sink_.clearTeleop(robot);
+    v1::Command stop;
+    stop.mutable_stop();
+    sink_.sendCommand(robot, std::move(stop));
+    out_ << robot << ": control taken over from " << r.previous->name << " (robot stopped)\n";
+  } else {
+    out_ << robot << ": controlled by " << control_->sessionName(session_) << "\n";
+  }
+  return true;
 }
 
 std::optional<std::string> Console::connectedRobot(const std::string& cmd) {
@@ -448,7 +515,7 @@ bool Console::cmdDrive(const Args& args, const std::string&, int) {
     return fail("drive", "w " + args[1] + " rad/s is outside [-" + fmtShort(options_.max_w_rad_s) + ", " +
                              fmtShort(options_.max_w_rad_s) + "]");
   const auto robot = connectedRobot("drive");
-  if (!robot) return false;
+  if (!robot || !mayMove(*robot, "drive")) return false;
   const uint64_t id = sink_.setTeleop(*robot, *v, *w);
   if (id == 0) return fail("drive", *robot + " is not connected");
   const std::string what = "drive " + fmtSigned(*v) + " m/s " + fmtSigned(*w) + " rad/s";
@@ -476,7 +543,7 @@ bool Console::cmdTeleop(const Args& args, const std::string&, int) {
     return fail("teleop", "unknown mode '" + args[0] + "' (step or hold)");
   if (!teleop_handler_) return fail("teleop", "keyboard teleop needs an interactive terminal (scripts use drive)");
   const auto robot = connectedRobot("teleop");
-  if (!robot) return false;
+  if (!robot || !mayMove(*robot, "teleop")) return false;
   if (!teleop_handler_(mode, *robot)) {
     ++tally_.errors;
     return false;
@@ -734,6 +801,9 @@ bool Console::cmdRoute(const Args& args, const std::string&, int) {
 bool Console::sendAndReport(const std::string& name, v1::Command cmd, bool runs) {
   const auto robot = connectedRobot(name);
   if (!robot) return false;
+  // Everything but stop, e-stop and the camera stream's settings moves the robot or its mount.
+  const bool motion = !cmd.has_stop() && !cmd.has_estop() && !cmd.has_video();
+  if (motion && !mayMove(*robot, name)) return false;
   const uint64_t id = sink_.sendCommand(*robot, std::move(cmd));
   if (id == 0) return fail(name, *robot + " is not connected");
   const auto ack = waitAck(*robot, id);

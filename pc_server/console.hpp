@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pc_server/command_sink.hpp"
+#include "pc_server/control_arbiter.hpp"
 #include "pc_server/keyboard_teleop.hpp"
 #include "pc_server/robot_registry.hpp"
 #include "pc_server/stop_flag.hpp"
@@ -62,6 +63,15 @@ class Console {
   void setAlarmStyle(bool on) { alarm_style_ = on; }
   /// Enables `teleop` (only an interactive terminal has one).
   void setTeleopHandler(TeleopHandler handler) { teleop_handler_ = std::move(handler); }
+
+  /// Makes this console a session of `arbiter`: its motion commands need the
+  /// robot's control (taken on first use when free), `control` shows and
+  /// changes it, and notes from other sessions print in background().
+  void setSession(ControlArbiter* arbiter, uint64_t session) {
+    control_ = arbiter;
+    session_ = session;
+  }
+  uint64_t session() const { return session_; }
 
   bool quitRequested() const { return quit_; }
   const std::string& selected() const { return selected_; }
@@ -141,6 +151,9 @@ class Console {
   bool fail(const std::string& cmd, const std::string& message);
   /// The selected robot when it is connected; otherwise prints why (as `cmd`) and returns nullopt.
   std::optional<std::string> connectedRobot(const std::string& cmd);
+  /// Whether this session may move `robot` (see setSession); prints why not.
+  bool mayMove(const std::string& robot, const std::string& cmd);
+  bool cmdControl(const Args& args, const std::string& rest, int line_no);
   /// Sends a Stop/EStop/Resume and reports its Ack.
   bool simpleCommand(const std::string& name, const Args& args, v1::Command cmd);
   /// Sends `cmd` to the selected robot, waits for its Ack and prints the answer. With `runs`
@@ -162,6 +175,9 @@ class Console {
   Recorder* recorder_ = nullptr;
   bool alarm_style_ = false;
   std::string selected_;
+  uint64_t event_cursor_ = 0;
+  ControlArbiter* control_ = nullptr;
+  uint64_t session_ = 0;  // this session's place in the registry's event feed (from the start for the first)
   bool quit_ = false;
   Tally tally_;
   /// An accepted long-running command waiting for its COMPLETED Ack (at most one per robot).

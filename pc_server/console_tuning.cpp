@@ -432,6 +432,7 @@ bool Console::pushGains(const std::string& robot, const control::GainSet& g, con
   TuningState* ts = tuning("gains");
   if (!ts) return false;
   if (const std::string why = control::validateGains(g); !why.empty()) return fail("gains", "not pushed: " + why);
+  if (!mayMove(robot, "gains push")) return false;
   v1::Command c;
   auto* u = c.mutable_gains();
   net::toProto(g, *u->mutable_gains());

@@ -28,6 +28,14 @@ LinkServer::LinkServer(asio::io_context& ioc, const ServerConfig& config, RobotR
 LinkServer::~LinkServer() = default;
 
 tcp::endpoint LinkServer::listen() {
+  if (!config_.tls.plaintext) {
+    try {
+      tls_ = net::makeTlsContext({config_.tls.ca, config_.tls.cert, config_.tls.key}, net::TlsRole::kServer);
+      cert_info_ = net::describeCertificate(config_.tls.cert);
+    } catch (const net::TlsError& e) {
+      throw StartupError(std::string("TLS: ") + e.what() + " (or --plaintext for an isolated test bench)");
+    }
+  }
   error_code ec;
   const auto address = asio::ip::make_address(config_.bind_address, ec);
   if (ec) throw StartupError("bind address '" + config_.bind_address + "' is not an IP address");
@@ -57,7 +65,7 @@ void LinkServer::doAccept() {
       });
       return;
     }
-    auto session = std::make_shared<RobotSession>(strand, std::move(socket), *this, registry_, config_,
+    auto session = std::make_shared<RobotSession>(strand, std::move(socket), tls_, *this, registry_, config_,
                                                   next_serial_.fetch_add(1));
     {
       std::lock_guard lk(mu_);

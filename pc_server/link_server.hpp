@@ -18,6 +18,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "pc_server/command_sink.hpp"
+#include "shared/net/tls.hpp"
 #include "pc_server/server_config.hpp"
 
 namespace inspect::server {
@@ -32,12 +33,15 @@ class LinkServer : public CommandSink {
   LinkServer(const LinkServer&) = delete;
   LinkServer& operator=(const LinkServer&) = delete;
 
-  /// Binds to config.bind_address:config.port and starts accepting. Throws StartupError.
+  /// Loads the TLS files (unless config.tls.plaintext), binds to
+  /// config.bind_address:config.port and starts accepting. Throws StartupError.
   boost::asio::ip::tcp::endpoint listen();
   /// Stops accepting and closes every session; thread-safe, idempotent.
   void stop();
   /// Waits until every session has closed; false on timeout.
   bool waitAllClosed(std::chrono::steady_clock::duration timeout);
+  /// The certificate the server presents ("" in plaintext mode), for the start-up line.
+  const std::string& certificateInfo() const { return cert_info_; }
   /// Sessions open now (including those still in the handshake).
   std::size_t sessionCount() const;
   /// Whether robot events also go to the log (when no console shows them).
@@ -80,6 +84,8 @@ class LinkServer : public CommandSink {
 
   boost::asio::io_context& ioc_;
   const ServerConfig config_;
+  std::shared_ptr<boost::asio::ssl::context> tls_;  // null: plaintext
+  std::string cert_info_;
   RobotRegistry& registry_;
   boost::asio::ip::tcp::acceptor acceptor_;  // on its own strand
   boost::asio::steady_timer accept_retry_timer_;

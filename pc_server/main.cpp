@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "pc_server/cli_options.hpp"
+#include "pc_server/operator_socket.hpp"
 #include "pc_server/server_app.hpp"
 #include "pc_server/startup_error.hpp"
 
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
       std::cout << usageText();
       return 0;
     }
+    if (options.attach) return attachToOperatorSocket(*options.attach);
     return runServer(options);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "pc_server: %s (see --help)\n", e.what());

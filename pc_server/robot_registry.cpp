@@ -86,11 +86,7 @@ void RobotRegistry::onTelemetry(const std::string& id, uint64_t serial, const v1
                   (a.fault().empty() ? "" : " " + a.fault()) +
                   " alarm in force (learnt from telemetry: its raise event was not received)");
       *ev.mutable_gas_alarm() = a;
-      pending_.push_back({id, ev});
-      if (pending_.size() > kMaxPendingEvents) {
-        pending_.pop_front();
-        ++dropped_events_;
-      }
+      pushEventLocked(id, ev);
     }
   }
   for (auto& r : alarms_) {
@@ -186,11 +182,7 @@ void RobotRegistry::onEvent(const std::string& id, uint64_t serial, const v1::Ev
   if (ev.kind() == v1::Event::GAINS_APPLIED && ev.has_gains()) noteGainsLocked(*e, ev.gains(), ev.gains_version());
   e->events.push_back(ev);
   if (e->events.size() > kMaxEventsPerRobot) e->events.pop_front();
-  pending_.push_back({id, ev});
-  if (pending_.size() > kMaxPendingEvents) {
-    pending_.pop_front();
-    ++dropped_events_;
-  }
+  pushEventLocked(id, ev);
 }
 
 void RobotRegistry::onAck(const std::string& id, uint64_t serial, const v1::Ack& a) {
@@ -273,16 +265,46 @@ std::optional<v1::Ack> RobotRegistry::ack(const std::string& id, uint64_t comman
   return a->second;
 }
 
+void RobotRegistry::pushEventLocked(const std::string& id, const v1::Event& ev) {
+  pending_.push_back({id, ev});
+  if (pending_.size() > kMaxPendingEvents) {
+    pending_.pop_front();
+    ++first_event_;
+  }
+}
+
 std::vector<PendingEvent> RobotRegistry::takeEvents() {
+  uint64_t cursor;
+  {
+    std::lock_guard lk(mu_);
+    cursor = take_cursor_;
+  }
+  uint64_t missed = 0;
+  auto out = eventsSince(cursor, &missed);
   std::lock_guard lk(mu_);
-  std::vector<PendingEvent> out(std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
-  pending_.clear();
+  take_cursor_ = cursor;
+  dropped_events_ += missed;
   return out;
 }
 
 uint64_t RobotRegistry::droppedEvents() const {
   std::lock_guard lk(mu_);
   return dropped_events_;
+}
+
+uint64_t RobotRegistry::eventCursor() const {
+  std::lock_guard lk(mu_);
+  return first_event_ + pending_.size();
+}
+
+std::vector<PendingEvent> RobotRegistry::eventsSince(uint64_t& cursor, uint64_t* missed) const {
+  std::lock_guard lk(mu_);
+  if (missed) *missed = cursor < first_event_ ? first_event_ - cursor : 0;
+  const uint64_t end = first_event_ + pending_.size();
+  std::vector<PendingEvent> out;
+  for (uint64_t i = std::max(cursor, first_event_); i < end; ++i) out.push_back(pending_[i - first_event_]);
+  cursor = end;
+  return out;
 }
 
 std::vector<v1::Event> RobotRegistry::events(const std::string& id) const {

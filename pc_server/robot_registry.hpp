@@ -83,10 +83,16 @@ class RobotRegistry {
   std::string firstConnected() const;
   /// The latest Ack of a command (bounded history per robot).
   std::optional<v1::Ack> ack(const std::string& id, uint64_t command_id) const;
-  /// Events received since the last call, oldest first.
+  /// Events received since the last call, oldest first (one consumer; the
+  /// operator sessions use eventsSince, each with its own cursor).
   std::vector<PendingEvent> takeEvents();
-  /// Number of events dropped because nobody took them.
+  /// Number of events takeEvents() missed (they left the buffer of kMaxPendingEvents first).
   uint64_t droppedEvents() const;
+  /// A cursor at the newest event: a new operator session sees events from now on.
+  uint64_t eventCursor() const;
+  /// Events after `cursor` (advanced past them), oldest first; `missed` counts
+  /// those that left the buffer before this reader came for them.
+  std::vector<PendingEvent> eventsSince(uint64_t& cursor, uint64_t* missed = nullptr) const;
   /// The robot's recent events, oldest first.
   std::vector<v1::Event> events(const std::string& id) const;
 
@@ -133,7 +139,10 @@ class RobotRegistry {
   mutable std::mutex mu_;
   std::map<std::string, Entry> robots_;
   uint64_t connect_counter_ = 0;
-  std::deque<PendingEvent> pending_;
+  std::deque<PendingEvent> pending_;  // the newest kMaxPendingEvents; pending_[i] has number first_event_ + i
+  uint64_t first_event_ = 0;
+  uint64_t take_cursor_ = 0;
+  void pushEventLocked(const std::string& id, const v1::Event& ev);
   /// Applies a robot's alarm transition (or telemetry resync) to the book; mu_ held.
   void noteAlarmLocked(const std::string& id, const v1::GasAlarm& a, int64_t now_ns);
   std::deque<AlarmRecord> alarms_;

@@ -37,10 +37,11 @@ std::chrono::nanoseconds seconds(double s) {
 }
 }  // namespace
 
-RobotSession::RobotSession(Strand strand, asio::ip::tcp::socket socket, LinkServer& server, RobotRegistry& registry,
+RobotSession::RobotSession(Strand strand, asio::ip::tcp::socket socket,
+                           const std::shared_ptr<asio::ssl::context>& tls, LinkServer& server, RobotRegistry& registry,
                            const ServerConfig& config, uint64_t serial)
     : strand_(strand),
-      socket_(std::move(socket)),
+      stream_(std::move(socket), tls),
       server_(server),
       registry_(registry),
       config_(config),
@@ -49,11 +50,12 @@ RobotSession::RobotSession(Strand strand, asio::ip::tcp::socket socket, LinkServ
       watchdog_timer_(strand_),
       heartbeat_timer_(strand_),
       teleop_timer_(strand_),
+      stale_timer_(strand_),
       decoder_(config.max_frame_bytes) {
   error_code ec;
-  const auto ep = socket_.remote_endpoint(ec);
+  const auto ep = stream_.socket().remote_endpoint(ec);
   address_ = ec ? std::string("?") : ep.address().to_string() + ":" + std::to_string(ep.port());
-  socket_.set_option(asio::ip::tcp::no_delay(true), ec);  // small frames, latency matters
+  stream_.socket().set_option(asio::ip::tcp::no_delay(true), ec);  // small frames, latency matters
 }
 
 std::string RobotSession::who() const { return robot_id_.empty() ? address_ : robot_id_ + " (" + address_ + ")"; }
@@ -64,10 +66,25 @@ void RobotSession::start() {
     self->handshake_timer_.expires_after(seconds(self->config_.handshake_timeout_s));
     self->handshake_timer_.async_wait([self](const error_code& ec) {
       if (ec || self->closed_ || self->accepted_ || self->rejecting_) return;
-      self->closeNow("no Hello within " + fmtShort(self->config_.handshake_timeout_s) + " s (handshake timeout)",
+      self->closeNow(std::string(self->cert_name_.empty() && self->stream_.tls() ? "no TLS handshake" : "no Hello") +
+                         " within " + fmtShort(self->config_.handshake_timeout_s) + " s (handshake timeout)",
                      log::Level::kWarn);
     });
-    self->doRead();
+    self->stream_.asyncHandshake(asio::ssl::stream_base::server, [self](const error_code& ec) {
+      if (self->closed_) return;
+      if (ec) {
+        self->closeNow("TLS handshake failed: " + net::describeHandshakeError(ec, self->stream_.ssl()),
+                       log::Level::kWarn);
+        return;
+      }
+      if (self->stream_.tls()) {
+        self->cert_name_ = net::peerCommonName(self->stream_.ssl());
+        log::debug(kTag, self->address_, ": TLS up, robot certificate CN=", self->cert_name_);
+      } else {
+        log::warn(kTag, self->address_, ": UNAUTHENTICATED plaintext connection (--plaintext)");
+      }
+      self->doRead();
+    });
   });
 }
 
@@ -114,7 +131,7 @@ void RobotSession::clearTeleop() {
 }
 
 void RobotSession::doRead() {
-  socket_.async_read_some(asio::buffer(rx_buf_),
+  stream_.asyncReadSome(asio::buffer(rx_buf_),
                           [self = shared_from_this()](const error_code& ec, std::size_t n) { self->onRead(ec, n); });
 }
 
@@ -127,7 +144,7 @@ void RobotSession::onRead(const error_code& ec, std::size_t n) {
     return;
   }
   if (ec) {
-    if (ec == asio::error::eof) {
+    if (ec == asio::error::eof || ec == asio::ssl::error::stream_truncated) {  // TCP FIN without TLS close_notify
       if (decoder_.buffered() > 0)
         closeNow("connection closed in the middle of a frame (" + std::to_string(decoder_.buffered()) +
                      " bytes of an incomplete frame)",
@@ -177,7 +194,13 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
   switch (body) {
     case v1::Envelope::kHeartbeat:
       return true;  // last_rx_ already counts it
-    case v1::Envelope::kTelemetry:
+    case v1::Envelope::kTelemetry: {
+      const auto& t = env.telemetry();
+      last_telemetry_ = Clock::now();
+      stale_stopped_ = false;
+      robot_moving_ = t.mode() == v1::TELEOP || t.mode() == v1::TRACKING || t.mode() == v1::NAVIGATING ||
+                      t.mode() == v1::WHEEL_TEST || t.cmd_v_m_s() != 0.0 || t.cmd_w_rad_s() != 0.0;
+    }
       registry_.onTelemetry(robot_id_, serial_, env.telemetry(), monoNowNs());
       server_.observe(robot_id_, address_, env, true, monoNowUs());
       return true;
@@ -208,6 +231,9 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
 
 void RobotSession::handleHello(const v1::Hello& hello) {
   if (const auto why = helloRejection(hello)) rejectHello(*why);
+  else if (stream_.tls() && hello.robot_id() != cert_name_)
+    rejectHello("robot id '" + hello.robot_id() + "' does not match its certificate (CN '" + cert_name_ +
+                "'): a robot may only connect as the id its certificate was made for");
   else acceptHello(hello);
 }
 
@@ -250,6 +276,8 @@ void RobotSession::acceptHello(const v1::Hello& hello) {
   heartbeat_timer_.expires_after(std::chrono::nanoseconds(0));
   armHeartbeat();
   armWatchdog();
+  last_telemetry_ = Clock::now();
+  if (config_.telemetry_stale_s > 0) armStaleCheck();
 }
 
 void RobotSession::armWatchdog() {
@@ -263,6 +291,37 @@ void RobotSession::armWatchdog() {
       return;
     }
     self->armWatchdog();
+  });
+}
+
+// The operator is blind to a robot whose telemetry stopped while it moves
+// (e.g. the robot->server direction stalled while commands still arrive, so
+// the robot's own link timeout does not fire): stop it, once per gap. Not
+// latched on the robot; the operator decides what next.
+void RobotSession::armStaleCheck() {
+  stale_timer_.expires_after(std::chrono::milliseconds(50));
+  stale_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
+    if (ec || self->closed_) return;
+    const auto gap = Clock::now() - self->last_telemetry_;
+    if (!self->stale_stopped_ && (self->robot_moving_ || self->teleop_active_) &&
+        gap >= seconds(self->config_.telemetry_stale_s)) {
+      self->stale_stopped_ = true;
+      self->teleop_active_ = false;
+      ++self->teleop_generation_;
+      self->teleop_timer_.cancel();
+      const std::string why = "no telemetry for " + fmtShort(std::chrono::duration<double>(gap).count(), 2) +
+                              " s while moving: Stop sent (the operator cannot see the robot)";
+      log::warn(kTag, self->who(), ": ", why);
+      v1::Envelope env;
+      env.mutable_command()->set_id(self->server_.nextCommandId());
+      env.mutable_command()->mutable_stop();
+      self->enqueue(env);
+      v1::Event ev;  // shown on every console like the robot's own events
+      ev.set_kind(v1::Event::FAULT_RAISED);
+      ev.set_text("server: " + why);
+      self->registry_.onEvent(self->robot_id_, self->serial_, ev, monoNowNs());
+    }
+    self->armStaleCheck();
   });
 }
 
@@ -331,7 +390,7 @@ void RobotSession::enqueue(v1::Envelope& env) {
 }
 
 void RobotSession::doWrite() {
-  asio::async_write(socket_, asio::buffer(tx_queue_.front()),
+  stream_.asyncWrite(asio::buffer(tx_queue_.front()),
                     [self = shared_from_this()](const error_code& ec, std::size_t) { self->onWrite(ec); });
 }
 
@@ -348,7 +407,7 @@ void RobotSession::onWrite(const error_code& ec) {
   } else if (rejecting_) {
     // The reply is out: half-close so the robot reads it and sees EOF; its close ends the linger.
     error_code ignored;
-    socket_.shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
+    stream_.socket().shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
   }
 }
 
@@ -361,9 +420,8 @@ void RobotSession::closeNow(const std::string& reason, log::Level level) {
   watchdog_timer_.cancel();
   heartbeat_timer_.cancel();
   teleop_timer_.cancel();
-  error_code ignored;
-  socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
-  socket_.close(ignored);
+  stale_timer_.cancel();
+  stream_.close();
   if (accepted_) registry_.onDisconnected(robot_id_, serial_, reason, monoNowNs());
   server_.detach(shared_from_this(), robot_id_);
 }

@@ -18,6 +18,7 @@
 #include "inspect/v1/link.pb.h"
 #include "pc_server/server_config.hpp"
 #include "shared/net/delimited_codec.hpp"
+#include "shared/net/tls.hpp"
 #include "shared/util/log.hpp"
 
 namespace inspect::server {
@@ -34,11 +35,13 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   /// How long a rejected robot gets to read the HelloReply before the socket closes.
   static constexpr auto kRejectLinger = std::chrono::milliseconds(500);
 
-  /// `socket` must use `strand` as its executor (accepted onto it).
-  RobotSession(Strand strand, boost::asio::ip::tcp::socket socket, LinkServer& server, RobotRegistry& registry,
+  /// `socket` must use `strand` as its executor (accepted onto it); `tls`
+  /// null = plaintext (--plaintext), else the TLS handshake comes first.
+  RobotSession(Strand strand, boost::asio::ip::tcp::socket socket,
+               const std::shared_ptr<boost::asio::ssl::context>& tls, LinkServer& server, RobotRegistry& registry,
                const ServerConfig& config, uint64_t serial);
 
-  /// Starts reading and the handshake timeout.
+  /// Starts the TLS handshake, then reading; arms the handshake timeout (TLS + Hello).
   void start();
   /// Closes the connection, logging `reason`; thread-safe.
   void close(std::string reason);
@@ -52,6 +55,8 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   uint64_t serial() const { return serial_; }
   /// Peer "ip:port" (fixed at construction).
   const std::string& address() const { return address_; }
+  /// The common name of the robot's verified certificate ("" before the TLS handshake or in plaintext).
+  const std::string& certificateName() const { return cert_name_; }
 
  private:
   void doRead();
@@ -65,6 +70,7 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   void doWrite();
   void onWrite(const boost::system::error_code& ec);
   void armWatchdog();
+  void armStaleCheck();
   void armHeartbeat();
   void armTeleop(uint64_t generation);
   void sendTeleopNow(uint64_t id);
@@ -72,7 +78,7 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   std::string who() const;
 
   Strand strand_;
-  boost::asio::ip::tcp::socket socket_;
+  net::LinkStream stream_;
   LinkServer& server_;
   RobotRegistry& registry_;
   const ServerConfig config_;
@@ -83,6 +89,7 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   boost::asio::steady_timer watchdog_timer_;
   boost::asio::steady_timer heartbeat_timer_;
   boost::asio::steady_timer teleop_timer_;
+  boost::asio::steady_timer stale_timer_;
 
   net::DelimitedDecoder decoder_;
   std::array<char, 16 * 1024> rx_buf_{};
@@ -90,12 +97,16 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   std::size_t queued_bytes_ = 0;
   uint64_t tx_seq_ = 0;
 
+  std::string cert_name_;        // CN of the robot's certificate, after the TLS handshake
   std::string robot_id_;         // set by an accepted Hello
   bool accepted_ = false;
   bool rejecting_ = false;       // HelloReply{accepted=false} queued; close once sent
   std::string reject_reason_;
   bool closed_ = false;
   Clock::time_point last_rx_;
+  Clock::time_point last_telemetry_;
+  bool robot_moving_ = false;    // its last telemetry: a moving mode or a non-zero command
+  bool stale_stopped_ = false;   // a Stop went out for the current telemetry gap
 
   bool teleop_active_ = false;
   double teleop_v_m_s_ = 0;

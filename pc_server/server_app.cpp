@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <functional>
 #include <csignal>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include "pc_server/console.hpp"
 #include "pc_server/console_runner.hpp"
 #include "pc_server/link_server.hpp"
+#include "pc_server/operator_socket.hpp"
 #include "pc_server/robot_registry.hpp"
 #include "pc_server/startup_error.hpp"
 #include "pc_server/stop_flag.hpp"
@@ -54,6 +56,11 @@ struct IoThreads {
 };
 }  // namespace
 
+static std::string localUserName() {
+  if (const char* u = std::getenv("USER"); u && *u) return u;
+  return "operator";
+}
+
 ServerConfig resolveConfig(const CliOptions& options) {
   ServerConfig c;
   if (options.config_path) {
@@ -68,6 +75,13 @@ ServerConfig resolveConfig(const CliOptions& options) {
   if (options.no_video) c.video.enabled = false;
   if (options.runs_dir) c.recording.dir = *options.runs_dir;
   if (options.no_record) c.recording.enabled = false;
+  if (options.certs_dir) {
+    c.tls.ca = *options.certs_dir + "/ca.pem";
+    c.tls.cert = *options.certs_dir + "/server.pem";
+    c.tls.key = *options.certs_dir + "/server.key";
+  }
+  c.tls.plaintext = options.plaintext;
+  if (options.operator_socket) c.operator_socket = *options.operator_socket;
   return c;
 }
 
@@ -96,8 +110,13 @@ int runServer(const CliOptions& options) {
   link.setLogEvents(mode == ConsoleMode::kNone);
   if (mode != ConsoleMode::kNone) link.setConsoleWatchdog(kConsoleWatchdog);
   const auto endpoint = link.listen();
-  log::warn(kTag, "robot link is plaintext TCP (TLS is not implemented yet): use it only on a trusted network");
-  std::cout << "pc_server: listening on " << endpoint.address().to_string() << ":" << endpoint.port() << std::endl;
+  if (config.tls.plaintext) {
+    log::warn(kTag, net::kPlaintextWarning);
+    std::cerr << "pc_server: " << net::kPlaintextWarning << std::endl;
+  }
+  std::cout << "pc_server: listening on " << endpoint.address().to_string() << ":" << endpoint.port()
+            << (config.tls.plaintext ? " (PLAINTEXT)" : " (mutual TLS, server certificate " + link.certificateInfo() + ")")
+            << std::endl;
   if (options.port_file) writePortFile(*options.port_file, endpoint.port(), "--port-file");
 
   std::unique_ptr<Recorder> recorder;
@@ -188,17 +207,28 @@ int runServer(const CliOptions& options) {
   int status = 0;
   {
     Console::Options copt;
-    Console console(registry, link, std::cout, stop, copt);
-    console.setVideo(video.get());
-    console.setRecorder(recorder.get());
-    {
+    // Every console (this one and those attached to the operator socket) is one
+    // session; one session at a time controls a robot (docs/console.md).
+    ControlArbiter control;
+    const auto configure = [&](Console& c) {
+      c.setVideo(video.get());
+      c.setRecorder(recorder.get());
       // The tuning host reads the robot and control configs beside the server's
       // (config/robot.yaml, config/control.yaml) and writes sessions under the runs.
       const std::filesystem::path cfg_dir =
           options.config_path ? std::filesystem::path(*options.config_path).parent_path() : std::filesystem::path("config");
       const auto beside = [&](const char* name) { return (cfg_dir.empty() ? std::filesystem::path(".") : cfg_dir) / name; };
-      console.setTuningPaths(beside("robot.yaml").string(), beside("control.yaml").string(),
-                             (recorder ? recorder->config().dir : config.recording.dir) + "/tuning");
+      c.setTuningPaths(beside("robot.yaml").string(), beside("control.yaml").string(),
+                       (recorder ? recorder->config().dir : config.recording.dir) + "/tuning");
+    };
+    Console console(registry, link, std::cout, stop, copt);
+    configure(console);
+    console.setSession(&control, control.openSession(localUserName() + "@console"));
+    std::unique_ptr<OperatorSocket> operators;
+    if (!config.operator_socket.empty()) {
+      operators = std::make_unique<OperatorSocket>(config.operator_socket, registry, link, control, copt, configure);
+      operators->start();
+      std::cout << "pc_server: operator consoles: pc_server --attach " << config.operator_socket << std::endl;
     }
     console.setAlarmStyle(::isatty(STDOUT_FILENO) == 1);  // red + bell on a terminal, plain text into pipes
     ConsoleRunner runner(console, stop, config.status_refresh_hz);
@@ -217,6 +247,7 @@ int runServer(const CliOptions& options) {
         status = runner.runStream(0) ? 0 : 1;
         break;
     }
+    if (operators) operators->stop();
   }
   std::cout.flush();
 

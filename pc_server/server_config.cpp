@@ -21,6 +21,9 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   c.heartbeat_period_s = root.number("heartbeat_period_s", c.heartbeat_period_s, 0.01, 5);
   // The robot sends heartbeats at 0.1 s by default; a timeout must cover a few of them.
   c.session_timeout_s = root.number("session_timeout_s", c.session_timeout_s, 0.2, 60);
+  c.telemetry_stale_s = root.number("telemetry_stale_s", c.telemetry_stale_s, 0, 60);
+  if (c.telemetry_stale_s > 0 && c.telemetry_stale_s < 0.1)
+    root.fail("telemetry_stale_s", "must be 0 (off) or at least 0.1 s (robots send telemetry at up to 100 Hz)");
   c.handshake_timeout_s = root.number("handshake_timeout_s", c.handshake_timeout_s, 0.1, 60);
   // The robot zeroes a set-point older than 300 ms; below 10 Hz it would stutter.
   c.teleop_resend_hz = root.number("teleop_resend_hz", c.teleop_resend_hz, 10, 100);
@@ -52,6 +55,13 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   if (rc.compression != "zstd" && rc.compression != "none")
     r.fail("compression", "'" + rc.compression + "' is not one of zstd, none");
   rc.max_fragment_s = r.number("max_fragment_s", rc.max_fragment_s, 0.1, 60);
+  c.operator_socket = root.string("operator_socket", c.operator_socket);
+  const auto t = root.optChild("tls");
+  for (const char* key : {"ca", "cert", "key"}) {
+    std::string& field = key[0] == 'c' ? (key[1] == 'a' ? c.tls.ca : c.tls.cert) : c.tls.key;
+    field = t.string(key, field);
+    if (field.empty()) t.fail(key, "must not be empty (plaintext is only the --plaintext flag)");
+  }
   return c;
 }
 

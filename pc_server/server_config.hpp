@@ -30,6 +30,14 @@ struct RecordingServerConfig {
   double max_fragment_s = 0.5;
 };
 
+/// Mutual TLS on the robot link (docs/security.md). Relative paths are from the working directory.
+struct TlsServerConfig {
+  bool plaintext = false;                // only from --plaintext, never from a file
+  std::string ca = "certs/ca.pem";       // the CA that signed the robots' certificates
+  std::string cert = "certs/server.pem";
+  std::string key = "certs/server.key";
+};
+
 /// Link and console settings; defaults are those documented in config/server.yaml.
 struct ServerConfig {
   std::string bind_address = "0.0.0.0";  // all interfaces: robots connect from the network
@@ -37,12 +45,15 @@ struct ServerConfig {
   std::string server_id = "pc_server";
   double heartbeat_period_s = 0.1;
   double session_timeout_s = 1.0;
+  double telemetry_stale_s = 0.5;        // a moving robot whose telemetry stops this long is stopped; 0 = never
   double handshake_timeout_s = 5.0;
   double teleop_resend_hz = 20.0;
   std::size_t max_frame_bytes = 1u << 20;
   double status_refresh_hz = 5.0;
   VideoServerConfig video;
   RecordingServerConfig recording;
+  TlsServerConfig tls;
+  std::string operator_socket;           // Unix socket for more operator consoles; "" = none
 };
 
 /// True for a numeric IPv4/IPv6 address.

@@ -24,6 +24,12 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   c.handshake_timeout_s = s.number("handshake_timeout_s", c.handshake_timeout_s, 0.1, 60);
   c.server_heartbeat_period_s = s.number("heartbeat_period_s", c.server_heartbeat_period_s, 0.01, 5);
   c.telemetry_hz = s.number("telemetry_hz", c.telemetry_hz, 1, 100);
+  const auto t = root.optChild("tls");
+  c.tls.ca = t.string("ca", c.tls.ca);
+  if (c.tls.ca.empty()) t.fail("ca", "must not be empty (plaintext is only the --plaintext flag)");
+  c.tls.cert = t.string("cert", c.tls.cert);
+  c.tls.key = t.string("key", c.tls.key);
+  c.tls.server_name = t.string("server_name", c.tls.server_name);
   const auto ser = root.optChild("serial");
   c.serial_device = ser.string("device", c.serial_device);
   c.baud = static_cast<int>(ser.integer("baud", c.baud, 1200, 4000000));

@@ -44,6 +44,15 @@ struct VideoParams {
   int mtu = 1200;
 };
 
+/// Mutual TLS on the link (docs/security.md); relative paths are from the working directory.
+struct TlsParams {
+  bool plaintext = false;            // only from --plaintext, never from a file
+  std::string ca = "certs/ca.pem";   // the CA that signed the server's certificate
+  std::string cert;                  // "" = certs/<robot_id>.pem
+  std::string key;                   // "" = certs/<robot_id>.key
+  std::string server_name;           // name the server's certificate must carry; "" = server.host
+};
+
 struct ClientConfig {
   std::string robot_id = "robot1";
   std::string server_host = "127.0.0.1";
@@ -59,6 +68,7 @@ struct ClientConfig {
   double mcu_heartbeat_period_s = 0.1;
   SafetyParams safety;
   VideoParams video;
+  TlsParams tls;
   std::string map_file;  // world file whose walls people tracking ignores ("" = no map); --map overrides
 };
 

@@ -17,6 +17,7 @@
 #include "shared/config/control_config.hpp"
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/config/config_node.hpp"
+#include "shared/net/tls.hpp"
 #include "shared/util/log.hpp"
 #include "sim/world.hpp"
 
@@ -43,6 +44,10 @@ options:
                        map: in the client config)
   --gas-reaction R     reaction to a gas HIGH alarm on a route: continue, stop
                        (hold until resume) or retreat (overrides safety.gas_reaction)
+  --certs DIR          TLS files DIR/ca.pem, DIR/<robot id>.pem, DIR/<robot id>.key
+                       (overrides tls.*; default certs; scripts/make_certs.sh makes them)
+  --plaintext          no TLS: the link is neither encrypted nor authenticated
+                       (isolated test benches only; the server needs --plaintext too)
   --cmd-log FILE       write every wheel command sent to the MCU (CSV; for tests)
   --video-source URI   camera stream source (overrides video.source): synthetic,
                        v4l2:/dev/videoN or file:PATH
@@ -73,7 +78,8 @@ int main(int argc, char** argv) {
   std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
   std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
   std::string serial_dev, server, id, cmd_log, map_path, video_source, video_port, gas_reaction;
-  bool no_video = false;
+  bool no_video = false, plaintext = false;
+  std::string certs_dir;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -108,6 +114,10 @@ int main(int argc, char** argv) {
       video_source = value();
     } else if (a == "--video-port") {
       video_port = value();
+    } else if (a == "--certs") {
+      certs_dir = value();
+    } else if (a == "--plaintext") {
+      plaintext = true;
     } else if (a == "--no-video") {
       no_video = true;
     } else if (a == "--gas-reaction") {
@@ -139,6 +149,21 @@ int main(int argc, char** argv) {
       const long port = std::strtol(server.c_str() + colon + 1, &end, 10);
       if (*end != '\0' || port < 1 || port > 65535) usageError("--server '" + server + "': bad port");
       cfg.server_port = static_cast<int>(port);
+    }
+
+    if (plaintext && !certs_dir.empty()) usageError("--plaintext cannot be combined with --certs");
+    if (!certs_dir.empty()) {
+      cfg.tls.ca = certs_dir + "/ca.pem";
+      cfg.tls.cert = certs_dir + "/" + cfg.robot_id + ".pem";
+      cfg.tls.key = certs_dir + "/" + cfg.robot_id + ".key";
+    }
+    if (cfg.tls.cert.empty()) cfg.tls.cert = "certs/" + cfg.robot_id + ".pem";
+    if (cfg.tls.key.empty()) cfg.tls.key = "certs/" + cfg.robot_id + ".key";
+    if (cfg.tls.server_name.empty()) cfg.tls.server_name = cfg.server_host;
+    cfg.tls.plaintext = plaintext;
+    if (plaintext) {
+      std::fprintf(stderr, "robot_client: %s\n", net::kPlaintextWarning);
+      log::warn("main", net::kPlaintextWarning);
     }
 
     if (!video_source.empty()) cfg.video.source = video_source;
@@ -192,6 +217,9 @@ int main(int argc, char** argv) {
     io.run();
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "robot_client: %s\n", e.what());
+    return 2;
+  } catch (const net::TlsError& e) {
+    std::fprintf(stderr, "robot_client: TLS: %s (or --plaintext for an isolated test bench)\n", e.what());
     return 2;
   }
   return 0;

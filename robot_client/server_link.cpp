@@ -22,8 +22,17 @@ std::chrono::steady_clock::duration secs(double s) {
 }  // namespace
 
 ServerLink::ServerLink(asio::io_context& io, const ClientConfig& cfg)
-    : io_(io), cfg_(cfg), resolver_(io), socket_(io), retry_timer_(io), handshake_timer_(io), heartbeat_timer_(io),
-      backoff_s_(cfg.reconnect_min_s) {}
+    : io_(io),
+      cfg_(cfg),
+      resolver_(io),
+      tls_(cfg.tls.plaintext ? nullptr
+                             : net::makeTlsContext({cfg.tls.ca, cfg.tls.cert, cfg.tls.key}, net::TlsRole::kClient)),
+      retry_timer_(io),
+      handshake_timer_(io),
+      heartbeat_timer_(io),
+      backoff_s_(cfg.reconnect_min_s) {
+  if (tls_) log::info("link", "mutual TLS, robot certificate ", net::describeCertificate(cfg.tls.cert));
+}
 
 void ServerLink::start(Handlers h) {
   h_ = std::move(h);
@@ -35,8 +44,7 @@ void ServerLink::stop() {
   retry_timer_.cancel();
   handshake_timer_.cancel();
   heartbeat_timer_.cancel();
-  boost::system::error_code ec;
-  socket_.close(ec);
+  if (stream_) stream_->close();
 }
 
 void ServerLink::connect() {
@@ -50,22 +58,44 @@ void ServerLink::connect() {
           close("cannot resolve " + cfg_.server_host + ": " + ec.message());
           return;
         }
-        asio::async_connect(socket_, results, [this, gen](const boost::system::error_code& ec2, const tcp::endpoint&) {
-          if (gen != generation_ || stopped_) return;
-          if (ec2) {
-            close("cannot connect to " + cfg_.server_host + ":" + std::to_string(cfg_.server_port) + ": " +
-                  ec2.message());
-            return;
-          }
-          onConnected();
-        });
+        stream_ = std::make_shared<net::LinkStream>(tcp::socket(io_), tls_);
+        if (tls_) stream_->expectServerName(cfg_.tls.server_name);
+        asio::async_connect(stream_->socket(), results,
+                            [this, gen, s = stream_](const boost::system::error_code& ec2, const tcp::endpoint&) {
+                              if (gen != generation_ || stopped_) return;
+                              if (ec2) {
+                                close("cannot connect to " + cfg_.server_host + ":" +
+                                      std::to_string(cfg_.server_port) + ": " + ec2.message());
+                                return;
+                              }
+                              onTcpConnected();
+                            });
       });
+}
+
+void ServerLink::onTcpConnected() {
+  boost::system::error_code ec;
+  stream_->socket().set_option(tcp::no_delay(true), ec);
+  const uint64_t gen = generation_;
+  // One deadline for the TLS handshake and the HelloReply.
+  handshake_timer_.expires_after(secs(cfg_.handshake_timeout_s));
+  handshake_timer_.async_wait([this, gen](const boost::system::error_code& e) {
+    if (!e && gen == generation_ && !up_)
+      close("no handshake reply within " + std::to_string(cfg_.handshake_timeout_s) + " s");
+  });
+  stream_->asyncHandshake(asio::ssl::stream_base::client, [this, gen, s = stream_](const boost::system::error_code& e) {
+    if (gen != generation_ || stopped_) return;
+    if (e) {
+      close("TLS handshake with " + cfg_.server_host + ":" + std::to_string(cfg_.server_port) +
+            " failed: " + net::describeHandshakeError(e, s->ssl()));
+      return;
+    }
+    onConnected();
+  });
 }
 
 void ServerLink::onConnected() {
   connected_ = true;
-  boost::system::error_code ec;
-  socket_.set_option(tcp::no_delay(true), ec);
   decoder_ = net::DelimitedDecoder();
   tx_queue_.clear();
   v1::Envelope hello;
@@ -82,11 +112,6 @@ void ServerLink::onConnected() {
   h->set_software_version(INSPECT_VERSION);
   if (hello_filler_) hello_filler_(*h);
   send(hello);
-  const uint64_t gen = generation_;
-  handshake_timer_.expires_after(secs(cfg_.handshake_timeout_s));
-  handshake_timer_.async_wait([this, gen](const boost::system::error_code& e) {
-    if (!e && gen == generation_ && !up_) close("no handshake reply within " + std::to_string(cfg_.handshake_timeout_s) + " s");
-  });
   doRead();
 }
 
@@ -106,9 +131,7 @@ void ServerLink::close(const std::string& why) {
   connected_ = false;
   handshake_timer_.cancel();
   heartbeat_timer_.cancel();
-  boost::system::error_code ec;
-  socket_.shutdown(tcp::socket::shutdown_both, ec);
-  socket_.close(ec);
+  if (stream_) stream_->close();
   tx_queue_.clear();
   if (was_up || why != last_error_) log::warn("link", why);
   last_error_ = why;
@@ -118,10 +141,15 @@ void ServerLink::close(const std::string& why) {
 
 void ServerLink::doRead() {
   const uint64_t gen = generation_;
-  socket_.async_read_some(asio::buffer(rx_buf_), [this, gen](const boost::system::error_code& ec, std::size_t n) {
+  stream_->asyncReadSome(asio::buffer(rx_buf_), [this, gen, s = stream_](const boost::system::error_code& ec,
+                                                                          std::size_t n) {
     if (gen != generation_ || stopped_) return;
     if (ec) {
-      close(ec == asio::error::eof ? "server closed the connection" : "read failed: " + ec.message());
+      if (ec == asio::error::eof || ec == asio::ssl::error::stream_truncated)
+        close(std::string("server closed the connection") +
+              (!up_ && !tls_ ? " before the handshake reply (does it expect TLS? this robot runs --plaintext)" : ""));
+      else
+        close("read failed: " + ec.message());
       return;
     }
     last_rx_ns_ = monoNowNs();
@@ -202,7 +230,8 @@ void ServerLink::send(v1::Envelope& env) {
 
 void ServerLink::doWrite() {
   const uint64_t gen = generation_;
-  asio::async_write(socket_, asio::buffer(tx_queue_.front()), [this, gen](const boost::system::error_code& ec, std::size_t) {
+  stream_->asyncWrite(asio::buffer(tx_queue_.front()), [this, gen, s = stream_](const boost::system::error_code& ec,
+                                                                               std::size_t) {
     if (gen != generation_ || stopped_) return;
     if (ec) {
       close("write failed: " + ec.message());

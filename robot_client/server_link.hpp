@@ -4,6 +4,7 @@
 #include <array>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include <boost/asio/io_context.hpp>
@@ -13,6 +14,7 @@
 #include "inspect/v1/link.pb.h"
 #include "robot_client/client_config.hpp"
 #include "shared/net/delimited_codec.hpp"
+#include "shared/net/tls.hpp"
 
 namespace inspect::client {
 
@@ -24,6 +26,7 @@ class ServerLink {
     std::function<void(const v1::Envelope&)> on_message;      // any message after the handshake
   };
 
+  /// Loads the TLS files of cfg.tls unless cfg.tls.plaintext; throws net::TlsError naming the file.
   ServerLink(boost::asio::io_context& io, const ClientConfig& cfg);
 
   void start(Handlers h);
@@ -47,6 +50,7 @@ class ServerLink {
 
  private:
   void connect();
+  void onTcpConnected();
   void onConnected();
   void scheduleReconnect();
   void doRead();
@@ -61,7 +65,8 @@ class ServerLink {
   std::function<void(v1::Hello&)> hello_filler_;
   Handlers h_;
   boost::asio::ip::tcp::resolver resolver_;
-  boost::asio::ip::tcp::socket socket_;
+  std::shared_ptr<boost::asio::ssl::context> tls_;  // null: --plaintext
+  std::shared_ptr<net::LinkStream> stream_;         // a new one per connection; handlers keep theirs alive
   boost::asio::steady_timer retry_timer_;
   boost::asio::steady_timer handshake_timer_;
   boost::asio::steady_timer heartbeat_timer_;

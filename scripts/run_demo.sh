@@ -44,6 +44,8 @@ cleanup() {
 trap cleanup EXIT
 
 echo "demo: logs and ground truth in $OUT"
+# Mutual TLS: certificates in certs/ (made once; the programs' default paths), docs/security.md.
+bash scripts/make_certs.sh --out certs robot1 | sed 's/^/demo: /'
 if [ "$JOB" = tuning ]; then
   WORLD=config/worlds/tuning_floor.yaml; SCRIPT=scripts/demo/tuning.console; SIM_ARGS=()
 else
@@ -70,7 +72,9 @@ PIDS+=("$CLIENT")
 # Video on an ephemeral UDP port (5600 may be taken); SDP and snapshots in $OUT/video.
 ARGS=(--config config/server.yaml --bind 127.0.0.1 --port "$PORT" --port-file "$OUT/port"
       --video-port 0 --video-port-file "$OUT/video_port" --video-dir "$OUT/video" --runs-dir "$OUT/runs"
-      --script "$SCRIPT")
+      --operator-socket "$OUT/operator.sock" --script "$SCRIPT")
+echo "demo: link: mutual TLS with certs/ (scripts/make_certs.sh); a second operator (observer; 'help control'):"
+echo "        $BIN/pc_server --attach $OUT/operator.sock"
 echo "demo: camera: $OUT/video/robot1.sdp (play it while the console runs:"
 echo "        ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay $OUT/video/robot1.sdp)"
 echo "      snapshots: $OUT/video/robot1_latest.png (refreshed every 5 s), 'snapshot' at the console" 

@@ -5,6 +5,8 @@ set -euo pipefail
 
 PACKAGES=(
   g++ cmake ninja-build pkg-config git
+  clang libclang-rt-14-dev
+  libssl-dev openssl
   libboost-dev
   libprotobuf-dev protobuf-compiler
   libyaml-cpp-dev

@@ -1,4 +1,5 @@
 #include "tests/integration/stack.hpp"
+#include "tests/test_certs.hpp"
 
 #include <algorithm>
 
@@ -92,6 +93,11 @@ bool Stack::startServer(const std::string& script, const std::vector<std::string
   } else {
     argv.push_back("--no-video");
   }
+  // Mutual TLS with the tests' certificates, as in the field (unless the test asks for --plaintext).
+  if (std::find(extra.begin(), extra.end(), "--plaintext") == extra.end()) {
+    argv.push_back("--certs");
+    argv.push_back(testCertsDir());
+  }
   argv.insert(argv.end(), extra.begin(), extra.end());
   server_ = Process::spawn(argv, dir_ / "server.out", dir_ / "server.err");
   if (!waitUntil([&] { return exists(dir_ / "port"); }, 10.0)) return false;
@@ -134,6 +140,10 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     client_argv.push_back(std::to_string(video_port_));
   } else {
     client_argv.push_back("--no-video");
+  }
+  if (std::find(client_args.begin(), client_args.end(), "--plaintext") == client_args.end()) {
+    client_argv.push_back("--certs");
+    client_argv.push_back(testCertsDir({id}));
   }
   client_argv.insert(client_argv.end(), client_args.begin(), client_args.end());
   r->client = Process::spawn(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));

@@ -16,6 +16,7 @@
 
 #include "shared/catalog/catalog.hpp"
 #include "tests/integration/stack.hpp"
+#include "tests/test_certs.hpp"
 
 using namespace inspect::test;
 
@@ -129,7 +130,8 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   const std::string second = runDir(runs, ids[1]);
   writeFile(s.dir() / "restart.txt", "runs\nrun show 2\nreport 1\nexport 1 csv\nreplay 1 20\n");
   auto restarted = Process::spawn({binPath("pc_server"), "--config", srcPath("config/server.yaml"), "--bind",
-                                   "127.0.0.1", "--port", "0", "--no-video", "--runs-dir", runs, "--script",
+                                   "127.0.0.1", "--port", "0", "--no-video", "--certs", testCertsDir(), "--runs-dir",
+                                   runs, "--script",
                                    s.dir() / "restart.txt"},
                                   s.dir() / "restart.out", s.dir() / "restart.err");
   ASSERT_TRUE(restarted.wait(20.0).has_value());

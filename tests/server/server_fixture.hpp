@@ -22,6 +22,11 @@ inline server::ServerConfig testConfig() {
   c.bind_address = "127.0.0.1";
   c.port = 0;
   c.server_id = "test_server";
+  c.telemetry_stale_s = 0;  // test robots often send no telemetry; LinkServerTest.StaleTelemetry* turns it on
+  const std::string certs = testCertsDir();
+  c.tls.ca = certs + "/ca.pem";
+  c.tls.cert = certs + "/server.pem";
+  c.tls.key = certs + "/server.key";
   return c;
 }
 

@@ -426,3 +426,44 @@ TEST_F(LinkServerTest, StopClosesAllSessions) {
   EXPECT_TRUE(a.waitClosed(1000ms));
   EXPECT_TRUE(pending.waitClosed(1000ms));
 }
+
+namespace inspect::test {
+
+TEST_F(ServerFixture, StaleTelemetryOfAMovingRobotSendsOneStop) {
+  auto config = testConfig();
+  config.telemetry_stale_s = 0.3;
+  startServer(config);
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(50);  // mode TELEOP: moving
+  ASSERT_TRUE(eventually([&] { return snap("robot1") && snap("robot1")->telemetry_count > 5; }));
+  const auto stops = [&] {
+    int n = 0;
+    for (const auto& m : r.received()) n += m.env.has_command() && m.env.command().has_stop();
+    return n;
+  };
+  std::this_thread::sleep_for(400ms);
+  EXPECT_EQ(stops(), 0);  // telemetry flowing: nothing
+  const auto muted = Clock::now();
+  r.mute_telemetry = true;  // heartbeats go on, so the session stays open
+  ASSERT_TRUE(eventually([&] { return stops() > 0; }, 2000ms));
+  const double after_s = std::chrono::duration<double>(Clock::now() - muted).count();
+  EXPECT_GE(after_s, 0.29);
+  EXPECT_LT(after_s, 1.5);  // (0.3 s + the 50 ms check + scheduling; not a timing benchmark)
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(stops(), 1);  // once per gap
+  EXPECT_TRUE(connected("robot1"));
+  bool told = false;
+  for (const auto& e : registry_.events("robot1")) told = told || e.text().find("no telemetry for") != std::string::npos;
+  EXPECT_TRUE(told);
+  // Telemetry back, then stale again: a second Stop.
+  r.mute_telemetry = false;
+  std::this_thread::sleep_for(200ms);
+  r.mute_telemetry = true;
+  EXPECT_TRUE(eventually([&] { return stops() == 2; }, 2000ms));
+  r.stopPump();
+}
+
+}  // namespace inspect::test
+

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -61,6 +62,12 @@ class Program {
     if (std::find(args.begin(), args.end(), "--video-port") == args.end()) args.push_back("--no-video");
     // Nor a catalog in the working directory.
     if (std::find(args.begin(), args.end(), "--runs-dir") == args.end()) args.push_back("--no-record");
+    // Mutual TLS with the tests' certificates unless the test says otherwise.
+    if (std::find(args.begin(), args.end(), "--plaintext") == args.end() &&
+        std::find(args.begin(), args.end(), "--certs") == args.end()) {
+      args.push_back("--certs");
+      args.push_back(testCertsDir());
+    }
     args.insert(args.begin(), kBinary);
     pid_ = ::fork();
     ASSERT_GE(pid_, 0);
@@ -260,4 +267,51 @@ TEST(Program, SigintDuringTuneCancelsItKeepingTheBestAndTheScriptGoesOn) {
   EXPECT_HAS(out, "tuned");               // gains show has the tuned column
   EXPECT_HAS(out, "(cancelled)");         // tune list: the session is in the catalog
   EXPECT_TRUE(fs::exists(p.path("runs") / "tuning"));
+}
+
+TEST(Program, AttachedOperatorObservesAndIsRefusedMotionWhileTheConsoleControls) {
+  Program p("attach");
+  const auto script = p.file("s.txt",
+                             "expect robots >= 1 within 5\n"
+                             "drive 0.2 0\n"
+                             "wait 3\n"
+                             "stop\n");
+  const auto port_file = p.path("port");
+  const auto sock = p.path("op.sock");
+  p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--port-file", port_file.string(),
+           "--operator-socket", sock.string(), "--script", script.string()});
+  const uint16_t port = p.waitPort(port_file);
+  ASSERT_GT(port, 0);
+  TestRobot r;
+  ASSERT_TRUE(r.connect(port));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(50);
+  // Once the console drives, a second operator attaches through the real binary.
+  const auto driving = [&] {
+    for (const auto& m : r.received())
+      if (m.env.has_command() && m.env.command().has_teleop() && m.env.command().teleop().v_m_s() == 0.2) return true;
+    return false;
+  };
+  const auto deadline = Clock::now() + 5s;
+  while (!driving() && Clock::now() < deadline) std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(driving());
+  const auto input = p.file("attach_in.txt", "control\ndrive 0.1 0\nstatus\nstop\nquit\n");
+  const std::string cmd =
+      "timeout 10 " + kBinary + " --attach " + sock.string() + " < " + input.string() + " 2>&1";
+  std::string attached;
+  if (FILE* f = ::popen(cmd.c_str(), "r")) {
+    char buf[4096];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) attached.append(buf, n);
+    EXPECT_EQ(::pclose(f), 0) << attached;
+  }
+  EXPECT_HAS(attached, "pc_server operator session: ");
+  EXPECT_HAS(attached, "@console (session 1)");  // control shows who drives
+  EXPECT_HAS(attached, "robot1: drive refused: robot1 is controlled by ");
+  EXPECT_HAS(attached, "robot1 |");  // the observer sees the status line
+  EXPECT_HAS(attached, "robot1: stop accepted");  // and may stop it
+  for (const auto& m : r.received())
+    EXPECT_FALSE(m.env.has_command() && m.env.command().has_teleop() && m.env.command().teleop().v_m_s() == 0.1);
+  EXPECT_EQ(p.wait(), 0) << p.out() << p.err();
+  r.stopPump();
 }
