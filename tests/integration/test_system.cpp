@@ -6,12 +6,14 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <set>
 #include <sstream>
 #include <tuple>
 
 #include "tests/integration/stack.hpp"
+#include "tests/test_certs.hpp"
 
 using namespace inspect::test;
 
@@ -235,4 +237,37 @@ TEST(System, SecondRobotConnectsWhileFirstDrives) {
     EXPECT_GT(std::abs(row.set_r), 0.4) << "robot1 slowed at t=" << row.t;
   }
   EXPECT_GT(checked, 200u);
+}
+
+// Issue 9: the link is mutual TLS, and nothing secret reaches a log or a
+// recording: no line of the robot's or the server's private key appears in any
+// file the programs wrote (logs, run.mcap, the catalog, the MP4).
+TEST(System, NoPrivateKeyInLogsOrRecordings) {
+  Stack s("secrets");
+  std::string script = kConnect;
+  script += "record start secrets\ndrive 0.2 0\nwait 2\nstop\nrecord stop\n";
+  ASSERT_TRUE(s.startServer(script)) << s.logs();
+  s.startRobot("robot1");
+  const auto rc = s.server().wait(60);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  EXPECT_EQ(*rc, 0) << s.serverOutput();
+  const std::string out = s.serverOutput();
+  EXPECT_NE(out.find("(mutual TLS, server certificate CN=pc_server"), std::string::npos) << out;
+  // The base64 lines of both keys (each 64 characters of key material, or the last shorter one).
+  std::vector<std::string> secret_lines;
+  for (const char* key : {"robot1.key", "server.key"}) {
+    std::istringstream in(readFile(testCertsDir({"robot1"}) + "/" + key));
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind("-----", 0) != 0 && line.size() >= 16) secret_lines.push_back(line);
+  }
+  ASSERT_GE(secret_lines.size(), 4u);
+  int files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(s.dir().path())) {
+    if (!entry.is_regular_file()) continue;
+    const std::string text = readFile(entry.path().string());
+    ++files;
+    EXPECT_EQ(text.find("PRIVATE KEY"), std::string::npos) << entry.path();
+    for (const auto& l : secret_lines) EXPECT_EQ(text.find(l), std::string::npos) << entry.path();
+  }
+  EXPECT_GE(files, 8);  // logs of 3 programs, truth, run.mcap, catalog, ...
 }
