@@ -1,5 +1,6 @@
 #include "pc_server/server_app.hpp"
 
+#include <pwd.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -58,6 +59,7 @@ struct IoThreads {
 
 static std::string localUserName() {
   if (const char* u = std::getenv("USER"); u && *u) return u;
+  if (const passwd* pw = ::getpwuid(::getuid())) return pw->pw_name;
   return "operator";
 }
 

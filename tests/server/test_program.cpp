@@ -306,7 +306,7 @@ TEST(Program, AttachedOperatorObservesAndIsRefusedMotionWhileTheConsoleControls)
     EXPECT_EQ(::pclose(f), 0) << attached;
   }
   EXPECT_HAS(attached, "pc_server operator session: ");
-  EXPECT_HAS(attached, "@console (session 1)");  // control shows who drives
+  EXPECT_HAS(attached, "@console (session 1)");  // control shows who drives (the user running pc_server)
   EXPECT_HAS(attached, "robot1: drive refused: robot1 is controlled by ");
   EXPECT_HAS(attached, "robot1 |");  // the observer sees the status line
   EXPECT_HAS(attached, "robot1: stop accepted");  // and may stop it
