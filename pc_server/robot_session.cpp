@@ -296,10 +296,11 @@ void RobotSession::armWatchdog() {
 
 // The operator is blind to a robot whose telemetry stopped while it moves
 // (e.g. the robot->server direction stalled while commands still arrive, so
-// the robot's own link timeout does not fire): stop it, once per gap. Not
-// latched on the robot; the operator decides what next.
+// the robot's own link timeout does not fire): e-stop it, once per gap. The
+// EStop zeroes the wheels at once (a Stop ramps down) and is latched: the
+// operator resumes once the robot is visible again (no automatic restart).
 void RobotSession::armStaleCheck() {
-  stale_timer_.expires_after(std::chrono::milliseconds(50));
+  stale_timer_.expires_after(std::chrono::milliseconds(20));
   stale_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
     if (ec || self->closed_) return;
     const auto gap = Clock::now() - self->last_telemetry_;
@@ -310,11 +311,12 @@ void RobotSession::armStaleCheck() {
       ++self->teleop_generation_;
       self->teleop_timer_.cancel();
       const std::string why = "no telemetry for " + fmtShort(std::chrono::duration<double>(gap).count(), 2) +
-                              " s while moving: Stop sent (the operator cannot see the robot)";
+                              " s while moving: EStop sent (the operator cannot see the robot; resume once it is "
+                              "back)";
       log::warn(kTag, self->who(), ": ", why);
       v1::Envelope env;
       env.mutable_command()->set_id(self->server_.nextCommandId());
-      env.mutable_command()->mutable_stop();
+      env.mutable_command()->mutable_estop();
       self->enqueue(env);
       v1::Event ev;  // shown on every console like the robot's own events
       ev.set_kind(v1::Event::FAULT_RAISED);

@@ -43,9 +43,9 @@ struct ServerConfig {
   std::string bind_address = "0.0.0.0";  // all interfaces: robots connect from the network
   uint16_t port = 7600;                  // 0 = ephemeral (tests)
   std::string server_id = "pc_server";
-  double heartbeat_period_s = 0.1;
+  double heartbeat_period_s = 0.05;
   double session_timeout_s = 1.0;
-  double telemetry_stale_s = 0.5;        // a moving robot whose telemetry stops this long is stopped; 0 = never
+  double telemetry_stale_s = 0.25;       // a moving robot whose telemetry stops this long is e-stopped; 0 = never
   double handshake_timeout_s = 5.0;
   double teleop_resend_hz = 20.0;
   std::size_t max_frame_bytes = 1u << 20;

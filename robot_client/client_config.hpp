@@ -8,7 +8,7 @@ namespace inspect::client {
 
 /// Safety timeouts of the control core.
 struct SafetyParams {
-  double link_timeout_s = 0.3;
+  double link_timeout_s = 0.25;
   double command_timeout_s = 0.3;
   double sensor_timeout_s = 0.1;
   // Tracking only: the nearest front-sonar range scales the speed down from

@@ -623,12 +623,15 @@ void RobotCore::onLinkUp(double now_s) {
 void RobotCore::onLinkDown(double /*now_s*/, const std::string& why) {
   link_up_ = false;
   raise(v1::FAULT_LINK_LOST, why);
-  if (moving()) latchFailsafe("link lost");
+  if (movingAtLinkLoss()) latchFailsafe("link lost");
   setpoint_ = {};
   setpoint_time_s_ = -1.0;
 }
 
 void RobotCore::onLinkActivity(double now_s) {
+  // A message after a silence that no timer saw in time (this process was
+  // stalled, or its loop was late) still ends the silence as a link loss.
+  checkLinkSilence(now_s);
   last_link_activity_s_ = now_s;
   if (link_up_) clear(v1::FAULT_LINK_LOST, "link restored");
 }
@@ -651,6 +654,9 @@ void RobotCore::setSerialCounters(const serial::DecoderCounters& rx, uint64_t by
 }
 
 v1::Ack RobotCore::onCommand(const v1::Command& cmd, double now_s) {
+  // Timeouts that fell due before this command first (after a stall of this
+  // process the command may be handled before the timer and the frames).
+  checkTimeouts(now_s);
   onLinkActivity(now_s);
   v1::Ack ack;
   ack.set_command_id(cmd.id());
@@ -724,17 +730,26 @@ v1::Ack RobotCore::onCommand(const v1::Command& cmd, double now_s) {
   return reject("unknown or empty command");
 }
 
-void RobotCore::checkTimeouts(double now_s) {
-  // Each check tests the bit first so that no string is built on every tick.
+void RobotCore::checkLinkSilence(double now_s) {
+  // Tests the bit first so that no string is built on every tick.
   if (link_up_ && !(faults_ & v1::FAULT_LINK_LOST) && now_s - last_link_activity_s_ > safety_.link_timeout_s) {
     raise(v1::FAULT_LINK_LOST, "no heartbeat or command for " +
                                    std::to_string(static_cast<int>(safety_.link_timeout_s * 1000)) + " ms");
-    if (moving()) latchFailsafe("link lost");
+    if (movingAtLinkLoss()) latchFailsafe("link lost");
   }
+}
+
+void RobotCore::checkTimeouts(double now_s) {
+  checkLinkSilence(now_s);
   if (mode_ == v1::TELEOP && setpoint_time_s_ >= 0 && now_s - setpoint_time_s_ > safety_.command_timeout_s) {
     raise(v1::FAULT_COMMAND_STALE, "");
     setpoint_ = {};
     setpoint_time_s_ = -1.0;
+    // With both timeouts at 300 ms, the set-point of a robot whose link went
+    // silent usually expires first (the last message was a heartbeat): the
+    // link loss that follows must still latch FAILSAFE, or the robot would
+    // drive on when the link comes back with the console still re-sending.
+    stale_stop_s_ = now_s;
     setMode(v1::IDLE, "teleop set-point stale");
   }
   if (have_frame_ && !(faults_ & v1::FAULT_SENSOR_STALE) && now_s - last_frame_s_ > safety_.sensor_timeout_s) {
@@ -815,6 +830,10 @@ serial::WheelCommand RobotCore::wheelCommand(bool enable) {
 }
 
 serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, double now_s) {
+  // The frames were stale if this one comes too late, whether or not the
+  // timer saw it (after a stall of this process the backlog of old frames may
+  // be read before the timer runs): latch before accepting it.
+  checkTimeouts(now_s);
   double dt_s = 0.01;
   if (!have_frame_) {
     // First frame after start or after the serial line came back: re-anchor
@@ -872,6 +891,7 @@ serial::WheelCommand RobotCore::onSensorFrame(const serial::SensorFrame& f, doub
 serial::WheelCommand RobotCore::commandNow() { return computeCommand(0.0); }
 
 std::optional<serial::WheelCommand> RobotCore::onTimer(double now_s) {
+  const v1::Mode before = mode_;
   checkTimeouts(now_s);
   // No frames (stale, or the serial device closed after frames had come): no
   // gas readings either - the channels go to no_data after 0.5 s.
@@ -880,6 +900,8 @@ std::optional<serial::WheelCommand> RobotCore::onTimer(double now_s) {
     if (!gas_out_.empty()) onGasTransitions(now_s);
   }
   if (faults_ & v1::FAULT_SENSOR_STALE) return computeCommand(0.01);
+  // A latch (link loss) stops the wheels now, not at the next sensor frame.
+  if (mode_ != before && (mode_ == v1::FAILSAFE || mode_ == v1::ESTOP)) return computeCommand(0.0);
   return std::nullopt;
 }
 

@@ -132,6 +132,12 @@ class RobotCore {
   /// Turns the route round: back through the goals already reached to the start.
   void startRetreat(const std::string& why);
   void checkTimeouts(double now_s);
+  /// The link has been silent for longer than link_timeout_s: LINK_LOST, and
+  /// FAILSAFE if the robot was moving when the silence began.
+  void checkLinkSilence(double now_s);
+  /// Whether the robot was moving when the link last carried anything (a
+  /// teleop set-point that went stale in the silence does not count as a stop).
+  bool movingAtLinkLoss() const { return moving() || stale_stop_s_ >= last_link_activity_s_; }
   serial::WheelCommand computeCommand(double dt_s);
   /// cmd_wheels_ as the MCU command (and cmd_twist_ from it).
   serial::WheelCommand wheelCommand(bool enable);
@@ -151,6 +157,7 @@ class RobotCore {
   // Teleop set-point.
   control::Twist setpoint_;
   double setpoint_time_s_ = -1.0;
+  double stale_stop_s_ = -1.0;  // when a stale teleop set-point last stopped the robot
   uint64_t last_command_id_ = 0;
 
   // Sensors and estimate.

@@ -7,6 +7,8 @@
 
 #include <boost/asio/write.hpp>
 
+#include "shared/serial/cobs.hpp"
+#include "shared/serial/crc16.hpp"
 #include "shared/util/log.hpp"
 
 namespace inspect::client {
@@ -17,7 +19,16 @@ SerialLink::SerialLink(asio::io_context& io, std::string device, int baud, doubl
     : io_(io), port_(io), reopen_timer_(io), device_(std::move(device)), baud_(baud),
       reopen_period_s_(reopen_period_s) {}
 
+SerialLink::~SerialLink() {
+  const auto& c = decoder_.counters();
+  log::info("serial", device_, ": received ", c.bytes_rx, " bytes, ", c.frames_ok, " frames ok, bad_cobs ", c.bad_cobs,
+            ", bad_crc ", c.bad_crc, ", bad_length ", c.bad_length, ", unknown_id ", c.unknown_id, ", overflow ",
+            c.overflow, ", seq_gaps ", c.seq_gaps, "; sent ", frames_tx_, " frames (", bytes_tx_, " bytes), ",
+            frames_dropped_, " dropped");
+}
+
 void SerialLink::start(MessageHandler on_message, StateHandler on_state) {
+  log_frames_ = log::level() <= log::Level::kDebug;
   on_message_ = std::move(on_message);
   on_state_ = std::move(on_state);
   tryOpen();
@@ -83,9 +94,32 @@ void SerialLink::doRead() {
       if (ec != asio::error::operation_aborted && !stopped_) fail("read failed: " + ec.message());
       return;
     }
-    decoder_.feed({rx_buf_.data(), n}, on_message_);
+    if (log_frames_) {
+      decoder_.feed({rx_buf_.data(), n}, [this](const serial::Message& m, uint8_t seq) {
+        logFrame(m, seq);
+        on_message_(m, seq);
+      });
+    } else {
+      decoder_.feed({rx_buf_.data(), n}, on_message_);
+    }
     doRead();
   });
+}
+
+void SerialLink::logFrame(const serial::Message& m, uint8_t seq) {
+  // The decoded fields encode back to the very bytes that passed the CRC
+  // check, so re-encoding gives the frame's wire CRC (to compare with what
+  // the sender logged: mcu_sim --frame-log).
+  serial::FrameEncoder enc;
+  const auto f = enc.encode(m);
+  std::array<uint8_t, serial::kMaxRawFrame> raw{};
+  const auto n = serial::cobsDecode({f.bytes.data(), f.size - 1}, raw);
+  if (!n || *n < 4) return;
+  raw[1] = seq;
+  const unsigned crc = serial::crc16CcittFalse({raw.data(), *n - 2});
+  const auto* sf = std::get_if<serial::SensorFrame>(&m);
+  log::debug("serial", "rx frame id=", static_cast<unsigned>(raw[0]), " seq=", static_cast<unsigned>(seq), " crc=", crc,
+             " mcu_time_ms=", sf ? sf->mcu_time_ms : 0u);
 }
 
 uint8_t SerialLink::send(const serial::Message& msg) {

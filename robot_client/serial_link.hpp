@@ -19,6 +19,10 @@ class SerialLink {
   using StateHandler = std::function<void(bool open, const std::string& why)>;
 
   SerialLink(boost::asio::io_context& io, std::string device, int baud, double reopen_period_s);
+  /// Logs the line's counters (frames in and out, errors by kind).
+  ~SerialLink();
+  SerialLink(const SerialLink&) = delete;
+  SerialLink& operator=(const SerialLink&) = delete;
 
   /// Starts opening the device (and keeps retrying while it fails).
   void start(MessageHandler on_message, StateHandler on_state);
@@ -39,6 +43,8 @@ class SerialLink {
   void doRead();
   void doWrite();
   void fail(const std::string& why);
+  /// Debug log of an accepted frame: id, sequence number, wire CRC (and MCU time of a sensor frame).
+  void logFrame(const serial::Message& m, uint8_t seq);
 
   boost::asio::io_context& io_;
   boost::asio::serial_port port_;
@@ -49,6 +55,7 @@ class SerialLink {
   MessageHandler on_message_;
   StateHandler on_state_;
   bool stopped_ = false;
+  bool log_frames_ = false;  // INSPECT_LOG=debug: one line per accepted frame
   std::string last_error_;
 
   serial::FrameEncoder encoder_;

@@ -82,7 +82,7 @@ class ServerLink {
   uint64_t dropped_ = 0;
   uint64_t generation_ = 0;
   int64_t last_rx_ns_ = 0;
-  static constexpr double kDeadAfterS = 1.0;  // invalidates handlers of an old connection
+  static constexpr double kDeadAfterS = 0.8;  // invalidates handlers of an old connection
   std::string last_error_;
 };
 

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
     const std::string world_name = world.name;
     std::unique_ptr<sim::TruthLog> truth;
     if (!opt.truth_path.empty()) truth = std::make_unique<sim::TruthLog>(opt.truth_path);
+    if (truth && !opt.frame_log_path.empty()) truth->openFrameLog(opt.frame_log_path);
     sim::Simulation simulation(robot, std::move(world), opt.seed, truth.get());
     simulation.setPeopleWaitForMotion(opt.people_wait_motion);
     sim::PtyPort port(opt.pty_link);

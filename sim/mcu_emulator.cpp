@@ -118,6 +118,7 @@ serial::SensorFrame McuEmulator::sendSensorFrame(uint64_t now_ms, const McuInput
   const auto enc = encoder_.encode(f);
   tx.insert(tx.end(), enc.bytes.begin(), enc.bytes.begin() + static_cast<std::ptrdiff_t>(enc.size));
   ++frames_sent_;
+  if (observer_) observer_->onFrameSent(simSeconds(now_ms), enc.span(), f.mcu_time_ms);
   return f;
 }
 

@@ -4,6 +4,7 @@
 // the 100 Hz sensor frames. Pure: no I/O, time is an argument (ms of sim time).
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <span>
 #include <vector>
@@ -48,6 +49,11 @@ class McuEmulator {
   /// McuFault bits at the current state (GAS_SENSOR: the last frame had a configured channel with no data).
   uint16_t faults() const;
   bool watchdogTripped() const { return watchdog_tripped_; }
+  /// Sim time (ms) at which the watchdog trips unless a wheel command comes first; empty when tripped.
+  std::optional<uint64_t> watchdogDeadlineMs() const {
+    if (watchdog_tripped_) return std::nullopt;
+    return last_cmd_ms_ + kWatchdog_ms;
+  }
   /// Counters of the host -> MCU decoder (corrupt frames, sequence gaps ...).
   const serial::DecoderCounters& rxCounters() const { return decoder_.counters(); }
   uint64_t framesSent() const { return frames_sent_; }

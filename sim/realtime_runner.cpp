@@ -119,6 +119,11 @@ RunSummary RealtimeRunner::run() {
     // at t is sent by the step from t to t + 1 ms).
     constexpr uint64_t kP = Simulation::kFramePeriod_ms;
     uint64_t wake_ms = (sim_.timeMs() + kP - 1) / kP * kP + Simulation::kStep_ms;
+    // The MCU's watchdog runs every 1 ms step like the firmware's timer
+    // interrupt: wake for the step in which it would trip, so that the motors
+    // stop at that moment of wall time too, not at the next frame.
+    if (const auto wd = sim_.mcu().watchdogDeadlineMs(); wd && *wd >= sim_.timeMs())
+      wake_ms = std::min(wake_ms, *wd + Simulation::kStep_ms);
     if (end_ms) wake_ms = std::min(wake_ms, *end_ms);
     const int64_t wake_ns =
         t0_ns + static_cast<int64_t>(std::ceil(static_cast<double>(wake_ms - start_ms) * 1e6 / rate)) + 1;

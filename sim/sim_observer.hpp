@@ -49,6 +49,8 @@ class SimObserver {
   /// A named event (start, watchdog_trip, watchdog_clear, host_silent, collision, collision_person,
   /// pedestrian_start, pedestrian_end, gas_channels, gas_source, gas_fault_start, gas_fault_end, ptz, stop).
   virtual void onEvent(double /*sim_t_s*/, std::string_view /*event*/, std::string_view /*detail*/) {}
+  /// Every sensor frame the MCU sent: its wire bytes (COBS, with the 0x00 delimiter) and MCU time.
+  virtual void onFrameSent(double /*sim_t_s*/, std::span<const uint8_t> /*wire*/, uint32_t /*mcu_time_ms*/) {}
   /// Each present pedestrian, every 100 ms of sim time.
   virtual void onPedestrian(const PedestrianSample& /*sample*/) {}
   /// The gas channels at the inlet, every 100 ms of sim time (when any channel is configured).

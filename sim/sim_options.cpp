@@ -25,6 +25,8 @@ std::string simUsage() {
          "  --robot FILE     robot config (default: config/robot.yaml, relative to the working directory)\n"
          "  --pty-link PATH  also make PATH a symlink to the serial device (removed on exit)\n"
          "  --truth FILE     write the ground-truth CSV log (docs/simulator.md)\n"
+         "  --frame-log FILE also log every sensor frame sent (id, sequence number, CRC; needs --truth),\n"
+         "                   to check what a receiver accepted against what was sent (docs/failsafes.md)\n"
          "  --rate F         run F times faster than real time, F in [0.1, 100] (default 1)\n"
          "  --duration S     stop after S seconds of simulated time, S in (0, 1e6] (default: until SIGINT/SIGTERM)\n"
          "  --seed N         seed of the sensor noise, integer >= 0 (default 1)\n"
@@ -64,6 +66,9 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     } else if (flag == "--truth") {
       o.truth_path = value();
       if (o.truth_path.empty()) throw UsageError("--truth: empty path");
+    } else if (flag == "--frame-log") {
+      o.frame_log_path = value();
+      if (o.frame_log_path.empty()) throw UsageError("--frame-log: empty path");
     } else if (flag == "--people-wait-motion") {
       o.people_wait_motion = true;
     } else if (flag == "--rate") {
@@ -85,6 +90,7 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     }
   }
   if (!o.help && (!have_world || o.world_path.empty())) throw UsageError("--world: required");
+  if (!o.help && !o.frame_log_path.empty() && o.truth_path.empty()) throw UsageError("--frame-log: needs --truth");
   return o;
 }
 

@@ -20,6 +20,7 @@ struct SimOptions {
   std::string robot_path = "config/robot.yaml";
   std::string pty_link;              // empty: no symlink
   std::string truth_path;            // empty: no truth log
+  std::string frame_log_path;        // empty: no log of the sensor frames sent (needs truth_path)
   double rate = 1.0;                 // sim seconds per wall second, [0.1, 100]
   std::optional<double> duration_s;  // sim seconds; empty: until SIGINT/SIGTERM
   uint64_t seed = 1;

@@ -1,11 +1,13 @@
 #include "sim/truth_log.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 
+#include "shared/serial/cobs.hpp"
 #include "shared/util/clock.hpp"
 
 namespace inspect::sim {
@@ -23,6 +25,29 @@ TruthLog::TruthLog(const std::string& path) : file_(std::fopen(path.c_str(), "w"
 
 TruthLog::~TruthLog() {
   if (file_) std::fclose(file_);
+  if (frames_) std::fclose(frames_);
+}
+
+void TruthLog::openFrameLog(const std::string& path) {
+  if (frames_) std::fclose(frames_);
+  frames_ = std::fopen(path.c_str(), "w");
+  if (!frames_) throw std::runtime_error("--frame-log " + path + ": cannot open for writing: " + std::strerror(errno));
+  std::fputs("# mcu_sim sensor frames sent; format: docs/failsafes.md\n"
+             "# F,mono_ns,sim_t_s,msg_id,seq,crc16,mcu_time_ms\n",
+             frames_);
+  std::fflush(frames_);
+}
+
+void TruthLog::onFrameSent(double sim_t_s, std::span<const uint8_t> wire, uint32_t mcu_time_ms) {
+  if (!frames_ || wire.size() < 2) return;
+  // The wire CRC as sent: undo COBS (without the delimiter); the frame ends with the CRC, little-endian.
+  std::array<uint8_t, serial::kMaxRawFrame> raw{};
+  const auto n = serial::cobsDecode(wire.first(wire.size() - 1), raw);
+  if (!n || *n < 4) return;
+  const unsigned crc = raw[*n - 2] | (static_cast<unsigned>(raw[*n - 1]) << 8);
+  std::fprintf(frames_, "F,%lld,%.3f,%u,%u,%u,%u\n", static_cast<long long>(monoNowNs()), sim_t_s,
+               static_cast<unsigned>(raw[0]), static_cast<unsigned>(raw[1]), crc, static_cast<unsigned>(mcu_time_ms));
+  // Buffered (unlike the truth lines): 100 lines a second, read once mcu_sim has exited.
 }
 
 void TruthLog::line(const char* text, int n) {

@@ -4,6 +4,7 @@
 // '#' comments; every line flushed at once because tests read the file while the
 // simulator runs. Format: docs/simulator.md.
 #include <cstdio>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -24,12 +25,16 @@ class TruthLog : public SimObserver {
   void onEvent(double sim_t_s, std::string_view event, std::string_view detail) override;
   void onPedestrian(const PedestrianSample& s) override;
   void onGas(const GasSample& s) override;
+  void onFrameSent(double sim_t_s, std::span<const uint8_t> wire, uint32_t mcu_time_ms) override;
+  /// Also writes every sensor frame sent to `path` (F rows, docs/failsafes.md); throws like the constructor.
+  void openFrameLog(const std::string& path);
   /// Writes "# <text>".
   void comment(std::string_view text);
 
  private:
   void line(const char* text, int n);
   std::FILE* file_ = nullptr;
+  std::FILE* frames_ = nullptr;
 };
 
 }  // namespace inspect::sim

@@ -429,7 +429,7 @@ TEST_F(LinkServerTest, StopClosesAllSessions) {
 
 namespace inspect::test {
 
-TEST_F(ServerFixture, StaleTelemetryOfAMovingRobotSendsOneStop) {
+TEST_F(ServerFixture, StaleTelemetryOfAMovingRobotSendsOneEStop) {
   auto config = testConfig();
   config.telemetry_stale_s = 0.3;
   startServer(config);
@@ -440,7 +440,7 @@ TEST_F(ServerFixture, StaleTelemetryOfAMovingRobotSendsOneStop) {
   ASSERT_TRUE(eventually([&] { return snap("robot1") && snap("robot1")->telemetry_count > 5; }));
   const auto stops = [&] {
     int n = 0;
-    for (const auto& m : r.received()) n += m.env.has_command() && m.env.command().has_stop();
+    for (const auto& m : r.received()) n += m.env.has_command() && m.env.command().has_estop();
     return n;
   };
   std::this_thread::sleep_for(400ms);

@@ -1,8 +1,10 @@
 // serial_relay: sits on the serial line between mcu_sim and robot_client and
 // damages it on purpose: random bit errors at a given bit error rate and
-// bursts of random garbage bytes, in either direction. For tests only.
+// bursts of random garbage bytes, in either direction, and cuts one or both
+// directions on command (--control). For tests only.
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -15,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "shared/util/clock.hpp"
 #include "sim/pty_port.hpp"
 
 namespace {
@@ -31,6 +34,10 @@ options:
   --ber-down X        bit error rate towards robot_client (default 0)
   --garbage-per-s N   bursts of 1-24 random bytes per second, each direction (default 0)
   --seed N            random seed (default 1)
+  --control FIFO      read commands from FIFO (made if missing), one per line:
+                        stall up|down|both   cut that direction: bytes read from it are dropped
+                        flow                 both directions pass again
+                      each applied command is printed: "serial_relay: <command> at mono_ns=<ns>"
   --help
 )";
 
@@ -38,7 +45,8 @@ struct Direction {
   const char* name;
   int idx;  // 0 = down (to robot_client), 1 = up (to the MCU)
   double ber = 0.0;
-  uint64_t bytes = 0, flipped_bits = 0, garbage_bytes = 0, dropped = 0;
+  bool stalled = false;
+  uint64_t bytes = 0, flipped_bits = 0, garbage_bytes = 0, dropped = 0, cut = 0;
 };
 
 class Damage {
@@ -87,10 +95,33 @@ double number(const char* s, const std::string& flag) {
   return v;
 }
 
+// Applies the complete lines of `buf` (commands from --control); keeps a partial last line.
+void controlCommands(std::string& buf, Direction& up, Direction& down) {
+  for (auto nl = buf.find('\n'); nl != std::string::npos; nl = buf.find('\n')) {
+    std::string cmd = buf.substr(0, nl);
+    buf.erase(0, nl + 1);
+    while (!cmd.empty() && (cmd.back() == '\r' || cmd.back() == ' ')) cmd.pop_back();
+    if (cmd == "stall up") {
+      up.stalled = true;
+    } else if (cmd == "stall down") {
+      down.stalled = true;
+    } else if (cmd == "stall both") {
+      up.stalled = down.stalled = true;
+    } else if (cmd == "flow") {
+      up.stalled = down.stalled = false;
+    } else {
+      std::fprintf(stderr, "serial_relay: unknown control command '%s'\n", cmd.c_str());
+      continue;
+    }
+    std::printf("serial_relay: %s at mono_ns=%lld\n", cmd.c_str(), static_cast<long long>(inspect::monoNowNs()));
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string mcu_path, link_path;
+  std::string mcu_path, link_path, control_path;
   Direction up{"up", 1}, down{"down", 0};
   double garbage_per_s = 0;
   unsigned seed = 1;
@@ -113,6 +144,8 @@ int main(int argc, char** argv) {
       down.ber = number(value(), a);
     } else if (a == "--garbage-per-s") {
       garbage_per_s = number(value(), a);
+    } else if (a == "--control") {
+      control_path = value();
     } else if (a == "--seed") {
       seed = static_cast<unsigned>(number(value(), a));
     } else {
@@ -133,6 +166,16 @@ int main(int argc, char** argv) {
   std::printf("serial_relay: serial device %s\n", host.slavePath().c_str());
   std::fflush(stdout);
 
+  int control = -1;
+  if (!control_path.empty()) {
+    if (::mkfifo(control_path.c_str(), 0600) != 0 && errno != EEXIST)
+      die("--control: cannot make " + control_path + ": " + std::strerror(errno));
+    // O_RDWR: the FIFO never reports end of file when a writer closes it.
+    control = ::open(control_path.c_str(), O_RDWR | O_NONBLOCK);
+    if (control < 0) die("--control: cannot open " + control_path + ": " + std::strerror(errno));
+  }
+  std::string control_buf;
+
   std::signal(SIGINT, [](int) { g_stop = 1; });
   std::signal(SIGTERM, [](int) { g_stop = 1; });
 
@@ -142,8 +185,17 @@ int main(int argc, char** argv) {
   std::vector<uint8_t> chunk;
   const double poll_s = 0.005;
   while (!g_stop) {
-    pollfd fds[2] = {{mcu, POLLIN, 0}, {host.fd(), POLLIN, 0}};
-    ::poll(fds, 2, static_cast<int>(poll_s * 1000));
+    pollfd fds[3] = {{mcu, POLLIN, 0}, {host.fd(), POLLIN, 0}, {control, POLLIN, 0}};
+    ::poll(fds, control >= 0 ? 3 : 2, static_cast<int>(poll_s * 1000));
+    if (control >= 0 && (fds[2].revents & POLLIN)) {
+      char cbuf[256];
+      for (;;) {
+        const ssize_t n = ::read(control, cbuf, sizeof cbuf);
+        if (n <= 0) break;
+        control_buf.append(cbuf, static_cast<std::size_t>(n));
+      }
+      controlCommands(control_buf, up, down);
+    }
     // MCU -> robot_client.
     chunk.clear();
     for (;;) {
@@ -151,7 +203,11 @@ int main(int argc, char** argv) {
       if (n <= 0) break;
       chunk.insert(chunk.end(), buf.begin(), buf.begin() + n);
     }
-    if (garbage_per_s > 0 && dmg.chance(garbage_per_s * poll_s)) dmg.garbage(chunk, down);
+    if (down.stalled) {
+      down.cut += chunk.size();
+      chunk.clear();
+    }
+    if (garbage_per_s > 0 && !down.stalled && dmg.chance(garbage_per_s * poll_s)) dmg.garbage(chunk, down);
     if (!chunk.empty()) {
       dmg.corrupt(chunk, down);
       const std::size_t w = host.write(chunk);
@@ -164,7 +220,11 @@ int main(int argc, char** argv) {
       if (n == 0) break;
       chunk.insert(chunk.end(), buf.begin(), buf.begin() + static_cast<long>(n));
     }
-    if (garbage_per_s > 0 && dmg.chance(garbage_per_s * poll_s)) dmg.garbage(chunk, up);
+    if (up.stalled) {
+      up.cut += chunk.size();
+      chunk.clear();
+    }
+    if (garbage_per_s > 0 && !up.stalled && dmg.chance(garbage_per_s * poll_s)) dmg.garbage(chunk, up);
     if (!chunk.empty()) {
       dmg.corrupt(chunk, up);
       const ssize_t w = ::write(mcu, chunk.data(), chunk.size());
@@ -172,10 +232,13 @@ int main(int argc, char** argv) {
     }
   }
   for (const Direction* d : {&down, &up})
-    std::printf("serial_relay %-4s: %llu bytes, %llu bits flipped (BER %.2g), %llu garbage bytes, %llu dropped\n",
+    std::printf("serial_relay %-4s: %llu bytes, %llu bits flipped (BER %.2g), %llu garbage bytes, %llu dropped, "
+                "%llu cut\n",
                 d->name, static_cast<unsigned long long>(d->bytes), static_cast<unsigned long long>(d->flipped_bits),
                 d->bytes ? static_cast<double>(d->flipped_bits) / (8.0 * static_cast<double>(d->bytes)) : 0.0,
-                static_cast<unsigned long long>(d->garbage_bytes), static_cast<unsigned long long>(d->dropped));
+                static_cast<unsigned long long>(d->garbage_bytes), static_cast<unsigned long long>(d->dropped),
+                static_cast<unsigned long long>(d->cut));
   ::close(mcu);
+  if (control >= 0) ::close(control);
   return 0;
 }
