@@ -90,7 +90,9 @@ TEST(ServerConfig, EmptyFileGivesDefaults) {
   const auto c = loadServerConfig(config::ConfigNode::loadString("", "server.yaml"));
   EXPECT_EQ(c.bind_address, "0.0.0.0");
   EXPECT_EQ(c.port, 7600);
-  EXPECT_DOUBLE_EQ(c.heartbeat_period_s, 0.1);
+  EXPECT_DOUBLE_EQ(c.heartbeat_period_s, 0.05);
+  EXPECT_DOUBLE_EQ(c.telemetry_stale_s, 0.25);
+  EXPECT_EQ(c.operator_socket, "");
   EXPECT_DOUBLE_EQ(c.session_timeout_s, 1.0);
   EXPECT_DOUBLE_EQ(c.handshake_timeout_s, 5.0);
   EXPECT_DOUBLE_EQ(c.teleop_resend_hz, 20.0);

@@ -21,7 +21,7 @@ std::string errorOf(const std::string& yaml) {
 TEST(ClientConfig, ShippedFileLoads) {
   const auto c = client::loadClientConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/client.yaml");
   EXPECT_EQ(c.server_port, 7600);
-  EXPECT_DOUBLE_EQ(c.safety.link_timeout_s, 0.3);
+  EXPECT_DOUBLE_EQ(c.safety.link_timeout_s, 0.25);  // docs/failsafes.md
   EXPECT_EQ(c.baud, 115200);
 }
 
