@@ -359,7 +359,10 @@ std::vector<AlarmSpan> alarmSpans(const RunReportInput& in, const Frame& f) {
     if (!g.has_pose()) return;
     std::tie(a.x, a.y) = f.point(g.pose().x_m(), g.pose().y_m());
   };
-  for (const auto& [t, g] : in.gas_alarms) {
+  for (const auto& tg : in.gas_alarms) {
+    // Not a structured binding: clang 14 cannot capture one in the lambda below.
+    const auto& t = tg.first;
+    const auto& g = tg.second;
     if (g.active()) {
       AlarmSpan a;
       a.raise = g;

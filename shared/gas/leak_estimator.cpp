@@ -262,7 +262,8 @@ class SearchArea {
     const std::size_t n = std::min<std::size_t>(12, near_.size());
     std::partial_sort(near_.begin(), near_.begin() + static_cast<std::ptrdiff_t>(n), near_.end());
     for (std::size_t i = 0; i < n; ++i) {
-      const auto [px, py] = near_[i].second;
+      // Not a structured binding: clang 14 cannot capture one in the lambda below.
+      const double px = near_[i].second.first, py = near_[i].second.second;
       if (std::none_of(walls_.begin(), walls_.end(), [&](const WallSegment& w) { return segmentsCross(x, y, px, py, w); }))
         return true;
     }

@@ -266,7 +266,8 @@ void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) 
     }
   }
   uint64_t capture_server_us = 0;
-  if (f.capture_us) capture_server_us = static_cast<uint64_t>(static_cast<int64_t>(*f.capture_us) + s.offset_us);
+  // Unsigned: a capture time from the wire may be anything; it wraps instead of overflowing.
+  if (f.capture_us) capture_server_us = *f.capture_us + static_cast<uint64_t>(s.offset_us);
   if (access_unit_hook_) access_unit_hook_(name, f, capture_server_us);
   if (!s.decoder) return;
   // After a loss the picture stays frozen until a keyframe: P frames that

@@ -678,6 +678,47 @@ TEST(VideoStreamBadInput, GarbageAndForeignPacketsAreCountedExactlyAndIgnored) {
   EXPECT_EQ(s.stream.packets, s.sender.packets) << "a foreign datagram entered the stream, or one of ours was lost";
 }
 
+// A capture time at the end of the clock (a damaged or forged header
+// extension) plus the stream's clock offset wraps instead of overflowing a
+// signed integer (undefined behaviour, caught by the sanitizer build's
+// UBSan; found while writing tests/fuzz/fuzz_rtp_h264).
+TEST(VideoStreamBadInput, CaptureTimeAtTheEndOfTheClockWrapsWithTheOffset) {
+  ReceiverSettings rs;
+  rs.bind = "127.0.0.1";
+  rs.port = 0;
+  rs.decode = false;
+  VideoReceiver rx(rs);
+  constexpr uint32_t kSsrc = 0x00C0FFEE;
+  constexpr int64_t kOffset = 5'000'000;
+  constexpr uint64_t kCapture = 0x7FFF'FFFF'FFFF'FFFFull;
+  rx.setStream(kStream, kSsrc, boost::asio::ip::make_address("127.0.0.1"), kOffset);
+  std::mutex mu;
+  std::vector<uint64_t> captures;
+  rx.setAccessUnitHook([&](const std::string&, const Frame&, uint64_t capture_us) {
+    std::lock_guard lk(mu);
+    captures.push_back(capture_us);
+  });
+  rx.start();
+  const RawSender tx("127.0.0.1", rx.port());
+  ASSERT_GE(tx.fd, 0);
+  H264Packetizer pk(kSsrc, 1200);
+  std::vector<std::vector<uint8_t>> packets;
+  const uint8_t access_unit_delimiter[] = {0, 0, 0, 1, 0x09, 0xF0};
+  pk.packetize(access_unit_delimiter, 0, kCapture, packets);
+  ASSERT_EQ(packets.size(), 1u);
+  tx.send(packets[0]);
+  EXPECT_TRUE(waitUntil(
+      [&] {
+        std::lock_guard lk(mu);
+        return !captures.empty();
+      },
+      3.0));
+  rx.stop();
+  std::lock_guard lk(mu);
+  ASSERT_EQ(captures.size(), 1u);
+  EXPECT_EQ(captures[0], kCapture + static_cast<uint64_t>(kOffset));
+}
+
 TEST(VideoStreamSettings, SizeChangeMidStreamIsFollowedAndBadValuesRefused) {
   StreamRig rig(vgaOptions());
   rig.start();
