@@ -232,9 +232,14 @@ double GasModel::mass(int f) const {
   return sum * h_ * h_;
 }
 
-int GasModel::substeps(double dt_s) const {
+std::int64_t GasModel::substeps(double dt_s) const {
   if (!(dt_s > 0.0) || nx_ == 0) return 0;
-  return std::max(1, static_cast<int>(std::ceil(dt_s / (kStabilityFactor * max_step_s_) - 1e-9)));
+  // In double first: a long jump (advanceTo over 1e8 s of a steady field) needs
+  // more sub-steps than an int holds, and the cast of an out-of-range double is undefined.
+  const double n = std::ceil(dt_s / (kStabilityFactor * max_step_s_) - 1e-9);
+  constexpr double kMax = 0x1p62;  // exactly representable; far beyond any run's sim time
+  if (!(n < kMax)) return static_cast<std::int64_t>(kMax);
+  return std::max<std::int64_t>(1, static_cast<std::int64_t>(n));
 }
 
 void GasModel::step(std::vector<double>& c, const std::vector<Emitter>& emitters, double t_s, double dt_s, bool emit) {
@@ -268,8 +273,8 @@ bool GasModel::steady(int f) const {
 void GasModel::advanceTo(double t_s) {
   const double dt_s = t_s - t_s_;
   if (!(dt_s > 0.0)) return;
-  const int n = substeps(dt_s);
-  const double dts = n > 0 ? dt_s / n : 0.0;
+  const std::int64_t n = substeps(dt_s);
+  const double dts = n > 0 ? dt_s / static_cast<double>(n) : 0.0;
   for (auto& f : fields_) {
     if (f.steady) {
       // A leak starting or stopping within this interval (generously) ends the steady state.
@@ -279,20 +284,20 @@ void GasModel::advanceTo(double t_s) {
       }
       if (f.steady) continue;
     }
-    for (int k = 0; k < n; ++k) step(f.c, f.emitters, t_s_ + k * dts, dts, true);
+    for (std::int64_t k = 0; k < n; ++k) step(f.c, f.emitters, t_s_ + static_cast<double>(k) * dts, dts, true);
   }
   t_s_ = t_s;
 }
 
 void GasModel::integrate(std::vector<double>& c, const Emitter& e, double duration_s, bool emit) {
-  const int n = substeps(duration_s);
+  const std::int64_t n = substeps(duration_s);
   if (n == 0) return;
   Emitter always = e;  // on for the whole interval
   always.source.start_s = -std::numeric_limits<double>::infinity();
   always.source.end_s = std::numeric_limits<double>::infinity();
   const std::vector<Emitter> one{always};
-  const double dts = duration_s / n;
-  for (int k = 0; k < n; ++k) step(c, one, 0.0, dts, emit);
+  const double dts = duration_s / static_cast<double>(n);
+  for (std::int64_t k = 0; k < n; ++k) step(c, one, 0.0, dts, emit);
 }
 
 bool GasModel::solveSteady(std::vector<double>& c, const Emitter& e) const {

@@ -73,8 +73,9 @@ class GasModel {
   bool solid(int i, int j) const { return solid_[index(i, j)] != 0; }
   /// Largest stable explicit step, s (infinity without a grid).
   double maxStableStepS() const { return max_step_s_; }
-  /// Sub-steps an advance by dt_s takes.
-  int substeps(double dt_s) const;
+  /// Sub-steps an advance by dt_s takes (64-bit: a jump of years of sim time
+  /// at a millisecond step does not fit an int; capped at 2^62).
+  std::int64_t substeps(double dt_s) const;
 
  private:
   // A leak as the grid sees it: its rate spread over up to four cells.

@@ -8,9 +8,11 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -180,6 +182,24 @@ TEST(GasModel, SteadyFieldsAreLeftAloneUntilALeakStartsOrStops) {
   EXPECT_TRUE(stepped.steady(0));
   stepped.advanceTo(1e8 + 0.05);
   EXPECT_FALSE(stepped.steady(0));
+}
+
+TEST(GasModel, SubstepCountHoldsLongJumps) {
+  const GasModel g(worldOf(room(3.0, "  sources: [{gas: CH4, x_m: 0.0, y_m: 0.0, rate: 1, start_s: 0}]\n")));
+  const double step = GasModel::kStabilityFactor * g.maxStableStepS();
+  EXPECT_EQ(g.substeps(0.0), 0);
+  EXPECT_EQ(g.substeps(-1.0), 0);
+  EXPECT_EQ(g.substeps(std::nan("")), 0);
+  EXPECT_EQ(g.substeps(0.5 * step), 1);
+  EXPECT_EQ(g.substeps(step), 1);
+  EXPECT_EQ(g.substeps(3.5 * step), 4);
+  // 1e8 s is more sub-steps than an int holds: counted exactly, not wrapped.
+  const std::int64_t n = g.substeps(1e8);
+  EXPECT_GT(n, std::int64_t{std::numeric_limits<int>::max()});
+  EXPECT_NEAR(static_cast<double>(n), 1e8 / step, 1.0);
+  // Beyond any sim time a run can reach: capped, still positive.
+  EXPECT_EQ(g.substeps(1e300), std::int64_t{1} << 62);
+  EXPECT_EQ(g.substeps(std::numeric_limits<double>::infinity()), std::int64_t{1} << 62);
 }
 
 TEST(GasModel, WallBlocksGas) {
@@ -679,9 +699,9 @@ TEST(GasLab, GasUpdateCost) {
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 1; i <= n; ++i) moving.advanceTo(i * (Simulation::kGasPeriod_ms / 1000.0));
   const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() / n;
-  std::printf("GAS gas_lab: one 50 ms update (%zu fields stepped, %d x %d cells, %d sub-steps) takes %.1f us = %.2f %% "
+  std::printf("GAS gas_lab: one 50 ms update (%zu fields stepped, %d x %d cells, %lld sub-steps) takes %.1f us = %.2f %% "
               "of real time; pre-integrating 60 s took %.1f ms\n",
-              moving.gases().size(), moving.nx(), moving.ny(), moving.substeps(0.05), us, us / 50000.0 * 100.0,
+              moving.gases().size(), moving.nx(), moving.ny(), static_cast<long long>(moving.substeps(0.05)), us, us / 50000.0 * 100.0,
               young_ms);
   EXPECT_LT(us, 5000.0);  // even on a loaded machine: < 10 % of real time
 
