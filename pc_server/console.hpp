@@ -72,6 +72,10 @@ class Console {
     session_ = session;
   }
   uint64_t session() const { return session_; }
+  /// Starts this console's event feed at the newest event: a session that
+  /// attaches mid-run does not replay the registry's buffer (up to
+  /// kMaxPendingEvents old events); `alarms` shows what is in force.
+  void eventsFromNow() { event_cursor_ = registry_.eventCursor(); }
 
   bool quitRequested() const { return quit_; }
   const std::string& selected() const { return selected_; }

@@ -40,10 +40,27 @@ LineReader::Result LineReader::readChunk(std::string& bytes, int timeout_ms) {
 
 LineReader::Result LineReader::nextLine(std::string& line, int timeout_ms) {
   for (;;) {
-    if (const auto nl = buf_.find('\n'); nl != std::string::npos) {
+    const auto nl = buf_.find('\n');
+    if (skipping_) {
+      if (nl == std::string::npos) {
+        buf_.clear();
+      } else {
+        buf_.erase(0, nl + 1);
+        skipping_ = false;
+        continue;
+      }
+    } else if (nl != std::string::npos) {
+      if (max_line_ > 0 && nl > max_line_) {
+        buf_.erase(0, nl + 1);
+        return Result::kTooLong;
+      }
       line = buf_.substr(0, nl);
       buf_.erase(0, nl + 1);
       return Result::kData;
+    } else if (max_line_ > 0 && buf_.size() > max_line_) {
+      buf_.clear();
+      skipping_ = true;
+      return Result::kTooLong;
     }
     if (eof_) {
       if (buf_.empty()) return Result::kEof;

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <streambuf>
 
+#include "pc_server/line_reader.hpp"
 #include "pc_server/startup_error.hpp"
 #include "shared/util/log.hpp"
 
@@ -181,44 +182,29 @@ void OperatorSocket::runSession(Session& s) {
   {
     Console console(registry_, sink_, out, s.stop, options_);
     console.setSession(&control_, id);
+    console.eventsFromNow();
     if (configure_) configure_(console);
     out << "pc_server operator session: " << name
         << ". 'help' lists the commands, 'control' shows who controls each robot, 'quit' detaches.\n";
     out.flush();
-    std::string pending;
+    LineReader reader(s.fd, s.stop, kMaxLine);
     int line_no = 0;
-    bool skipping = false;  // inside a line longer than kMaxLine
-    char chunk[1024];
-    while (!s.stop.requested() && !console.quitRequested()) {
-      pollfd p{s.fd, POLLIN, 0};
-      const int r = ::poll(&p, 1, 100);
-      if (r < 0 && errno != EINTR) break;
-      if (r <= 0) {
-        console.pump();
+    while (!console.quitRequested()) {
+      std::string line;
+      const auto r = reader.nextLine(line, 100);
+      if (r == LineReader::Result::kStopped || r == LineReader::Result::kEof) break;  // EOF: the operator left
+      if (r == LineReader::Result::kTimeout) {
+        console.pump();  // events and notes keep printing while the operator is quiet
         continue;
       }
-      const ssize_t n = ::recv(s.fd, chunk, sizeof chunk, 0);
-      if (n <= 0) break;  // the operator left (EOF after their last line)
-      for (ssize_t i = 0; i < n; ++i) {
-        const char c = chunk[i];
-        if (c != '\n') {
-          if (!skipping && pending.size() < kMaxLine) pending += c;
-          else if (!skipping) {
-            skipping = true;
-            out << "error: line longer than " << kMaxLine << " characters ignored\n";
-          }
-          continue;
-        }
-        ++line_no;
-        if (!skipping) {
-          if (!pending.empty() && pending.back() == '\r') pending.pop_back();
-          console.execute(pending, line_no);
-          out.flush();
-          if (console.quitRequested() || s.stop.requested()) break;
-        }
-        pending.clear();
-        skipping = false;
+      ++line_no;
+      if (r == LineReader::Result::kTooLong) {
+        out << "error: line longer than " << kMaxLine << " characters ignored\n";
+      } else {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        console.execute(line, line_no);
       }
+      out.flush();
       console.pump();
     }
     out.flush();

@@ -274,15 +274,9 @@ void RobotRegistry::pushEventLocked(const std::string& id, const v1::Event& ev) 
 }
 
 std::vector<PendingEvent> RobotRegistry::takeEvents() {
-  uint64_t cursor;
-  {
-    std::lock_guard lk(mu_);
-    cursor = take_cursor_;
-  }
-  uint64_t missed = 0;
-  auto out = eventsSince(cursor, &missed);
   std::lock_guard lk(mu_);
-  take_cursor_ = cursor;
+  uint64_t missed = 0;
+  auto out = eventsSinceLocked(take_cursor_, &missed);
   dropped_events_ += missed;
   return out;
 }
@@ -299,6 +293,10 @@ uint64_t RobotRegistry::eventCursor() const {
 
 std::vector<PendingEvent> RobotRegistry::eventsSince(uint64_t& cursor, uint64_t* missed) const {
   std::lock_guard lk(mu_);
+  return eventsSinceLocked(cursor, missed);
+}
+
+std::vector<PendingEvent> RobotRegistry::eventsSinceLocked(uint64_t& cursor, uint64_t* missed) const {
   if (missed) *missed = cursor < first_event_ ? first_event_ - cursor : 0;
   const uint64_t end = first_event_ + pending_.size();
   std::vector<PendingEvent> out;

@@ -143,6 +143,7 @@ class RobotRegistry {
   uint64_t first_event_ = 0;
   uint64_t take_cursor_ = 0;
   void pushEventLocked(const std::string& id, const v1::Event& ev);
+  std::vector<PendingEvent> eventsSinceLocked(uint64_t& cursor, uint64_t* missed) const;
   /// Applies a robot's alarm transition (or telemetry resync) to the book; mu_ held.
   void noteAlarmLocked(const std::string& id, const v1::GasAlarm& a, int64_t now_ns);
   std::deque<AlarmRecord> alarms_;

@@ -106,7 +106,7 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   Clock::time_point last_rx_;
   Clock::time_point last_telemetry_;
   bool robot_moving_ = false;    // its last telemetry: a moving mode or a non-zero command
-  bool stale_stopped_ = false;   // a Stop went out for the current telemetry gap
+  bool stale_stopped_ = false;   // an EStop went out for the current telemetry gap
 
   bool teleop_active_ = false;
   double teleop_v_m_s_ = 0;

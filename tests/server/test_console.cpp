@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include <stdlib.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -16,6 +17,7 @@
 #include <limits>
 
 #include "pc_server/console.hpp"
+#include "pc_server/line_reader.hpp"
 #include "pc_server/route_file.hpp"
 #include "pc_server/status_line.hpp"
 #include "shared/util/clock.hpp"
@@ -756,4 +758,25 @@ TEST_F(ConsoleTest, StatusLineNamesGasChannelsAndShowsAlarms) {
   EXPECT_NE(s.find("| gas CH4 25 H2S -- |"), std::string::npos) << s;
   EXPECT_NE(s.find("| ALARM CH4 HIGH 25 %LEL | SENSOR FAULT H2S no_data"), std::string::npos) << s;
   EXPECT_TRUE(statusIsAlarm(registry_.snapshot("robot1", monoNowNs())));
+}
+
+TEST(LineReader, ALineOverTheLimitIsDroppedAndReportedOnce) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const std::string in = "ok\n" + std::string(5000, 'a') + "\nnext\r\n" + std::string(10, 'b') + "\nlast";
+  ASSERT_EQ(::write(fds[1], in.data(), in.size()), static_cast<ssize_t>(in.size()));
+  ::close(fds[1]);
+  StopFlag stop;
+  LineReader reader(fds[0], stop, 8);
+  std::string line;
+  ASSERT_EQ(reader.nextLine(line, 1000), LineReader::Result::kData);
+  EXPECT_EQ(line, "ok");
+  EXPECT_EQ(reader.nextLine(line, 1000), LineReader::Result::kTooLong);  // 5000 bytes read in pieces: one report
+  ASSERT_EQ(reader.nextLine(line, 1000), LineReader::Result::kData);
+  EXPECT_EQ(line, "next\r");
+  EXPECT_EQ(reader.nextLine(line, 1000), LineReader::Result::kTooLong);  // whole in the buffer, 10 > 8
+  ASSERT_EQ(reader.nextLine(line, 1000), LineReader::Result::kData);
+  EXPECT_EQ(line, "last");
+  EXPECT_EQ(reader.nextLine(line, 1000), LineReader::Result::kEof);
+  ::close(fds[0]);
 }

@@ -109,6 +109,22 @@ TEST_F(ControlTest, ObserversSeeEveryEvent) {
   ASSERT_TRUE(eventually([&] { return !registry_.events("robot1").empty(); }));
   EXPECT_NE(alice_.console->background().find("mode TELEOP -> IDLE"), std::string::npos);
   EXPECT_NE(bob_.console->background().find("mode TELEOP -> IDLE"), std::string::npos);
+
+  // A session that attaches later starts at the newest event: no replay of the buffer.
+  Session carol;
+  carol.console = std::make_unique<server::Console>(registry_, *link_, carol.out, carol.stop, server::Console::Options{});
+  carol.console->setSession(&control_, control_.openSession("carol"));
+  carol.console->eventsFromNow();
+  EXPECT_EQ(carol.console->background().find("mode TELEOP -> IDLE"), std::string::npos);
+  e.mutable_event()->set_text("mode IDLE -> TELEOP");
+  ASSERT_TRUE(robot_.send(e));
+  ASSERT_TRUE(eventually([&] {
+    const auto ev = registry_.events("robot1");
+    return !ev.empty() && ev.back().text() == "mode IDLE -> TELEOP";
+  }));
+  const auto late = carol.console->background();
+  EXPECT_NE(late.find("mode IDLE -> TELEOP"), std::string::npos) << late;
+  EXPECT_EQ(late.find("mode TELEOP -> IDLE"), std::string::npos) << late;
 }
 
 TEST_F(ControlTest, TakeForceStopsTheRobotAndTellsTheOldHolder) {

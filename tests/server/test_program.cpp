@@ -295,7 +295,7 @@ TEST(Program, AttachedOperatorObservesAndIsRefusedMotionWhileTheConsoleControls)
   const auto deadline = Clock::now() + 5s;
   while (!driving() && Clock::now() < deadline) std::this_thread::sleep_for(20ms);
   ASSERT_TRUE(driving());
-  const auto input = p.file("attach_in.txt", "control\ndrive 0.1 0\nstatus\nstop\nquit\n");
+  const auto input = p.file("attach_in.txt", "control\ndrive 0.1 0\n" + std::string(5000, 'x') + "\nstatus\nstop\nquit\n");
   const std::string cmd =
       "timeout 10 " + kBinary + " --attach " + sock.string() + " < " + input.string() + " 2>&1";
   std::string attached;
@@ -310,6 +310,7 @@ TEST(Program, AttachedOperatorObservesAndIsRefusedMotionWhileTheConsoleControls)
   EXPECT_HAS(attached, "robot1: drive refused: robot1 is controlled by ");
   EXPECT_HAS(attached, "robot1 |");  // the observer sees the status line
   EXPECT_HAS(attached, "robot1: stop accepted");  // and may stop it
+  EXPECT_HAS(attached, "error: line longer than 4096 characters ignored");  // and the lines after it still run
   for (const auto& m : r.received())
     EXPECT_FALSE(m.env.has_command() && m.env.command().has_teleop() && m.env.command().teleop().v_m_s() == 0.1);
   EXPECT_EQ(p.wait(), 0) << p.out() << p.err();
