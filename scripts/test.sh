@@ -10,6 +10,27 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# After both stages: the tests that failed in build dir $1 and the last lines
+# of each one's output, so that the end of the log (all a CI viewer may keep)
+# names what failed and why. ctest's own --output-on-failure output stays where
+# it happened.
+report_failures() {
+  local dir=$1 stage=$2 failed="$1/Testing/Temporary/LastTestsFailed.log"
+  [ -s "$failed" ] || return 0
+  echo "test: stage $stage failed tests: $(cut -d: -f2- "$failed" | paste -sd' ')"
+  cut -d: -f2- "$failed" | head -n 5 | while IFS= read -r name; do
+    echo "test: --- last lines of $name (stage $stage) ---"
+    awk -v name="$name" '
+      $0 ~ "^[0-9]+/[0-9]+ Test: " && substr($0, index($0, "Test: ") + 6) == name { on = 1; n = 0; next }
+      on && /^<end of output>$/ { on = 0; next }
+      on && /^(Running main|Note: Google Test filter|\[(==========|----------|  PASSED  )\]|$)/ { next }
+      on { buf[n++ % 25] = $0 }
+      END { for (i = (n > 25 ? n - 25 : 0); i < n; ++i) print "  " buf[i % 25] }
+    ' "$1/Testing/Temporary/LastTest.log" || true
+  done
+  return 0
+}
+
 # --- stage 1: the normal build (g++) and the whole suite ---------------------
 start=$(date +%s)
 bash scripts/setup.sh
@@ -17,6 +38,7 @@ bash scripts/build.sh
 built=$(date +%s)
 echo "test: build took $((built - start)) s"
 stage1=0
+rm -f "${BUILD_DIR:-build}/Testing/Temporary/LastTestsFailed.log"
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j "$(nproc)" "$@") || stage1=$?
 done1=$(date +%s)
 echo "test: suite took $((done1 - built)) s"
@@ -41,6 +63,7 @@ else
   echo "test: sanitizer build took $((built2 - done1)) s"
   if [ $stage2 -eq 0 ]; then
     export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
+    rm -f "$ASAN_DIR/Testing/Temporary/LastTestsFailed.log"
     (cd "$ASAN_DIR" && ctest --output-on-failure -j "$(nproc)" -L '^(fuzz|sanitize)$') || stage2=$?
   fi
   done2=$(date +%s)
@@ -49,6 +72,8 @@ else
   summary2+=" build $((built2 - done1)) s, tests $((done2 - built2)) s"
 fi
 
+[ $stage1 -eq 0 ] || report_failures "${BUILD_DIR:-build}" 1
+[ $stage2 -eq 0 ] || [ "${INSPECT_SKIP_SANITIZE:-0}" = 1 ] || report_failures "${ASAN_DIR}" 2
 echo "test: $summary1"
 echo "test: $summary2"
 [ $stage1 -eq 0 ] && [ $stage2 -eq 0 ]

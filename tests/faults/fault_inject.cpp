@@ -58,6 +58,11 @@ struct Options {
   int trials = 30;
   std::vector<std::string> faults;  // empty: all
   std::set<std::string> allow_miss;
+  // For the exit status only: a p99 over its target by at most this much does
+  // not fail the run (the tables still say NO). The ctest short version runs on
+  // shared CI machines, where scheduling can delay any process by tens of ms;
+  // the targets themselves are judged by the long run (docs/failsafes.md).
+  double margin_ms = 0;
   std::string json;
   bool video = true;
   double hold_s = 1.3;  // how long a fault lasts before recovery
@@ -757,12 +762,17 @@ Verdict printFaults(const std::vector<FaultResult>& results, const Options& o, s
   std::printf("headline = set-points zero: the instant the MCU's applied wheel set-points became 0 (the zero command\n"
               "or the watchdog trip, from the truth log's C/E rows); T row = the first 100 Hz T row showing it;\n"
               "still = both wheels below %.2f rad/s (the motors' %.1f s time constant follows). p50 / p99 / max, ms.\n"
-              "MCU watchdog targets are met within +%.0f ms: its 1 ms tick, and a last command still on the wire.\n\n",
+              "MCU watchdog targets are met within +%.0f ms: its 1 ms tick, and a last command still on the wire.\n",
               kStill, 0.2, kWatchdogSlackMs);
+  if (o.margin_ms > 0)
+    std::printf("--margin-ms %.0f: a p99 over its target by at most that much is NO but does not fail the run.\n",
+                o.margin_ms);
+  std::printf("\n");
   std::printf("| fault | n | set-points zero | T row | still (< %.2f rad/s) | target | met |\n", kStill);
   std::printf("|---|---|---|---|---|---|---|\n");
   json = "{\n  \"trials_per_fault\": " + std::to_string(o.trials) + ",\n  \"video\": " + (o.video ? "true" : "false") +
-         ",\n  \"still_threshold_rad_s\": " + fmt("%.3f", kStill) + ",\n  \"faults\": [\n";
+         ",\n  \"still_threshold_rad_s\": " + fmt("%.3f", kStill) + ",\n  \"exit_margin_ms\": " +
+         fmt("%.0f", o.margin_ms) + ",\n  \"faults\": [\n";
   for (std::size_t fi = 0; fi < results.size(); ++fi) {
     const auto& r = results[fi];
     const auto& d = *r.def;
@@ -786,8 +796,10 @@ Verdict printFaults(const std::vector<FaultResult>& results, const Options& o, s
     }
     const bool complete = r.setup_error.empty() && static_cast<int>(r.trials.size()) == o.trials && errors.empty();
     const bool met = zero.n() > 0 && zero.pct(0.99) <= d.target_ms + d.slack_ms;
-    const bool allowed = o.allow_miss.count(d.name) > 0;
-    std::string verdict = met ? "yes" : (allowed ? "NO (allowed)" : "NO");
+    const bool in_margin = !met && zero.n() > 0 && o.margin_ms > 0 && zero.pct(0.99) <= d.target_ms + d.slack_ms + o.margin_ms;
+    const bool allowed = o.allow_miss.count(d.name) > 0 || in_margin;
+    std::string verdict = met ? "yes" : (in_margin ? "NO (within the " + fmt("%.0f", o.margin_ms) + " ms margin)"
+                                                   : (allowed ? "NO (allowed)" : "NO"));
     if (met && zero.pct(0.99) > d.target_ms) verdict = "yes (watchdog tick)";
     std::printf("| %s | %zu | %s | %s | %s | <= %.0f (%s) | %s |\n", d.label, zero.n(), zero.cell().c_str(),
                 trow.cell().c_str(), still.cell().c_str(), d.target_ms, d.target_what, verdict.c_str());
@@ -798,9 +810,13 @@ Verdict printFaults(const std::vector<FaultResult>& results, const Options& o, s
     // Detection targets.
     for (const auto& dd : d.detectors)
       if (dd.target_ms > 0 && det[dd.name].n() > 0 && det[dd.name].pct(0.99) > dd.target_ms + dd.slack_ms) {
-        if (!allowed) v.ok = false;
+        const bool excused = o.allow_miss.count(d.name) > 0 ||
+                             det[dd.name].pct(0.99) <= dd.target_ms + dd.slack_ms + o.margin_ms;
+        if (!excused) v.ok = false;
         v.notes.push_back(std::string(d.name) + ": " + dd.name + " p99 " + fmt("%.0f", det[dd.name].pct(0.99)) +
-                          " ms > target " + fmt("%.0f", dd.target_ms) + " ms" + (allowed ? " (allowed)" : ""));
+                          " ms > target " + fmt("%.0f", dd.target_ms) + " ms" +
+                          (o.allow_miss.count(d.name) ? " (allowed)"
+                                                      : excused ? " (within the " + fmt("%.0f", o.margin_ms) + " ms margin)" : ""));
       }
 
     json += std::string("    {\"name\": \"") + d.name + "\", \"label\": \"" + d.label + "\", \"target_ms\": " +
@@ -1115,6 +1131,8 @@ options:
   --hold S            how long each fault lasts before recovery, s (default 1.3)
   --no-video          robots without the camera stream (video is checked after recovery otherwise)
   --allow-miss LIST   faults whose timing target may be missed without failing (known, reported)
+  --margin-ms M       a p99 over its target by at most M ms does not fail the run (reported as NO
+                      all the same); for ctest on shared machines (default 0)
   --ber               instead: the serial bit-error test
   --ber-rates LIST    bit error rates (default 1e-4,1e-3)
   --ber-seconds S     seconds per rate (default 45)
@@ -1161,6 +1179,8 @@ int main(int argc, char** argv) {
           usage("--faults: unknown fault '" + f + "'");
     } else if (a == "--allow-miss") {
       for (const auto& f : split(value(), ',')) o.allow_miss.insert(f);
+    } else if (a == "--margin-ms") {
+      o.margin_ms = number(0, 10000);
     } else if (a == "--hold") {
       o.hold_s = number(0.5, 30);
     } else if (a == "--no-video") {
