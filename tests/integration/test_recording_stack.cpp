@@ -60,7 +60,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   ASSERT_TRUE(s.startServer("expect robots >= 1 within 15\n"
                             "record start first run\n"
                             "drive 0.3 0.3\n"
-                            "wait 3\n"
+                            "wait 4\n"
                             "stop\n"
                             "wait 1\n"
                             "record stop\n"
@@ -99,8 +99,8 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   // 1. The first run, ended normally: every reader opens it.
   const std::string first = runDir(runs, ids[0]);
   const auto counts = capture(std::string("node ") + reader + " " + first + "/run.mcap");
-  EXPECT_GT(topicCount(counts, "/telemetry"), 150) << counts;  // 50 Hz for ~4 s
-  EXPECT_GT(topicCount(counts, "/camera"), 90) << counts;      // 30 fps
+  EXPECT_GT(topicCount(counts, "/telemetry"), 150) << counts;  // 50 Hz for ~5 s
+  EXPECT_GT(topicCount(counts, "/camera"), 90) << counts;      // 30 fps (~150, less the stream's start)
   EXPECT_GT(topicCount(counts, "/command"), 20) << counts;     // teleop re-sent at 20 Hz
   EXPECT_GT(topicCount(counts, "/ack"), 20) << counts;
   EXPECT_GE(topicCount(counts, "/server_event"), 2) << counts;

@@ -173,8 +173,12 @@ TEST(System, KillingTheClientTripsTheMcuWatchdog) {
   ASSERT_NE(trip, nullptr) << s.logs();
   std::printf("MCU_WATCHDOG client SIGKILL -> set-points zero %.1f ms (trip %s ms after the last command)\n", ms,
               trip->detail.c_str());
-  EXPECT_LE(ms, 200.0 + 10.0 + 5.0);  // 200 ms + one 10 ms frame + scheduling slack
+  // The watchdog's own time is exact in sim time; the wall-clock figure gets
+  // the 100 ms margin of fault_inject_short (tests/faults/CMakeLists.txt):
+  // structurally at most about 210 ms, and a shared CI machine can schedule
+  // mcu_sim a few ms late. The target itself is judged by fault_inject.
   EXPECT_LE(std::stod(trip->detail), 201.0);
+  EXPECT_LE(ms, 200.0 + 10.0 + 100.0);  // 200 ms + one 10 ms frame + the margin
 }
 
 TEST(System, SerialGarbageNeverBecomesAWheelCommand) {

@@ -38,11 +38,13 @@ sim::ClosedLoopMetrics inProcess(control::WheelControl wc, double dead_time_s, u
 
 TEST(TrackingStack, CircleMatchesTheInProcessExperimentSpreadWithin20Percent) {
   // The maxima are peaks of a lightly damped oscillation: they move with the
-  // noise and with the link's latency (0-20 ms). The full stack must land
-  // within 20 % of the in-process spread over 5 noise seeds x those latencies.
+  // noise and with the link's latency (about 10 ms of wall time, 20 ms of
+  // sim time at --rate 2; up to 30 ms when a shared machine schedules a
+  // process late). The full stack must land within 20 % of the in-process
+  // spread over 5 noise seeds x those latencies.
   double pos_lo = 1e9, pos_hi = 0, ang_lo = 1e9, ang_hi = 0;
   for (uint32_t seed = 1; seed <= 5; ++seed)
-    for (double d : {0.0, 0.01, 0.02}) {
+    for (double d : {0.0, 0.01, 0.02, 0.03}) {
       const auto m = inProcess(control::WheelControl::kFuzzyPid, d, seed);
       pos_lo = std::min(pos_lo, m.max_pos_err_m);
       pos_hi = std::max(pos_hi, m.max_pos_err_m);

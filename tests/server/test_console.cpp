@@ -274,7 +274,7 @@ TEST_F(ConsoleTest, WaitSleepsAndQuitIsRecorded) {
 }
 
 TEST_F(ConsoleTest, ConsoleReportsItIsAliveWhileWaiting) {
-  EXPECT_TRUE(run("wait 0.1").first);
+  EXPECT_TRUE(run("wait 0.5").first);  // polls every 5 ms: about 100 signs (5 leave room for a shared machine)
   EXPECT_GE(sink_.alive_calls, 5) << "the console watchdog needs a sign of life every poll";
 }
 
@@ -355,7 +355,7 @@ TEST_F(ConsoleTest, ExpectWithinPollsUntilTrue) {
   EXPECT_TRUE(ok) << out;
   EXPECT_HAS(out, "x = 2.01");
   EXPECT_GE(dt, std::chrono::milliseconds(90));
-  EXPECT_LT(dt, std::chrono::milliseconds(1000));
+  EXPECT_LT(dt, std::chrono::milliseconds(1900));  // before the 2 s `within` ran out
 }
 
 TEST_F(ConsoleTest, ExpectWithinTimesOut) {
@@ -367,7 +367,7 @@ TEST_F(ConsoleTest, ExpectWithinTimesOut) {
   EXPECT_FALSE(ok);
   EXPECT_EQ(out, "EXPECT FAILED (line 4): x = 0.5, wanted >= 1 within 0.2 s\n");
   EXPECT_GE(dt, std::chrono::milliseconds(200));
-  EXPECT_LT(dt, std::chrono::milliseconds(800));
+  EXPECT_LT(dt, std::chrono::milliseconds(1500));  // 0.2 s + room for a shared machine
 }
 
 TEST_F(ConsoleTest, ExpectRobotsWorksWithoutSelection) {

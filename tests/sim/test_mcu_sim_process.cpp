@@ -212,8 +212,12 @@ TEST(McuSimProgram, RealPtyFramesCommandsAndWatchdog) {
   ASSERT_GE(fd, 0) << link;
   serial::FrameDecoder dec;
   std::vector<serial::SensorFrame> frames;
+  // (wall ns, mcu_time_ms) of the newest frame of each read: that frame left
+  // the simulator just before it was read, however late this thread was.
+  std::vector<std::pair<int64_t, uint32_t>> newest;
   auto drain = [&] {
     uint8_t buf[1024];
+    const std::size_t before = frames.size();
     for (int i = 0; i < 100; ++i) {
       const ssize_t n = read(fd, buf, sizeof buf);
       if (n <= 0) break;
@@ -221,6 +225,7 @@ TEST(McuSimProgram, RealPtyFramesCommandsAndWatchdog) {
         if (auto* s = std::get_if<serial::SensorFrame>(&m)) frames.push_back(*s);
       });
     }
+    if (frames.size() > before) newest.emplace_back(monoNowNs(), frames.back().mcu_time_ms);
   };
   auto pollFor = [&](int ms) {
     pollfd p{fd, POLLIN, 0};
@@ -234,10 +239,17 @@ TEST(McuSimProgram, RealPtyFramesCommandsAndWatchdog) {
   const double wall1_s = static_cast<double>(monoNowNs() - t1) / 1e9;
   const double frames_per_wall_s = static_cast<double>(frames.size()) / wall1_s;
   ASSERT_GE(frames.size(), 2u);
+  ASSERT_GE(newest.size(), 2u);
   const uint32_t span_ms = frames.back().mcu_time_ms - frames.front().mcu_time_ms;
-  std::printf("[ measured ] %zu frames in %.3f s wall = %.0f frames/s (expect %.0f); mcu_time span %u ms\n",
-              frames.size(), wall1_s, frames_per_wall_s, 100.0 * kRate, span_ms);
-  EXPECT_NEAR(frames_per_wall_s, 100.0 * kRate, 0.3 * 100.0 * kRate);
+  // The rate: sim time against wall time between the newest frames of the
+  // first and the last read (a count of frames in the window would also count
+  // a stall of either process at its ends).
+  const double rate_measured = (newest.back().second - newest.front().second) / 1000.0 /
+                               (static_cast<double>(newest.back().first - newest.front().first) / 1e9);
+  std::printf("[ measured ] %zu frames in %.3f s wall = %.0f frames/s (expect %.0f); mcu_time span %u ms; "
+              "sim/wall rate %.2f\n",
+              frames.size(), wall1_s, frames_per_wall_s, 100.0 * kRate, span_ms, rate_measured);
+  EXPECT_NEAR(rate_measured, kRate, 0.3 * kRate);
   EXPECT_EQ(frames.size(), span_ms / 10 + 1u) << "frames lost or duplicated";
   EXPECT_EQ(dec.counters().errors(), 0u);
   EXPECT_EQ(dec.counters().seq_gaps, 0u);
@@ -250,8 +262,8 @@ TEST(McuSimProgram, RealPtyFramesCommandsAndWatchdog) {
   const int64_t t2 = monoNowNs();
   while (monoNowNs() - t2 < 200'000'000) {
     const auto f = enc.encode(serial::WheelCommand{2500, 2500, serial::WheelCommand::kEnable});
+    last_send_ns = monoNowNs();  // before the write: the MCU cannot have it earlier
     ASSERT_EQ(write(fd, f.bytes.data(), f.size), static_cast<ssize_t>(f.size));
-    last_send_ns = monoNowNs();
     ++sent;
     pollFor(4);
   }
@@ -290,7 +302,7 @@ TEST(McuSimProgram, RealPtyFramesCommandsAndWatchdog) {
               "(200 ms sim / rate %.0f = %.0f ms)\n",
               trip_ms, latency_wall_ms, kRate, 200.0 / kRate);
   EXPECT_GT(latency_wall_ms, 0.8 * 200.0 / kRate);
-  EXPECT_LT(latency_wall_ms, 200.0 / kRate + 100.0);
+  EXPECT_LT(latency_wall_ms, 200.0 / kRate + 250.0);  // 40 ms + room for a shared machine (the sim-time figure is exact)
 
   close(fd);
 
