@@ -26,7 +26,7 @@ report_failures() {
       on && /^(Running main|Note: Google Test filter|\[(==========|----------|  PASSED  )\]|$)/ { next }
       on { buf[n++ % 25] = $0 }
       END { for (i = (n > 25 ? n - 25 : 0); i < n; ++i) print "  " buf[i % 25] }
-    ' "$1/Testing/Temporary/LastTest.log" || true
+    ' "$dir/Testing/Temporary/LastTest.log" || true
   done
   return 0
 }
