@@ -20,8 +20,6 @@
 namespace inspect::server {
 
 namespace {
-std::chrono::nanoseconds seconds(double s) { return std::chrono::nanoseconds(static_cast<int64_t>(s * 1e9)); }
-
 std::string padRight(std::string s, std::size_t w) {
   if (s.size() < w) s.append(w - s.size(), ' ');
   return s;
@@ -367,19 +365,18 @@ void Console::pump() {
 }
 
 bool Console::sleepPumping(double s) {
-  const auto deadline = std::chrono::steady_clock::now() + seconds(s);
+  const int64_t deadline = deadlineAfter(s);
   for (;;) {
     pump();
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= deadline) return true;
-    const auto step = std::min<std::chrono::steady_clock::duration>(deadline - now, seconds(options_.poll_period_s));
-    if (!stop_.sleepFor(step)) return false;
+    const int64_t left_ns = deadline - clock_->nowNs();
+    if (left_ns <= 0) return true;
+    if (!clock_->sleep(std::min(static_cast<double>(left_ns) * 1e-9, options_.poll_period_s))) return false;
   }
 }
 
 bool Console::mayMove(const std::string& robot, const std::string& cmd) {
   if (!control_) return true;
-  const auto d = control_->authorizeMotion(robot, session_, monoNowNs());
+  const auto d = control_->authorizeMotion(robot, session_, clock_->nowNs());
   if (d.taken_now) out_ << robot << ": control taken by " << control_->sessionName(session_) << "\n";
   if (d.allowed) return true;
   out_ << robot << ": " << cmd << " refused: " << d.reason << "\n";
@@ -392,7 +389,7 @@ bool Console::cmdControl(const Args& args, const std::string&, int) {
   if (args.empty()) {
     out_ << "this session: " << control_->sessionName(session_) << "\n";
     const auto holders = control_->holders();
-    for (const auto& snap : registry_.snapshots(monoNowNs())) {
+    for (const auto& snap : registry_.snapshots(clock_->nowNs())) {
       const auto it = holders.find(snap.id);
       out_ << "  " << snap.id << (snap.connected ? "" : " (not connected)") << ": "
            << (it == holders.end() ? std::string("free")
@@ -414,7 +411,7 @@ bool Console::cmdControl(const Args& args, const std::string&, int) {
     out_ << robot << ": control released; the robot is free\n";
     return true;
   }
-  const auto r = control_->take(robot, session_, force, monoNowNs());
+  const auto r = control_->take(robot, session_, force, clock_->nowNs());
   if (!r.ok) return fail("control", r.reason);
   if (r.previous) {
     // The new operator starts from standstill: nothing of the old one's commands goes on.
@@ -434,7 +431,7 @@ std::optional<std::string> Console::connectedRobot(const std::string& cmd) {
     fail(cmd, "no robot selected");
     return std::nullopt;
   }
-  const auto snap = registry_.snapshot(selected_, monoNowNs());
+  const auto snap = registry_.snapshot(selected_, clock_->nowNs());
   if (!snap || !snap->connected) {
     fail(cmd, selected_ + " is not connected");
     return std::nullopt;
@@ -443,14 +440,14 @@ std::optional<std::string> Console::connectedRobot(const std::string& cmd) {
 }
 
 std::optional<v1::Ack> Console::waitAck(const std::string& robot_id, uint64_t command_id) {
-  const auto deadline = std::chrono::steady_clock::now() + seconds(options_.ack_timeout_s);
+  const int64_t deadline = deadlineAfter(options_.ack_timeout_s);
   for (;;) {
     if (auto a = registry_.ack(robot_id, command_id)) return a;
-    if (std::chrono::steady_clock::now() >= deadline) return std::nullopt;
+    if (clock_->nowNs() >= deadline) return std::nullopt;
     pump();
     // Acks come back within a millisecond or two on a working link; polling
     // finely keeps 'drive' + 'wait T' close to T of motion.
-    if (!stop_.sleepFor(seconds(options_.ack_poll_period_s))) return std::nullopt;
+    if (!clock_->sleep(options_.ack_poll_period_s)) return std::nullopt;
   }
 }
 
@@ -468,7 +465,7 @@ bool Console::cmdHelp(const Args& args, const std::string&, int) {
 
 bool Console::cmdRobots(const Args& args, const std::string&, int) {
   if (!args.empty()) return fail("robots", "takes no arguments");
-  const auto all = registry_.snapshots(monoNowNs());
+  const auto all = registry_.snapshots(clock_->nowNs());
   if (all.empty()) {
     out_ << "no robot has connected yet\n";
     return true;
@@ -489,7 +486,7 @@ bool Console::cmdSelect(const Args& args, const std::string&, int) {
   if (args.size() != 1) return fail("select", "needs one robot id: select <robot>");
   if (!net::validRobotId(args[0])) return fail("select", "'" + args[0] + "' is not a valid robot id ([A-Za-z0-9_-]{1,64})");
   selected_ = args[0];
-  const auto snap = registry_.snapshot(selected_, monoNowNs());
+  const auto snap = registry_.snapshot(selected_, clock_->nowNs());
   out_ << "selected " << selected_ << (snap && snap->connected ? "" : " (not connected yet)") << "\n";
   return true;
 }
@@ -560,7 +557,7 @@ bool Console::cmdVideo(const Args& args, const std::string&, int) {
     if (args.size() != 1) return fail("video", kSyntax);
     const auto robot = connectedRobot("video");
     if (!robot) return false;
-    out_ << videoReport(*robot, registry_.snapshot(*robot, monoNowNs()), video_);
+    out_ << videoReport(*robot, registry_.snapshot(*robot, clock_->nowNs()), video_);
     return true;
   }
   v1::Command c;
@@ -626,7 +623,7 @@ bool Console::cmdSnapshot(const Args& args, const std::string&, int) {
 }
 
 std::string Console::statusText(const std::string& robot) const {
-  std::string s = statusLine(robot, registry_.snapshot(robot, monoNowNs()), video_);
+  std::string s = statusLine(robot, registry_.snapshot(robot, clock_->nowNs()), video_);
   if (recorder_)
     if (const auto run = recorder_->activeRun(robot)) s += " | REC " + *run;
   return s;
@@ -664,7 +661,7 @@ bool Console::cmdRuns(const Args& args, const std::string&, int) {
       f.limit = static_cast<int>(*n);
     } else if (a == "completed" || a == "stopped" || a == "failed" || a == "incomplete" || a == "running") {
       f.outcome = a;
-    } else if (registry_.snapshot(a, monoNowNs())) {
+    } else if (registry_.snapshot(a, clock_->nowNs())) {
       f.robot = a;
     } else {
       f.name_contains = a;
@@ -872,19 +869,19 @@ bool Console::cmdExpect(const Args& args, const std::string&, int line_no) {
     return false;
   }
   const auto& spec = std::get<ExpectSpec>(parsed);
-  const auto deadline = std::chrono::steady_clock::now() + seconds(spec.within_s);
+  const int64_t deadline = deadlineAfter(spec.within_s);
   FieldReading r;
   bool interrupted = false;
   for (;;) {
-    r = readField(spec.field, registry_, selected_, monoNowNs());
+    r = readField(spec.field, registry_, selected_, clock_->nowNs());
     if (r.ok && compare(spec.op, r.value, spec.value, spec.tol)) {
       out_ << "expect ok (line " << line_no << "): " << spec.field << " = " << r.text << "\n";
       ++tally_.expects_passed;
       return true;
     }
-    if (std::chrono::steady_clock::now() >= deadline) break;
+    if (clock_->nowNs() >= deadline) break;
     pump();
-    if (!stop_.sleepFor(seconds(options_.poll_period_s))) {
+    if (!clock_->sleep(options_.poll_period_s)) {
       interrupted = true;
       break;
     }

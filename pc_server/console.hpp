@@ -3,6 +3,7 @@
 // terminal and no socket: lines in, text out (tested on strings); the robots
 // are reached through the registry (state) and a CommandSink (commands).
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "pc_server/command_sink.hpp"
+#include "pc_server/console_clock.hpp"
 #include "pc_server/control_arbiter.hpp"
 #include "pc_server/keyboard_teleop.hpp"
 #include "pc_server/robot_registry.hpp"
@@ -57,6 +59,10 @@ class Console {
   std::string background();
   /// background() printed to the output, then the idle hook; used while waiting.
   void pump();
+  /// The clock this console reads and waits on (default: the real one; tests
+  /// pass one they advance themselves). Must outlive the console.
+  void setClock(ConsoleClock& clock) { clock_ = &clock; }
+  ConsoleClock& clock() { return *clock_; }
   /// Called while the console waits (e.g. to refresh the status line).
   void setIdleHook(std::function<void()> hook) { idle_hook_ = std::move(hook); }
   /// Interactive terminals: alarm lines in red with the terminal bell.
@@ -167,12 +173,18 @@ class Console {
   std::optional<v1::Ack> waitAck(const std::string& robot_id, uint64_t command_id);
   /// Sleeps up to `seconds` while pumping; false if the server is stopping.
   bool sleepPumping(double seconds);
+  /// Now on this console's clock, in seconds (for elapsed times).
+  double nowS() { return static_cast<double>(clock_->nowNs()) * 1e-9; }
+  /// The time `seconds` from now on this console's clock, in its nanoseconds.
+  int64_t deadlineAfter(double seconds) { return clock_->nowNs() + std::llround(seconds * 1e9); }
 
   RobotRegistry& registry_;
   CommandSink& sink_;
   std::ostream& out_;
   StopFlag& stop_;
   Options options_;
+  SteadyConsoleClock steady_clock_{stop_};
+  ConsoleClock* clock_ = &steady_clock_;
   std::function<void()> idle_hook_;
   TeleopHandler teleop_handler_;
   VideoHub* video_ = nullptr;

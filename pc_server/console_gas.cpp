@@ -78,14 +78,14 @@ bool Console::cmdAlarms(const Args& args, const std::string&, int) {
     out_ << (all ? "no gas alarms so far\n" : "no active or unacknowledged gas alarms\n");
     return true;
   }
-  const int64_t now = monoNowNs();
+  const int64_t now = clock_->nowNs();
   for (const auto& r : list) out_ << alarmLine(r, now) << "\n";
   return true;
 }
 
 bool Console::cmdAck(const Args& args, const std::string&, int) {
   if (args.size() != 1) return fail("ack", "syntax: ack <number>|all (alarms lists the numbers)");
-  const int64_t now = monoNowNs();
+  const int64_t now = clock_->nowNs();
   std::vector<AlarmRecord> done;
   if (args[0] == "all") {
     done = registry_.ackAllAlarms(now);

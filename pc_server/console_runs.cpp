@@ -188,11 +188,10 @@ bool Console::cmdReplay(const Args& args, const std::string&, int) {
   const double t0 = static_cast<double>(log.telemetry.front().robot_time_us()) * 1e-6;
   double next_line = 0;
   std::size_t next_event = 0;
-  const auto wall0 = std::chrono::steady_clock::now();
+  const double wall0 = nowS();
   for (std::size_t i = 0; i < log.telemetry.size(); ++i) {
     const double t = static_cast<double>(log.telemetry[i].robot_time_us()) * 1e-6 - t0;
-    const double wait_s =
-        t / speed - std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    const double wait_s = t / speed - (nowS() - wall0);
     if (wait_s > 0 && !sleepPumping(wait_s)) return fail("replay", "stopped");
     while (next_event < log.events.size() && log.events[next_event].first <= t)
       out_ << "[" << fmtFixed(log.events[next_event].first, 2) << " s] " << log.events[next_event++].second << "\n";

@@ -330,7 +330,7 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
   stop_.setInterruptTarget(&cancel);
   const bool tty = alarm_style_;  // an interactive terminal: one redrawn progress line
   int last_decile = -1;
-  const auto t0 = std::chrono::steady_clock::now();
+  const double t0 = nowS();
   double last_draw_s = -1.0;
   tuning::TuneResult result;
   try {
@@ -338,7 +338,7 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
         start_gains,
         [&](const tuning::TuneProgress& p) {
           if (stop_.requested()) cancel.store(true);
-          const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          const double el = nowS() - t0;
           const double frac = p.max_evals > 0 ? static_cast<double>(p.evals) / p.max_evals : 1.0;
           const int decile = static_cast<int>(frac * 10.0);
           char line[200];
@@ -480,7 +480,7 @@ bool Console::cmdGains(const Args& args, const std::string&, int) {
     if (args.size() > 2) return fail("gains", "syntax: gains show [robot]");
     const std::string robot = args.size() == 2 ? args[1] : selected_;
     std::optional<RobotSnapshot> snap;
-    if (!robot.empty()) snap = registry_.snapshot(robot, monoNowNs());
+    if (!robot.empty()) snap = registry_.snapshot(robot, clock_->nowNs());
     const bool have_robot = snap && snap->gains_known;
     const control::GainSet rg = have_robot ? net::fromProto(snap->gains) : control::GainSet{};
     char head[200];
@@ -511,7 +511,7 @@ bool Console::cmdGains(const Args& args, const std::string&, int) {
         ts->working = *ts->tuned;
       }
       if (args[1] == "robot") {
-        const auto snap = selected_.empty() ? std::optional<RobotSnapshot>() : registry_.snapshot(selected_, monoNowNs());
+        const auto snap = selected_.empty() ? std::optional<RobotSnapshot>() : registry_.snapshot(selected_, clock_->nowNs());
         if (!snap || !snap->gains_known) return fail("gains", "the selected robot has not announced its gains");
         ts->working = net::fromProto(snap->gains);
       }
@@ -547,7 +547,7 @@ bool Console::cmdGains(const Args& args, const std::string&, int) {
     std::string robot;
     if (args.size() == 2) {
       robot = args[1];
-      const auto snap = registry_.snapshot(robot, monoNowNs());
+      const auto snap = registry_.snapshot(robot, clock_->nowNs());
       if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
     } else {
       const auto r = connectedRobot("gains");
@@ -562,7 +562,7 @@ bool Console::cmdGains(const Args& args, const std::string&, int) {
     if (args.size() > 2) return fail("gains", "syntax: gains revert [robot]");
     const std::string robot = args.size() == 2 ? args[1] : selected_;
     if (robot.empty()) return fail("gains", "no robot selected");
-    const auto snap = registry_.snapshot(robot, monoNowNs());
+    const auto snap = registry_.snapshot(robot, clock_->nowNs());
     if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
     if (snap->gains_history.empty()) return fail("gains", robot + ": no earlier gains to go back to");
     const auto& [version, prev] = snap->gains_history.back();

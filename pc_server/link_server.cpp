@@ -15,7 +15,6 @@ using asio::ip::tcp;
 using boost::system::error_code;
 
 namespace {
-constexpr std::string_view kTag = "link";
 }
 
 LinkServer::LinkServer(asio::io_context& ioc, const ServerConfig& config, RobotRegistry& registry)
@@ -58,7 +57,7 @@ void LinkServer::doAccept() {
     if (ec == asio::error::operation_aborted || !acceptor_.is_open()) return;
     if (ec) {
       // E.g. out of file descriptors: retry shortly instead of spinning.
-      log::warn(kTag, "accept failed: ", ec.message());
+      log::warn(log::tag::kLink, "accept failed: ", ec.message());
       accept_retry_timer_.expires_after(std::chrono::milliseconds(100));
       accept_retry_timer_.async_wait([this](const error_code& e) {
         if (!e) doAccept();
@@ -72,7 +71,7 @@ void LinkServer::doAccept() {
       if (stopped_) return;  // the socket closes with the dropped session
       live_.insert(session);
     }
-    log::debug(kTag, "connection from ", session->address());
+    log::debug(log::tag::kLink, "connection from ", session->address());
     session->start();
     doAccept();
   });

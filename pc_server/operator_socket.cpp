@@ -19,7 +19,6 @@
 namespace inspect::server {
 
 namespace {
-constexpr std::string_view kTag = "operator";
 
 // An ostream buffer that writes to a socket; a gone peer just drops output.
 class FdBuf : public std::streambuf {
@@ -176,7 +175,7 @@ void OperatorSocket::runSession(Session& s) {
   const std::string user = peerUser(s.fd);
   const uint64_t id = control_.openSession(user);
   const std::string name = control_.sessionName(id);
-  log::info(kTag, name, " attached");
+  log::info(log::tag::kOperator, name, " attached");
   FdBuf buf(s.fd);
   std::ostream out(&buf);
   {
@@ -211,7 +210,7 @@ void OperatorSocket::runSession(Session& s) {
   }
   // Leaving gives its robots free; a teleop set-point of this session stops with it.
   for (const auto& robot : control_.closeSession(id)) sink_.clearTeleop(robot);
-  log::info(kTag, name, " detached");
+  log::info(log::tag::kOperator, name, " detached");
 }
 
 int attachToOperatorSocket(const std::string& path) {

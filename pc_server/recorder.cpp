@@ -18,7 +18,6 @@ namespace inspect::server {
 namespace fs = std::filesystem;
 
 namespace {
-constexpr std::string_view kTag = "record";
 
 uint64_t wallNowNs() {
   return static_cast<uint64_t>(
@@ -107,7 +106,7 @@ Recorder::Recorder(const RecordingConfig& config, std::string software_version)
       const std::string mp4 = dir + "/video.mp4";
       if (fs::exists(mp4)) catalog_->addFile(id, "video", mp4, fileBytes(mp4));
     }
-    log::warn(kTag, what);
+    log::warn(log::tag::kRecord, what);
     startup_report_ += (startup_report_.empty() ? "" : "; ") + what;
   }
 }
@@ -120,7 +119,7 @@ Recorder::~Recorder() {
     try {
       stopLocked(robot, "stopped");
     } catch (const std::exception& e) {
-      log::error(kTag, robot, ": ending the run at shutdown: ", e.what());
+      log::error(log::tag::kRecord, robot, ": ending the run at shutdown: ", e.what());
     }
   }
 }
@@ -145,7 +144,7 @@ void Recorder::setRunMap(const std::string& robot, const std::string& map_path) 
     try {
       catalog_->addFile(it->second->info.id, "map", map_path, fileBytes(map_path));
     } catch (const std::exception& e) {
-      log::error(kTag, robot, ": run map not in the catalog: ", e.what());
+      log::error(log::tag::kRecord, robot, ": run map not in the catalog: ", e.what());
     }
     return;
   }
@@ -162,7 +161,7 @@ void Recorder::noteAlarmAck(const std::string& robot, const v1::GasAlarm& a, con
     catalog_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), v1::GasAlarm::Level_Name(a.level()),
                        "acked", a.value(), a.pose().x_m(), a.pose().y_m());
   } catch (const std::exception& e) {
-    log::error(kTag, robot, ": alarm acknowledgement not recorded: ", e.what());
+    log::error(log::tag::kRecord, robot, ": alarm acknowledgement not recorded: ", e.what());
   }
 }
 
@@ -239,7 +238,7 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
     }
   }
   runs_[robot] = std::move(run);
-  log::info(kTag, robot, ": recording run ", id);
+  log::info(log::tag::kRecord, robot, ": recording run ", id);
   return id;
 }
 
@@ -283,7 +282,7 @@ std::string Recorder::stopLocked(const std::string& robot, const std::string& ou
   if (r.mp4)
     for (const auto& f : r.mp4->files()) catalog_->addFile(r.info.id, "video", f, fileBytes(f));
   catalog_->endRun(r.info.id, outcome, std::chrono::system_clock::now());
-  log::info(kTag, robot, ": run ", r.info.id, " ended (", outcome, "): ", r.mcap.stats().messages, " messages, ",
+  log::info(log::tag::kRecord, robot, ": run ", r.info.id, " ended (", outcome, "): ", r.mcap.stats().messages, " messages, ",
             r.video_frames, " video frames");
   return r.info.id;
 }
@@ -316,7 +315,7 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
                     c.has_go_to() ? c.go_to().name() : c.has_wheel_test() ? c.wheel_test().name() : "", c.id());
         it = runs_.find(robot);
       } catch (const std::exception& e) {
-        log::error(kTag, robot, ": cannot start a run: ", e.what());
+        log::error(log::tag::kRecord, robot, ": cannot start a run: ", e.what());
       }
     }
   }
@@ -328,7 +327,7 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
                          a.channel_name(), v1::GasAlarm::Level_Name(a.level()), a.active() ? "raised" : "cleared", a.value(),
                          a.pose().x_m(), a.pose().y_m());
     } catch (const std::exception& e) {
-      log::error(kTag, robot, ": alarm not in the catalog: ", e.what());
+      log::error(log::tag::kRecord, robot, ": alarm not in the catalog: ", e.what());
     }
   }
   if (it == runs_.end()) return;
@@ -377,7 +376,7 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
       default: break;
     }
   } catch (const std::exception& e) {
-    log::error(kTag, robot, ": run ", r.info.id, ": ", e.what());
+    log::error(log::tag::kRecord, robot, ": run ", r.info.id, ": ", e.what());
   }
   // The command that started the run ends it.
   if (inbound && env.has_ack() && r.command_id && env.ack().command_id() == r.command_id) {
@@ -404,7 +403,7 @@ void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame,
     r.mcap.write(r.ch_camera, wallNowNs(), capture_wall_ns, v);
     if (r.mp4) r.mp4->write(frame.annexb.data(), frame.annexb.size(), frame.keyframe, capture_us ? capture_us : monoNowUs());
   } catch (const std::exception& e) {
-    if (r.mp4_error.empty()) log::error(kTag, robot, ": run ", r.info.id, " video: ", e.what());
+    if (r.mp4_error.empty()) log::error(log::tag::kRecord, robot, ": run ", r.info.id, " video: ", e.what());
     r.mp4_error = e.what();
     r.mp4.reset();
   }
@@ -417,7 +416,7 @@ void Recorder::tick() {
     try {
       r->mcap.tick(now);
     } catch (const std::exception& e) {
-      log::error(kTag, robot, ": ", e.what());
+      log::error(log::tag::kRecord, robot, ": ", e.what());
     }
   }
 }

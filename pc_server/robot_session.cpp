@@ -16,7 +16,6 @@ namespace asio = boost::asio;
 using boost::system::error_code;
 
 namespace {
-constexpr std::string_view kTag = "link";
 
 const char* bodyName(v1::Envelope::BodyCase c) {
   switch (c) {
@@ -79,9 +78,9 @@ void RobotSession::start() {
       }
       if (self->stream_.tls()) {
         self->cert_name_ = net::peerCommonName(self->stream_.ssl());
-        log::debug(kTag, self->address_, ": TLS up, robot certificate CN=", self->cert_name_);
+        log::debug(log::tag::kLink, self->address_, ": TLS up, robot certificate CN=", self->cert_name_);
       } else {
-        log::warn(kTag, self->address_, ": UNAUTHENTICATED plaintext connection (--plaintext)");
+        log::warn(log::tag::kLink, self->address_, ": UNAUTHENTICATED plaintext connection (--plaintext)");
       }
       self->doRead();
     });
@@ -208,7 +207,7 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
       registry_.onEvent(robot_id_, serial_, env.event(), monoNowNs());
       server_.observe(robot_id_, address_, env, true, monoNowUs());
       if (server_.logEvents())
-        log::info(kTag, "[", robot_id_, "] ", v1::Event::Kind_Name(env.event().kind()), ": ", env.event().text());
+        log::info(log::tag::kLink, "[", robot_id_, "] ", v1::Event::Kind_Name(env.event().kind()), ": ", env.event().text());
       return true;
     case v1::Envelope::kAck:
       registry_.onAck(robot_id_, serial_, env.ack());
@@ -238,7 +237,7 @@ void RobotSession::handleHello(const v1::Hello& hello) {
 }
 
 void RobotSession::rejectHello(const std::string& reason) {
-  log::warn(kTag, address_, ": handshake rejected: ", reason);
+  log::warn(log::tag::kLink, address_, ": handshake rejected: ", reason);
   handshake_timer_.cancel();
   rejecting_ = true;
   reject_reason_ = "handshake rejected: " + reason;
@@ -263,7 +262,7 @@ void RobotSession::acceptHello(const v1::Hello& hello) {
   registry_.onConnected(robot_id_, address_, serial_, hello, monoNowNs());
   std::string caps;
   for (const auto& c : hello.capabilities()) caps += (caps.empty() ? "" : ",") + c;
-  log::info(kTag, robot_id_, " connected from ", address_, " (software '", hello.software_version(),
+  log::info(log::tag::kLink, robot_id_, " connected from ", address_, " (software '", hello.software_version(),
             "', capabilities [", caps, "])");
   server_.attach(robot_id_, shared_from_this());
   if (closed_) return;
@@ -313,7 +312,7 @@ void RobotSession::armStaleCheck() {
       const std::string why = "no telemetry for " + fmtShort(std::chrono::duration<double>(gap).count(), 2) +
                               " s while moving: EStop sent (the operator cannot see the robot; resume once it is "
                               "back)";
-      log::warn(kTag, self->who(), ": ", why);
+      log::warn(log::tag::kLink, self->who(), ": ", why);
       v1::Envelope env;
       env.mutable_command()->set_id(self->server_.nextCommandId());
       env.mutable_command()->mutable_estop();
@@ -348,7 +347,7 @@ void RobotSession::armTeleop(uint64_t generation) {
     if (!self->server_.consoleResponsive()) {
       // The robot's own 300 ms deadman takes it from here.
       self->teleop_active_ = false;
-      log::warn(kTag, self->who(), ": console unresponsive: teleop set-point cleared, re-send stopped");
+      log::warn(log::tag::kLink, self->who(), ": console unresponsive: teleop set-point cleared, re-send stopped");
       return;
     }
     self->sendTeleopNow(self->server_.nextCommandId());
@@ -376,7 +375,7 @@ void RobotSession::enqueue(v1::Envelope& env) {
   env.set_send_time_us(monoNowUs());
   std::string frame;
   if (!net::appendDelimited(env, frame)) {
-    log::error(kTag, who(), ": cannot serialise an outgoing ", bodyName(env.body_case()));
+    log::error(log::tag::kLink, who(), ": cannot serialise an outgoing ", bodyName(env.body_case()));
     return;
   }
   if (queued_bytes_ + frame.size() > kMaxQueuedBytes) {
@@ -417,7 +416,7 @@ void RobotSession::closeNow(const std::string& reason, log::Level level) {
   if (closed_) return;
   closed_ = true;
   teleop_active_ = false;
-  log::logf(level, kTag, who(), ": closed: ", reason);
+  log::logf(level, log::tag::kLink, who(), ": closed: ", reason);
   handshake_timer_.cancel();
   watchdog_timer_.cancel();
   heartbeat_timer_.cancel();

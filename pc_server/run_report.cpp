@@ -26,8 +26,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t kMaxPoints = 5000;  // per series
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
-// Odometry jumps longer than this are resets, not motion (as in RunStats).
-constexpr double kMaxStepM = 0.5;
 const char* const kGasColor[] = {"#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22"};
 
 // The decimated telemetry with its time (s from the first message, robot
@@ -43,7 +41,7 @@ Samples sampleTelemetry(const std::vector<v1::Telemetry>& tel) {
   for (std::size_t i = 1; i < tel.size(); ++i) {
     const double step = std::hypot(tel[i].pose().x_m() - tel[i - 1].pose().x_m(),
                                    tel[i].pose().y_m() - tel[i - 1].pose().y_m());
-    dist[i] = dist[i - 1] + (step < kMaxStepM ? step : 0.0);
+    dist[i] = dist[i - 1] + (step < kMaxOdometryStepM ? step : 0.0);
   }
   Samples s;
   const auto t0 = static_cast<int64_t>(tel.empty() ? 0 : tel.front().robot_time_us());
@@ -525,7 +523,7 @@ std::string gasMapScript(const std::string& png_path, const GasMapFigure& f) {
   }
   g << "EOD\n$path << EOD\n";
   for (std::size_t i : sampleIndices(f.path.size(), kMaxPoints)) {
-    if (i && std::hypot(f.path[i].x_m - f.path[i - 1].x_m, f.path[i].y_m - f.path[i - 1].y_m) > kMaxStepM) g << '\n';
+    if (i && std::hypot(f.path[i].x_m - f.path[i - 1].x_m, f.path[i].y_m - f.path[i - 1].y_m) > kMaxOdometryStepM) g << '\n';
     g << num(f.path[i].x_m) << ' ' << num(f.path[i].y_m) << '\n';
   }
   g << "EOD\n$walls << EOD\n";

@@ -5,12 +5,6 @@
 
 namespace inspect::server {
 
-namespace {
-// Odometry steps longer than this between two telemetry messages are a reset
-// or a reconnect, not motion (the robot's top speed is ~1 m/s, telemetry 50 Hz).
-constexpr double kMaxStepM = 0.5;
-}  // namespace
-
 void RunStats::add(const v1::Telemetry& t) {
   ++f_.telemetry;
   if (f_.telemetry == 1) first_us_ = t.robot_time_us();
@@ -18,7 +12,7 @@ void RunStats::add(const v1::Telemetry& t) {
   const double x = t.pose().x_m(), y = t.pose().y_m();
   if (have_pose_) {
     const double step = std::hypot(x - last_x_, y - last_y_);
-    if (step < kMaxStepM) f_.distance_m += step;
+    if (step < kMaxOdometryStepM) f_.distance_m += step;
   }
   have_pose_ = true;
   last_x_ = x;

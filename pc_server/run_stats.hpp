@@ -9,6 +9,10 @@
 
 namespace inspect::server {
 
+/// Odometry steps longer than this between two telemetry messages are a reset
+/// or a reconnect, not motion (the robot's top speed is ~1 m/s, telemetry 50 Hz).
+inline constexpr double kMaxOdometryStepM = 0.5;
+
 struct GasFigures {
   int channel = 0;
   double max = 0;

@@ -37,7 +37,6 @@ namespace inspect::server {
 namespace asio = boost::asio;
 
 namespace {
-constexpr std::string_view kTag = "pc_server";
 constexpr const char* kDefaultConfig = "config/server.yaml";
 constexpr int kIoThreads = 2;
 // The console thread checks in every 20-50 ms; a stall this long means it hangs.
@@ -113,7 +112,7 @@ int runServer(const CliOptions& options) {
   if (mode != ConsoleMode::kNone) link.setConsoleWatchdog(kConsoleWatchdog);
   const auto endpoint = link.listen();
   if (config.tls.plaintext) {
-    log::warn(kTag, net::kPlaintextWarning);
+    log::warn(log::tag::kServer, net::kPlaintextWarning);
     std::cerr << "pc_server: " << net::kPlaintextWarning << std::endl;
   }
   std::cout << "pc_server: listening on " << endpoint.address().to_string() << ":" << endpoint.port()
@@ -180,12 +179,12 @@ int runServer(const CliOptions& options) {
       if (ec) return;
       if (sig == SIGINT && stop.interrupt()) {
         // A console job (tune) takes Ctrl-C as "cancel, keep the best so far".
-        log::info(kTag, "SIGINT: cancelling the running console job (Ctrl-C again to shut down)");
+        log::info(log::tag::kServer, "SIGINT: cancelling the running console job (Ctrl-C again to shut down)");
         stop.setInterruptTarget(nullptr);
         wait_signal();
         return;
       }
-      log::info(kTag, "signal ", sig == SIGINT ? "SIGINT" : "SIGTERM", ": shutting down");
+      log::info(log::tag::kServer, "signal ", sig == SIGINT ? "SIGINT" : "SIGTERM", ": shutting down");
       stop.request();
     });
   };
@@ -253,9 +252,9 @@ int runServer(const CliOptions& options) {
   }
   std::cout.flush();
 
-  log::info(kTag, "stopping: closing robot sessions");
+  log::info(log::tag::kServer, "stopping: closing robot sessions");
   link.stop();
-  if (!link.waitAllClosed(std::chrono::seconds(1))) log::warn(kTag, "some sessions did not close within 1 s");
+  if (!link.waitAllClosed(std::chrono::seconds(1))) log::warn(log::tag::kServer, "some sessions did not close within 1 s");
   asio::post(ioc, [&signals, &record_timer] {
     boost::system::error_code ignored;
     signals.cancel(ignored);

@@ -20,7 +20,6 @@ namespace inspect::server {
 namespace asio = boost::asio;
 
 namespace {
-constexpr std::string_view kTag = "video";
 constexpr std::size_t kOffsetSamples = 250;  // 5 s of telemetry at 50 Hz
 
 std::string hostOf(const std::string& address) {
@@ -115,7 +114,7 @@ void VideoHub::onTelemetry(const std::string& robot_id, const std::string& addre
       r.sdp_path = config_.dir + "/" + robot_id + ".sdp";
       writeSdp(robot_id, r, false);
     }
-    log::info(kTag, robot_id, ": stream SSRC ", r.ssrc, " from ", ip,
+    log::info(log::tag::kVideo, robot_id, ": stream SSRC ", r.ssrc, " from ", ip,
               r.forward_port ? ", forwarded to 127.0.0.1:" + std::to_string(r.forward_port) : std::string(),
               "; play with: ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay ", r.sdp_path);
   } else if (std::abs(offset - r.offset_us) > 200) {
@@ -131,7 +130,7 @@ void VideoHub::writeSdp(const std::string& robot_id, Robot& r, bool with_params)
   p.port = r.forward_port;
   if (with_params && receiver_->parameterSets(robot_id, p.sps, p.pps)) r.sdp_has_params = true;
   if (const auto why = writeFileAtomically(r.sdp_path, video::makeSdp(p)); !why.empty())
-    log::warn(kTag, robot_id, ": SDP: ", why);
+    log::warn(log::tag::kVideo, robot_id, ": SDP: ", why);
 }
 
 void VideoHub::forward(const std::string& robot_id, const std::vector<uint8_t>& datagram) {
@@ -161,7 +160,7 @@ void VideoHub::onFrame(const std::string& robot_id, const cv::Mat& bgr, uint64_t
       latest = config_.dir + "/" + robot_id + "_latest.png";
     }
   }
-  if (!latest.empty() && !writePng(latest, bgr)) log::warn(kTag, robot_id, ": cannot write ", latest);
+  if (!latest.empty() && !writePng(latest, bgr)) log::warn(log::tag::kVideo, robot_id, ": cannot write ", latest);
 }
 
 std::optional<video::StreamStats> VideoHub::stats(const std::string& robot_id) const {
@@ -222,7 +221,7 @@ void VideoHub::windowLoop() {
     }
     cv::destroyAllWindows();
   } catch (const cv::Exception& e) {
-    log::warn(kTag, "no video window (", e.what(), "): PNG snapshots instead");
+    log::warn(log::tag::kVideo, "no video window (", e.what(), "): PNG snapshots instead");
   }
   window_running_ = false;
 }

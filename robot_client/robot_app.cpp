@@ -16,10 +16,6 @@ namespace asio = boost::asio;
 using std::chrono::steady_clock;
 
 namespace {
-steady_clock::duration secs(double s) {
-  return std::chrono::duration_cast<steady_clock::duration>(std::chrono::duration<double>(s));
-}
-
 video::SenderSettings senderSettings(const ClientConfig& cfg) {
   const VideoParams& v = cfg.video;
   video::SenderSettings s;
@@ -262,7 +258,7 @@ void RobotApp::sendTelemetry() {
     fillVideoStatus(*telemetry_env_.mutable_telemetry());
     link_.send(telemetry_env_);
   }
-  telemetry_timer_.expires_after(secs(1.0 / cfg_.telemetry_hz));
+  telemetry_timer_.expires_after(steadyDuration(1.0 / cfg_.telemetry_hz));
   telemetry_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (!ec) sendTelemetry();
   });
@@ -270,7 +266,7 @@ void RobotApp::sendTelemetry() {
 
 void RobotApp::mcuHeartbeat() {
   if (serial_.isOpen()) serial_.send(serial::Heartbeat{static_cast<uint32_t>(now() * 1000.0)});
-  mcu_hb_timer_.expires_after(secs(cfg_.mcu_heartbeat_period_s));
+  mcu_hb_timer_.expires_after(steadyDuration(cfg_.mcu_heartbeat_period_s));
   mcu_hb_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (!ec) mcuHeartbeat();
   });

@@ -16,9 +16,6 @@ using asio::ip::tcp;
 
 namespace {
 constexpr std::size_t kMaxQueued = 256;
-std::chrono::steady_clock::duration secs(double s) {
-  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(s));
-}
 }  // namespace
 
 ServerLink::ServerLink(asio::io_context& io, const ClientConfig& cfg)
@@ -78,7 +75,7 @@ void ServerLink::onTcpConnected() {
   stream_->socket().set_option(tcp::no_delay(true), ec);
   const uint64_t gen = generation_;
   // One deadline for the TLS handshake and the HelloReply.
-  handshake_timer_.expires_after(secs(cfg_.handshake_timeout_s));
+  handshake_timer_.expires_after(steadyDuration(cfg_.handshake_timeout_s));
   handshake_timer_.async_wait([this, gen](const boost::system::error_code& e) {
     if (!e && gen == generation_ && !up_)
       close("no handshake reply within " + std::to_string(cfg_.handshake_timeout_s) + " s");
@@ -117,7 +114,7 @@ void ServerLink::onConnected() {
 
 void ServerLink::scheduleReconnect() {
   if (stopped_) return;
-  retry_timer_.expires_after(secs(backoff_s_));
+  retry_timer_.expires_after(steadyDuration(backoff_s_));
   backoff_s_ = std::min(backoff_s_ * 2.0, cfg_.reconnect_max_s);
   retry_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (!ec) connect();
@@ -208,7 +205,7 @@ void ServerLink::heartbeat() {
   env.mutable_heartbeat()->set_time_us(monoNowUs());
   send(env);
   const uint64_t gen = generation_;
-  heartbeat_timer_.expires_after(secs(cfg_.server_heartbeat_period_s));
+  heartbeat_timer_.expires_after(steadyDuration(cfg_.server_heartbeat_period_s));
   heartbeat_timer_.async_wait([this, gen](const boost::system::error_code& ec) {
     if (!ec && gen == generation_) heartbeat();
   });

@@ -1,14 +1,26 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the whole test suite through ctest.
-# Then a second stage (docs/testing.md): the sanitizer build in build-asan/
-# (clang, AddressSanitizer + UndefinedBehaviorSanitizer, libFuzzer) builds
-# the fuzz harnesses and the fast unit-level test programs and runs them:
-# each harness for a short while from its seed corpus (ctest label `fuzz`)
-# and those programs' tests (label `sanitize`). INSPECT_SKIP_SANITIZE=1 skips
-# the second stage. Arguments go to the first stage's ctest. Exits non-zero
-# when either stage fails.
+# Installs what is missing, builds, and runs the whole test suite through
+# ctest, in two stages (docs/testing.md):
+#   1. the normal build (g++, build/) and every test but the long ones
+#      (ctest -L long runs those by hand), in parallel: ctest -j <3 x cores>,
+#      the unit-level tests at low CPU priority beside the real-time stack
+#      tests (tests/InspectTest.cmake says how tests are scheduled);
+#   2. the sanitizer build (clang, ASan + UBSan, build-asan/): the fuzz
+#      harnesses, each for a short while from its seed corpus (label `fuzz`),
+#      and the unit-level test programs chosen for it (label `sanitize`).
+#
+#   scripts/test.sh [--quick] [ctest arguments...]
+#
+# --quick: the inner loop: builds and runs the unit-level tests only (label
+# `unit`: no stack tests, no benchmarks, no sanitizer stage).
+# INSPECT_SKIP_SANITIZE=1 skips the second stage. Other arguments go to the
+# first stage's ctest (-R, -L, ...). Prints the time of every step and the
+# compiler cache's hit rate of each build; exits non-zero when a stage fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+quick=0
+if [ "${1:-}" = --quick ]; then quick=1; shift; fi
+jobs=$((3 * $(nproc)))
 
 # After both stages: the tests that failed in build dir $1 and the last lines
 # of each one's output, so that the end of the log (all a CI viewer may keep)
@@ -31,49 +43,65 @@ report_failures() {
   return 0
 }
 
-# --- stage 1: the normal build (g++) and the whole suite ---------------------
-start=$(date +%s)
-bash scripts/setup.sh
-bash scripts/build.sh
-built=$(date +%s)
-echo "test: build took $((built - start)) s"
-stage1=0
-rm -f "${BUILD_DIR:-build}/Testing/Temporary/LastTestsFailed.log"
-(cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j "$(nproc)" "$@") || stage1=$?
-done1=$(date +%s)
-echo "test: suite took $((done1 - built)) s"
-summary1="stage 1 (g++ build, whole suite): $([ $stage1 -eq 0 ] && echo passed || echo FAILED),"
-summary1+=" build $((built - start)) s, tests $((done1 - built)) s"
+# The "ccache hits ..." figure of the build whose output is in $1.
+hits_of() { sed -n 's/^build: .*: ccache hits \(.*\)$/\1/p; s/^build: .*: no ccache.*$/no ccache/p' "$1" | tail -n 1; }
 
-# --- stage 2: sanitizers and fuzzing (clang) -----------------------------------
+t0=$(date +%s)
+bash scripts/setup.sh
+t_setup=$(date +%s)
+echo "test: setup took $((t_setup - t0)) s"
+
+# --- stage 1: the normal build (g++) and the suite -----------------------------
+BUILD=${BUILD_DIR:-build}
+log1=$(mktemp)
+stage1=0
+bash scripts/build.sh 2>&1 | tee "$log1" || stage1=$?
+t_built=$(date +%s)
+hits1=$(hits_of "$log1")
+echo "test: build took $((t_built - t_setup)) s (ccache hits ${hits1:-?})"
+if [ $quick -eq 1 ]; then
+  labels=(-L '^unit$')
+else
+  labels=(-LE '^long$')
+fi
+rm -f "$BUILD/Testing/Temporary/LastTestsFailed.log"
+if [ $stage1 -eq 0 ]; then
+  (cd "$BUILD" && ctest --output-on-failure -j "$jobs" "${labels[@]}" "$@") || stage1=$?
+fi
+t_suite=$(date +%s)
+echo "test: suite took $((t_suite - t_built)) s"
+summary1="stage 1 (g++ build, $([ $quick -eq 1 ] && echo 'unit tests' || echo 'whole suite')):"
+summary1+=" $([ $stage1 -eq 0 ] && echo passed || echo FAILED), build $((t_built - t_setup)) s"
+summary1+=" (ccache hits ${hits1:-?}), tests $((t_suite - t_built)) s"
+
+# --- stage 2: sanitizers and fuzzing (clang) -------------------------------------
 stage2=0
-if [ "${INSPECT_SKIP_SANITIZE:-0}" = 1 ]; then
+ASAN_DIR=${ASAN_BUILD_DIR:-build-asan}
+if [ $quick -eq 1 ]; then
+  summary2="stage 2 (ASan+UBSan build, fuzz + unit tests): skipped (--quick)"
+elif [ "${INSPECT_SKIP_SANITIZE:-0}" = 1 ]; then
   summary2="stage 2 (ASan+UBSan build, fuzz + unit tests): skipped (INSPECT_SKIP_SANITIZE=1)"
 else
-  ASAN_DIR=${ASAN_BUILD_DIR:-build-asan}
-  if [ ! -f "$ASAN_DIR/build.ninja" ]; then
-    # -O1 with line tables: quicker to build than -O2 -g, still readable stacks; asserts on.
-    CC=clang CXX=clang++ cmake -S . -B "$ASAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-      "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
-      -DINSPECT_FUZZ=ON -DINSPECT_SANITIZE=address,undefined || stage2=$?
-  fi
-  # sanitize_tests (tests/fuzz/CMakeLists.txt): the harnesses and the selected test programs.
-  [ $stage2 -ne 0 ] || cmake --build "$ASAN_DIR" -j "$(nproc)" --target sanitize_tests || stage2=$?
-  built2=$(date +%s)
-  echo "test: sanitizer build took $((built2 - done1)) s"
+  log2=$(mktemp)
+  # sanitize_tests (tests/fuzz/CMakeLists.txt): the harnesses and the chosen test programs.
+  bash scripts/build.sh --sanitize --target sanitize_tests 2>&1 | tee "$log2" || stage2=$?
+  t_built2=$(date +%s)
+  hits2=$(hits_of "$log2")
+  echo "test: sanitizer build took $((t_built2 - t_suite)) s (ccache hits ${hits2:-?})"
   if [ $stage2 -eq 0 ]; then
     export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
     rm -f "$ASAN_DIR/Testing/Temporary/LastTestsFailed.log"
     (cd "$ASAN_DIR" && ctest --output-on-failure -j "$(nproc)" -L '^(fuzz|sanitize)$') || stage2=$?
   fi
-  done2=$(date +%s)
-  echo "test: sanitizer tests took $((done2 - built2)) s"
+  t_done2=$(date +%s)
+  echo "test: sanitizer tests took $((t_done2 - t_built2)) s"
   summary2="stage 2 (ASan+UBSan build, fuzz + unit tests): $([ $stage2 -eq 0 ] && echo passed || echo FAILED),"
-  summary2+=" build $((built2 - done1)) s, tests $((done2 - built2)) s"
+  summary2+=" build $((t_built2 - t_suite)) s (ccache hits ${hits2:-?}), tests $((t_done2 - t_built2)) s"
 fi
 
-[ $stage1 -eq 0 ] || report_failures "${BUILD_DIR:-build}" 1
-[ $stage2 -eq 0 ] || [ "${INSPECT_SKIP_SANITIZE:-0}" = 1 ] || report_failures "${ASAN_DIR}" 2
+[ $stage1 -eq 0 ] || report_failures "$BUILD" 1
+[ $stage2 -eq 0 ] || [ -z "${log2:-}" ] || report_failures "$ASAN_DIR" 2
+echo "test: setup $((t_setup - t0)) s, all $(($(date +%s) - t0)) s"
 echo "test: $summary1"
 echo "test: $summary2"
 [ $stage1 -eq 0 ] && [ $stage2 -eq 0 ]

@@ -1,6 +1,8 @@
 // Plant identification (method in plant_id.hpp), the run reader and the plant file.
 #include "pc_server/tuning/plant_id.hpp"
 
+#include "pc_server/tuning/number_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -31,11 +33,6 @@ constexpr double kSaturationGainNeeded = 0.9;  // a saturation is kept when the 
 constexpr double kSaturationBelow = 0.95;      // ... and it lies below this x the largest command
 constexpr int kPlateauWindow = 5;              // samples averaged for the plateau (0.1 s at 50 Hz)
 
-std::string fmt(double v, int precision = 4) {
-  std::ostringstream os;
-  os << std::setprecision(precision) << v;
-  return os.str();
-}
 
 // One stretch between gaps on the uniform grid.
 struct Stretch {
@@ -76,24 +73,24 @@ Grid prepare(const std::string& wheel, const WheelSeries& s, const IdentifyOptio
                                                    : !std::isfinite(y[i]) ? "measured_rad_s" : nullptr;
     if (bad) fail(wheel, std::string(bad) + " of sample " + std::to_string(i) + " is not finite");
     if (i > 0 && t[i] < t[i - 1])
-      fail(wheel, "time goes backwards at sample " + std::to_string(i) + " (" + fmt(t[i], 9) + " s after " +
-                      fmt(t[i - 1], 9) + " s)");
+      fail(wheel, "time goes backwards at sample " + std::to_string(i) + " (" + significant(t[i], 9) + " s after " +
+                      significant(t[i - 1], 9) + " s)");
     if (i > 0 && t[i] == t[i - 1])
-      fail(wheel, "time repeats at sample " + std::to_string(i) + " (" + fmt(t[i], 9) + " s)");
+      fail(wheel, "time repeats at sample " + std::to_string(i) + " (" + significant(t[i], 9) + " s)");
   }
   Grid g;
   for (double v : u) g.max_abs_command = std::max(g.max_abs_command, std::abs(v));
   if (!(g.max_abs_command > o.min_excitation_rad_s))
-    fail(wheel, "no excitation: the command never exceeds " + fmt(o.min_excitation_rad_s) + " rad/s");
+    fail(wheel, "no excitation: the command never exceeds " + significant(o.min_excitation_rad_s, 4) + " rad/s");
   const double y_lo = *std::min_element(y.begin(), y.end()), y_hi = *std::max_element(y.begin(), y.end());
   if (y_hi - y_lo < 1e-9)
-    fail(wheel, "the measured speed never changes (" + fmt(y_lo) + " rad/s): did the wheel move?");
+    fail(wheel, "the measured speed never changes (" + significant(y_lo, 4) + " rad/s): did the wheel move?");
 
   std::vector<double> dt(t.size() - 1);
   for (std::size_t i = 1; i < t.size(); ++i) dt[i - 1] = t[i] - t[i - 1];
   g.h_s = median(dt);
   if (g.h_s > o.max_gap_s)
-    fail(wheel, "the median sample interval (" + fmt(g.h_s) + " s) is longer than max_gap_s (" + fmt(o.max_gap_s) +
+    fail(wheel, "the median sample interval (" + significant(g.h_s, 4) + " s) is longer than max_gap_s (" + significant(o.max_gap_s, 4) +
                     " s)");
 
   // Split at gaps, then interpolate each stretch onto its own grid t0 + j h.
@@ -124,7 +121,7 @@ Grid prepare(const std::string& wheel, const WheelSeries& s, const IdentifyOptio
     begin = i;
   }
   if (g.points < kMinSamples)
-    fail(wheel, "too few samples between gaps longer than " + fmt(o.max_gap_s) + " s (" + std::to_string(g.points) +
+    fail(wheel, "too few samples between gaps longer than " + significant(o.max_gap_s, 4) + " s (" + std::to_string(g.points) +
                     " on the grid; at least " + std::to_string(kMinSamples) + " needed)");
   return g;
 }
@@ -350,16 +347,16 @@ WheelFit fitWheel(const std::string& wheel, const Grid& g, const IdentifyOptions
   fit.fit_percent = 100.0 * (1.0 - std::sqrt(sse / spread));  // spread > 0: the speed changes (checked)
 
   if (fit.fit_percent < kFitWarnPercent)
-    warnings.push_back(wheel + " wheel: fit " + fmt(fit.fit_percent, 3) + " % is below " + fmt(kFitWarnPercent) +
+    warnings.push_back(wheel + " wheel: fit " + significant(fit.fit_percent, 3) + " % is below " + significant(kFitWarnPercent, 4) +
                        " %: the model reproduces the run poorly (slip, load changes, a non-linear motor?)");
   if (g.excited_s < kMinExcitedTime_s)
-    warnings.push_back(wheel + " wheel: barely excited (" + fmt(g.excited_s, 3) + " s with |command| above " +
-                       fmt(o.min_excitation_rad_s) + " rad/s; the figures are uncertain)");
+    warnings.push_back(wheel + " wheel: barely excited (" + significant(g.excited_s, 3) + " s with |command| above " +
+                       significant(o.min_excitation_rad_s, 4) + " rad/s; the figures are uncertain)");
   if (o.max_dead_time_s > 0.0 && best.dead_s > o.max_dead_time_s - 0.5 * kDeadTimeStep_s)
-    warnings.push_back(wheel + " wheel: the dead time is at the search limit (" + fmt(o.max_dead_time_s) +
+    warnings.push_back(wheel + " wheel: the dead time is at the search limit (" + significant(o.max_dead_time_s, 4) +
                        " s): raise max_dead_time_s or check the recording");
   if (g.gaps > 0)
-    warnings.push_back(wheel + " wheel: " + std::to_string(g.gaps) + " gap(s) longer than " + fmt(o.max_gap_s) +
+    warnings.push_back(wheel + " wheel: " + std::to_string(g.gaps) + " gap(s) longer than " + significant(o.max_gap_s, 4) +
                        " s (link loss?); each stretch is simulated from its first sample");
   return fit;
 }
@@ -418,8 +415,8 @@ PlantFit identifyPlant(const WheelSeries& left, const WheelSeries& right, const 
   const double gmax = std::max(out.left.model.gain, out.right.model.gain);
   const double gmin = std::min(out.left.model.gain, out.right.model.gain);
   if (gmax > kGainRatioWarn * gmin)
-    out.warnings.push_back("the wheels' gains differ by more than 20 % (left " + fmt(out.left.model.gain) + ", right " +
-                           fmt(out.right.model.gain) + "): a worn or dragging motor?");
+    out.warnings.push_back("the wheels' gains differ by more than 20 % (left " + significant(out.left.model.gain, 4) + ", right " +
+                           significant(out.right.model.gain, 4) + "): a worn or dragging motor?");
   return out;
 }
 

@@ -2,6 +2,8 @@
 // worker pool and the two-phase NLopt search.
 #include "pc_server/tuning/tuner.hpp"
 
+#include "pc_server/tuning/number_text.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -168,11 +170,6 @@ bool isGainName(const std::string& name) {
                      [&](const char* n) { return name == n; });
 }
 
-std::string fmt(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 nlopt::algorithm globalAlgorithm(const std::string& name) {
   if (name == "GN_CRS2_LM") return nlopt::GN_CRS2_LM;
@@ -203,13 +200,13 @@ void validateSetup(const TuneSetup& s) {
     if (!isGainName(name))
       throw std::invalid_argument("bounds given for unknown parameter '" + name + "' (known: " + joinedGainNames() + ")");
     if (!std::isfinite(b.first) || !std::isfinite(b.second) || !(b.first < b.second))
-      throw std::invalid_argument("bounds of " + name + " [" + fmt(b.first) + ", " + fmt(b.second) +
+      throw std::invalid_argument("bounds of " + name + " [" + significant(b.first, 6) + ", " + significant(b.second, 6) +
                                   "] must be finite with lo < hi");
     double lo = 0, hi = 0;
     control::gainBounds(name, lo, hi);
     if (b.first < lo || b.second > hi)
-      throw std::invalid_argument("bounds of " + name + " [" + fmt(b.first) + ", " + fmt(b.second) +
-                                  "] are outside the allowed range [" + fmt(lo) + ", " + fmt(hi) + "]");
+      throw std::invalid_argument("bounds of " + name + " [" + significant(b.first, 6) + ", " + significant(b.second, 6) +
+                                  "] are outside the allowed range [" + significant(lo, 6) + ", " + significant(hi, 6) + "]");
   }
   if (const auto e = control::validatePlant(s.plant); !e.empty()) throw std::invalid_argument("plant: " + e);
   if (s.plant_variations < 1)
@@ -218,20 +215,20 @@ void validateSetup(const TuneSetup& s) {
   if (s.max_evals < 10) throw std::invalid_argument("max_evals = " + std::to_string(s.max_evals) + " must be >= 10");
   if (s.threads < 0) throw std::invalid_argument("threads = " + std::to_string(s.threads) + " must be >= 0");
   if (!(s.gain_spread >= 0 && s.gain_spread < 1))
-    throw std::invalid_argument("gain_spread = " + fmt(s.gain_spread) + " must be in [0, 1)");
+    throw std::invalid_argument("gain_spread = " + significant(s.gain_spread, 6) + " must be in [0, 1)");
   if (!(s.tau_spread >= 0 && s.tau_spread < 1))
-    throw std::invalid_argument("tau_spread = " + fmt(s.tau_spread) + " must be in [0, 1)");
+    throw std::invalid_argument("tau_spread = " + significant(s.tau_spread, 6) + " must be in [0, 1)");
   if (!(s.dead_spread_s >= 0 && s.dead_spread_s <= 1))
-    throw std::invalid_argument("dead_spread_s = " + fmt(s.dead_spread_s) + " must be in [0, 1]");
+    throw std::invalid_argument("dead_spread_s = " + significant(s.dead_spread_s, 6) + " must be in [0, 1]");
   if (!(s.global_fraction >= 0 && s.global_fraction <= 1))
-    throw std::invalid_argument("global_fraction = " + fmt(s.global_fraction) + " must be in [0, 1]");
+    throw std::invalid_argument("global_fraction = " + significant(s.global_fraction, 6) + " must be in [0, 1]");
   const CostWeights& w = s.weights;
   for (const auto& [name, v] : {std::pair{"max_pos", w.max_pos}, std::pair{"rms_pos", w.rms_pos},
                                 std::pair{"max_ang", w.max_ang}, std::pair{"rms_ang", w.rms_ang},
                                 std::pair{"convergence", w.convergence}, std::pair{"effort", w.effort},
                                 std::pair{"saturation", w.saturation}})
     if (!(std::isfinite(v) && v >= 0))
-      throw std::invalid_argument(std::string("weight ") + name + " = " + fmt(v) + " must be finite and >= 0");
+      throw std::invalid_argument(std::string("weight ") + name + " = " + significant(v, 6) + " must be finite and >= 0");
   globalAlgorithm(s.global_algorithm);
   localAlgorithm(s.local_algorithm);
 }

@@ -35,7 +35,7 @@ constexpr const char* kPalette[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", 
 
 const char* colorOf(std::size_t i) { return kPalette[i % std::size(kPalette)]; }
 
-std::string fmt(double v, int decimals) {
+std::string fmtOrNotConverged(double v, int decimals) {
   if (std::isnan(v)) return "not conv.";
   char b[48];
   std::snprintf(b, sizeof b, "%.*f", decimals, v);
@@ -162,7 +162,7 @@ plot::Panel errorPanel(const Comparison& c, bool position) {
     const double t = position ? positionConvergence(row.trace) : angleConvergence(row.trace);
     if (std::isnan(t) || t <= 0) continue;
     const double top = position ? row.trace.metrics.max_pos_err_m : row.trace.metrics.max_ang_err_rad;
-    auto m = series(row.label + " converged at " + fmt(t, 2) + " s", colorOf(i));
+    auto m = series(row.label + " converged at " + fmtOrNotConverged(t, 2) + " s", colorOf(i));
     m.style = "lines dt 3";
     m.x = {t, t};
     m.y = {0.0, top};
@@ -221,10 +221,10 @@ plot::Panel costPanel(const TuneResult& result) {
     s.y.push_back(result.best_cost_history[i]);
   }
   const double n = std::max<double>(1.0, static_cast<double>(result.best_cost_history.size()));
-  auto initial = series("initial gains: " + fmt(result.initial_eval.cost, 3), "#7f7f7f", 1, true);
+  auto initial = series("initial gains: " + fmtOrNotConverged(result.initial_eval.cost, 3), "#7f7f7f", 1, true);
   initial.x = {1.0, n};
   initial.y = {result.initial_eval.cost, result.initial_eval.cost};
-  auto best = series("best: " + fmt(result.best_eval.cost, 3), "#2ca02c", 1, true);
+  auto best = series("best: " + fmtOrNotConverged(result.best_eval.cost, 3), "#2ca02c", 1, true);
   best.x = {1.0, n};
   best.y = {result.best_eval.cost, result.best_eval.cost};
   // From 0, with room above the highest line for the key; a far worse start is clipped so that the descent
@@ -364,10 +364,10 @@ std::string comparisonTable(const Comparison& c) {
   os << "Reference: " << c.reference << "\nPlant: " << c.plant_description << "\n";
   line("metric", [&](std::size_t i) { return c.rows[i].label; });
   os << "-- the plant tuned for, noise seed 1 --\n";
-  for (const auto& r : kRows) line(r.label, [&](std::size_t i) { return fmt(r.value(c.rows[i]), r.decimals); });
+  for (const auto& r : kRows) line(r.label, [&](std::size_t i) { return fmtOrNotConverged(r.value(c.rows[i]), r.decimals); });
   os << "-- over " << scenarios << " scenario(s) (plant variations x noise seeds) --\n";
   for (const auto& r : kRobustRows)
-    line(r.label, [&](std::size_t i) { return fmt(r.value(c.rows[i]), r.decimals); });
+    line(r.label, [&](std::size_t i) { return fmtOrNotConverged(r.value(c.rows[i]), r.decimals); });
   return os.str();
 }
 
@@ -510,12 +510,12 @@ SessionFiles writeTuningSession(const std::string& dir, const TuneSetup& setup, 
     md << "- Scenarios per evaluation: " << describeScenarios(setup, scenarios) << "; seed " << setup.seed << "\n";
     md << "- Algorithm: " << (result.algorithm.empty() ? "-" : result.algorithm) << "; evaluations: " << result.evals
        << " of at most " << setup.max_evals << " (global share " << fmtG(setup.global_fraction) << "); wall time "
-       << fmt(result.wall_s, 1) << " s; " << (result.cancelled ? "**cancelled** (best so far kept)" : "not cancelled")
+       << fmtOrNotConverged(result.wall_s, 1) << " s; " << (result.cancelled ? "**cancelled** (best so far kept)" : "not cancelled")
        << "\n";
     md << "- Cost: " << fmtG(result.initial_eval.cost) << " (initial gains) -> " << fmtG(result.best_eval.cost)
        << " (best)";
     if (result.initial_eval.cost > 0 && std::isfinite(result.initial_eval.cost))
-      md << ", " << fmt(100.0 * (result.initial_eval.cost - result.best_eval.cost) / result.initial_eval.cost, 1)
+      md << ", " << fmtOrNotConverged(100.0 * (result.initial_eval.cost - result.best_eval.cost) / result.initial_eval.cost, 1)
          << " % lower";
     md << "\n\n";
 

@@ -1,5 +1,7 @@
 #include "shared/record/mcap_reader.hpp"
 
+#include "shared/record/mcap_format.hpp"
+
 #include <zlib.h>
 #include <zstd.h>
 
@@ -21,10 +23,7 @@ namespace {
 
 namespace pb = google::protobuf;
 
-constexpr std::string_view kMagic("\x89MCAP0\r\n", 8);
-constexpr uint64_t kPrefix = 9;  // opcode u8 + content length u64
-enum : uint8_t { kHeader = 0x01, kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kChunk = 0x06 };
-constexpr uint8_t kDataEnd = 0x0F;
+using namespace mcap;  // the format's magic, opcodes and record sizes
 constexpr uint64_t kMaxChunk = uint64_t{1} << 34;  // a larger uncompressed size is taken for corruption
 
 uint32_t crcOf(std::string_view s) {
@@ -69,14 +68,14 @@ struct In {
   // A record prefix at the front, or nullopt-like false when `s` ends inside
   // the record (op and content then untouched).
   bool record(uint8_t& op, In& content) {
-    if (s.size() < kPrefix) return false;
-    In p{s.substr(0, kPrefix)};
+    if (s.size() < kRecordPrefix) return false;
+    In p{s.substr(0, kRecordPrefix)};
     const auto o = static_cast<uint8_t>(p.num(1));
     const uint64_t len = p.u64();
-    if (len > s.size() - kPrefix) return false;
+    if (len > s.size() - kRecordPrefix) return false;
     op = o;
-    content = In{s.substr(kPrefix, len)};
-    s.remove_prefix(kPrefix + len);
+    content = In{s.substr(kRecordPrefix, len)};
+    s.remove_prefix(kRecordPrefix + len);
     return true;
   }
 };

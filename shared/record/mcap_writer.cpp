@@ -1,5 +1,7 @@
 #include "shared/record/mcap_writer.hpp"
 
+#include "shared/record/mcap_format.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -30,25 +32,7 @@
 namespace inspect::record {
 namespace {
 
-constexpr std::string_view kMagic("\x89MCAP0\r\n", 8);
-
-// Record opcodes (spec "Records").
-enum Op : uint8_t {
-  kHeader = 0x01,
-  kFooter = 0x02,
-  kSchema = 0x03,
-  kChannel = 0x04,
-  kMessage = 0x05,
-  kChunk = 0x06,
-  kMessageIndex = 0x07,
-  kChunkIndex = 0x08,
-  kStatistics = 0x0B,
-  kSummaryOffset = 0x0E,
-  kDataEnd = 0x0F,
-};
-
-constexpr uint64_t kRecordPrefix = 9;                 // opcode u8 + content length u64
-constexpr uint64_t kFooterRecord = kRecordPrefix + 20;  // summary_start, summary_offset_start, summary_crc
+using namespace mcap;  // the format's magic, opcodes and record sizes
 
 std::string defaultLibrary() { return "inspect_robot " INSPECT_VERSION; }
 

@@ -12,4 +12,9 @@ inline int64_t monoNowNs() {
 }
 inline uint64_t monoNowUs() { return static_cast<uint64_t>(monoNowNs() / 1000); }
 
+/// Seconds as a steady_clock duration (for timers).
+inline std::chrono::steady_clock::duration steadyDuration(double seconds) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+}
+
 }  // namespace inspect

@@ -21,6 +21,15 @@ void logf(Level l, std::string_view tag, const A&... a) {
   (os << ... << a);
   write(l, tag, os.str());
 }
+/// The tags of the components that log from several files.
+namespace tag {
+inline constexpr std::string_view kLink = "link";
+inline constexpr std::string_view kOperator = "operator";
+inline constexpr std::string_view kRecord = "record";
+inline constexpr std::string_view kServer = "pc_server";
+inline constexpr std::string_view kVideo = "video";
+}  // namespace tag
+
 template <class... A> void debug(std::string_view tag, const A&... a) { logf(Level::kDebug, tag, a...); }
 template <class... A> void info(std::string_view tag, const A&... a) { logf(Level::kInfo, tag, a...); }
 template <class... A> void warn(std::string_view tag, const A&... a) { logf(Level::kWarn, tag, a...); }

@@ -25,7 +25,6 @@ namespace inspect::video {
 
 namespace {
 
-constexpr const char* kTag = "video";
 constexpr AVRational kMicros{1, 1'000'000};
 constexpr AVRational kTimeBase{1, static_cast<int>(kClockRate)};  // 90 kHz, as RTP
 // Fragmented from the start (an empty moov, then moof/mdat pairs), a fragment
@@ -184,7 +183,7 @@ struct Mp4Writer::Impl {
     files.push_back(path);
     ++c.files;
     c.bytes = closed_bytes + static_cast<uint64_t>(avio_tell(fmt->pb));
-    log::info(kTag, "recording ", path, " (", width, "x", height, ", fragmented MP4)");
+    log::info(log::tag::kVideo, "recording ", path, " (", width, "x", height, ", fragmented MP4)");
   }
 
   void release() {
@@ -201,7 +200,7 @@ struct Mp4Writer::Impl {
   void fail(const std::string& message) {
     if (error.empty()) {
       error = message;
-      log::error(kTag, message, "; recording stopped");
+      log::error(log::tag::kVideo, message, "; recording stopped");
     }
     release();
   }
@@ -303,7 +302,7 @@ struct Mp4Writer::Impl {
       }
       open(*ps, capture_us);  // throws: the first file
     } else if (ps && (ps->width != width || ps->height != height)) {
-      log::warn(kTag, files.back(), ": picture size ", width, "x", height, " -> ", ps->width, "x", ps->height,
+      log::warn(log::tag::kVideo, files.back(), ": picture size ", width, "x", height, " -> ", ps->width, "x", ps->height,
                 ", continuing in a new file");
       finishFile();
       if (!error.empty()) {

@@ -15,7 +15,6 @@ namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-constexpr std::string_view kTag = "video";
 constexpr std::size_t kMaxDatagram = 65536;
 constexpr auto kTick = std::chrono::milliseconds(100);
 constexpr int kTicksPerWindow = 10;            // rates over 1 s
@@ -106,7 +105,7 @@ void VideoReceiver::setStream(const std::string& name, uint32_t ssrc, const asio
     }
     s = std::make_unique<Stream>(ssrc, source, clock_offset_us, settings_.reorder_window, settings_.decode);
     s->st.ssrc = ssrc;
-    log::info(kTag, name, ": expecting SSRC ", ssrc, " from ", source.is_unspecified() ? "any address" : source.to_string());
+    log::info(log::tag::kVideo, name, ": expecting SSRC ", ssrc, " from ", source.is_unspecified() ? "any address" : source.to_string());
   });
 }
 
@@ -283,7 +282,7 @@ void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) 
     if (s.decoder->counters().errors > s.st.decode_errors) {
       s.st.decode_errors = s.decoder->counters().errors;
       s.damaged = true;
-      log::debug(kTag, name, ": decode error: ", s.decoder->lastError());
+      log::debug(log::tag::kVideo, name, ": decode error: ", s.decoder->lastError());
     }
     return;
   }

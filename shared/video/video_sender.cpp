@@ -16,7 +16,6 @@ namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-constexpr std::string_view kTag = "video";
 // IPv4 + UDP headers, the RTP header and the capture-time extension on a
 // frame's first packet (docs/video.md).
 constexpr std::size_t kOverhead = 28 + kRtpHeaderSize + 16;
@@ -132,7 +131,7 @@ void VideoSender::setError(const std::string& e) {
     if (st_.error == e) return;
     st_.error = e;
   }
-  log::warn(kTag, e);
+  log::warn(log::tag::kVideo, e);
 }
 
 void VideoSender::captureLoop() {
@@ -155,7 +154,7 @@ void VideoSender::captureLoop() {
         src = openFrameSource(ss);
         src_generation = gen;
         next = Clock::now();
-        log::info(kTag, "source ", src->describe(), " ", ss.width, "x", ss.height, " @ ", ss.fps, " fps");
+        log::info(log::tag::kVideo, "source ", src->describe(), " ", ss.width, "x", ss.height, " @ ", ss.fps, " fps");
       } catch (const VideoError& e) {
         src.reset();
         setError(e.what());
@@ -225,7 +224,7 @@ void VideoSender::encodeLoop() {
         enc = std::make_unique<H264Encoder>(es);
         enc_generation = gen;
         keyframe_requested_ = true;
-        log::info(kTag, "encoder ", enc->codecName(), " ", es.width, "x", es.height, " @ ", es.fps, " fps, ",
+        log::info(log::tag::kVideo, "encoder ", enc->codecName(), " ", es.width, "x", es.height, " @ ", es.fps, " fps, ",
                   es.bitrate_kbps, " kbit/s, GOP ", es.gop, es.intra_refresh ? ", intra refresh" : "");
       } catch (const VideoError& e) {
         enc.reset();

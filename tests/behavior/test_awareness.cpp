@@ -8,6 +8,7 @@
 
 #include "shared/behavior/human_awareness.hpp"
 #include "tests/behavior/sonar_echoes.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using behavior::AwarenessConfig;
@@ -19,7 +20,7 @@ using test::echoes;
 
 namespace {
 
-const std::string kFis = std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/speed_strategy.fis";
+const std::string kFis = inspect::test::srcPath("config/fuzzy/speed_strategy.fis");
 
 HumanAwareness make(SpeedPolicy policy, AwarenessConfig cfg = {}) {
   cfg.policy = policy;

@@ -26,13 +26,14 @@
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "shared/fuzzy/fis_writer.hpp"
+#include "tests/support/paths.hpp"
 
 namespace inspect::behavior {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kFisPath = std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/speed_strategy.fis";
+const std::string kFisPath = inspect::test::srcPath("config/fuzzy/speed_strategy.fis");
 constexpr std::array<Pattern, 4> kPatterns{Pattern::kCrossing, Pattern::kEncountering, Pattern::kLeading,
                                            Pattern::kConfronting};
 constexpr double kSlack = 1e-9;  // numerical slack of the monotonicity checks
@@ -373,7 +374,7 @@ TEST(SpeedStrategy, RejectsSystemsOfTheWrongShape) {
       EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
     }
   };
-  expectFisError(fuzzy::readFisFile(std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/fuzzy_pid.fis"), "Sugeno");
+  expectFisError(fuzzy::readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")), "Sugeno");
   fuzzy::Fis missing = good;
   missing.rules.erase(missing.rules.begin() + 20);  // rule 21: DN VS BS
   expectFisError(missing, "no rule for DN and VS and BS");
@@ -396,7 +397,7 @@ TEST(SpeedStrategy, LoaderNamesTheFile) {
   } catch (const fuzzy::FisError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/speed.fis"), std::string::npos) << e.what();
   }
-  const std::string pid = std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/fuzzy_pid.fis";
+  const std::string pid = inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis");
   try {
     loadSpeedStrategy(pid);
     FAIL();

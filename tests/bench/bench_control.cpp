@@ -28,6 +28,7 @@
 
 #ifdef INSPECT_HAVE_FUZZYLITE
 #include <fl/Headers.h>
+#include "tests/support/paths.hpp"
 #endif
 
 namespace {
@@ -75,8 +76,8 @@ nlohmann::ordered_json numberOrNull(double v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string robot_path = std::string(INSPECT_SOURCE_DIR) + "/config/robot.yaml";
-  std::string control_path = std::string(INSPECT_SOURCE_DIR) + "/config/control.yaml";
+  std::string robot_path = inspect::test::srcPath("config/robot.yaml");
+  std::string control_path = inspect::test::srcPath("config/control.yaml");
   std::string json_path;
   int reps = 7;
   bool quick = false;

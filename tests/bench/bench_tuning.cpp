@@ -25,6 +25,7 @@
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "sim/robot_plant.hpp"
+#include "tests/support/paths.hpp"
 
 namespace {
 
@@ -98,8 +99,8 @@ nlohmann::ordered_json gainsJson(const control::GainSet& g) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string robot_path = std::string(INSPECT_SOURCE_DIR) + "/config/robot.yaml";
-  std::string control_path = std::string(INSPECT_SOURCE_DIR) + "/config/control.yaml";
+  std::string robot_path = inspect::test::srcPath("config/robot.yaml");
+  std::string control_path = inspect::test::srcPath("config/control.yaml");
   std::string json_path, plant_name = "nominal";
   int evals = -1, threads = 2, variations = -1, seeds = -1;
   bool quick = false, compare = false;

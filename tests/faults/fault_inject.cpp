@@ -41,7 +41,7 @@
 #include <vector>
 
 #include "shared/serial/frame_codec.hpp"
-#include "tests/integration/stack.hpp"
+#include "tests/support/stack.hpp"
 
 using namespace inspect::test;
 

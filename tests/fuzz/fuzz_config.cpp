@@ -22,12 +22,13 @@
 #include "shared/config/robot_config.hpp"
 #include "sim/world.hpp"
 #include "tests/fuzz/fuzz_records.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 
 namespace {
 
-const std::string kConfigDir = INSPECT_SOURCE_DIR "/config";
+const std::string kConfigDir = inspect::test::srcPath("config");
 
 template <class F>
 void tryLoad(const std::string& text, F&& load) {

@@ -44,6 +44,7 @@
 #include "shared/util/log.hpp"
 #include "sim/world.hpp"
 #include "tests/fuzz/fuzz_records.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 
@@ -143,7 +144,7 @@ struct Robot {
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   log::setLevel(log::Level::kError);
   google::protobuf::SetLogHandler([](google::protobuf::LogLevel, const char*, int, const std::string&) {});
-  const std::string dir = INSPECT_SOURCE_DIR "/config/";
+  const std::string dir = inspect::test::srcPath("config/");
   auto* s = new Setup;
   s->client = client::loadClientConfigFile(dir + "client.yaml");
   s->robot = config::loadRobotConfigFile(dir + "robot.yaml");

@@ -35,6 +35,7 @@
 #include "shared/video/h264_codec.hpp"
 #include "shared/video/rtp_h264.hpp"
 #include "tests/fuzz/fuzz_records.hpp"
+#include "tests/support/paths.hpp"
 
 namespace fs = std::filesystem;
 using namespace inspect;
@@ -42,7 +43,7 @@ using Bytes = std::vector<uint8_t>;
 
 namespace {
 
-const std::string kSrc = INSPECT_SOURCE_DIR;
+const std::string kSrc = inspect::test::sourceDir();
 fs::path g_out;
 
 void write(const std::string& corpus, const std::string& name, const Bytes& b) {

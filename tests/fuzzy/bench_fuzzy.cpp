@@ -22,6 +22,7 @@
 
 #ifdef INSPECT_HAVE_FUZZYLITE
 #include <fl/Headers.h>
+#include "tests/support/paths.hpp"
 #endif
 
 namespace {
@@ -65,7 +66,7 @@ Result timeIt(const std::string& name, long calls, int reps, const std::function
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string fis_path = std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/fuzzy_pid.fis";
+  std::string fis_path = inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis");
   std::string json_path;
   int reps = 7;
   bool quick = false;

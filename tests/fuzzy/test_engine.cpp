@@ -14,11 +14,11 @@
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "shared/fuzzy/lookup_surface.hpp"
+#include "tests/support/paths.hpp"
 
 namespace inspect::fuzzy {
 namespace {
 
-const std::string kSource = INSPECT_SOURCE_DIR;
 
 // One input x on [0 1] with lo/hi triangles; one output y with lo/hi
 // triangles; rules lo -> lo, hi -> hi. `system` replaces the method lines.
@@ -217,7 +217,7 @@ TEST(EngineNoRule, EmptyOutputSetGivesTheMiddleOfTheRange) {
 }
 
 TEST(EngineGuards, NonFiniteInputGivesNaNAndStatus) {
-  Engine e(readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis"));
+  Engine e(readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")));
   std::array<double, 3> out{};
   for (double bad : {std::nan(""), HUGE_VAL, -HUGE_VAL}) {
     const std::array<double, 2> in{0.5, bad};
@@ -243,7 +243,7 @@ TEST(EngineGuards, OutOfRangeInputsAreNotClippedUnlessAsked) {
 }
 
 TEST(EngineGuards, RefusesIncompleteSystemsAndBadOptions) {
-  Fis f = readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis");
+  Fis f = readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis"));
   EngineOptions bad;
   bad.num_samples = 1;
   EXPECT_THROW(Engine(f, bad), FisError);
@@ -272,7 +272,7 @@ int termIndex(const std::string& t) {
 }
 
 TEST(ShippedFuzzyPid, RulesAreTheCitedTables) {
-  const Fis f = readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis");
+  const Fis f = readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis"));
   ASSERT_EQ(f.rules.size(), 49u);
   const char* const* tables[3] = {kKpTable, kKiTable, kKdTable};
   for (const Rule& r : f.rules) {
@@ -291,7 +291,7 @@ TEST(ShippedFuzzyPid, RulesAreTheCitedTables) {
 TEST(ShippedFuzzyPid, SurfaceFollowsTheTables) {
   // At the centre of each (e, ec) cell its own rule fires fully and the
   // neighbours at 0.0625: the correction has the sign of the table entry.
-  Engine e(readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis"));
+  Engine e(readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")));
   const char* const* tables[3] = {kKpTable, kKiTable, kKdTable};
   std::array<double, 3> out{};
   for (int i = 0; i < 7; ++i) {
@@ -321,12 +321,12 @@ TEST(ShippedFuzzyPid, SurfaceFollowsTheTables) {
 
 TEST(EngineAllocation, EvaluateNeverAllocates) {
   std::vector<Engine> engines;
-  engines.emplace_back(readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis"));
+  engines.emplace_back(readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")));
   for (const char* f : {"shapes_bisector", "shapes_sum_centroid", "shapes_probor_centroid", "peak_mom", "peak_som",
                         "sugeno_wtaver", "sugeno_wtsum"}) {
-    engines.emplace_back(readFisFile(kSource + "/tests/fuzzy/data/" + f + ".fis"));
+    engines.emplace_back(readFisFile(inspect::test::srcPath("tests/fuzzy/data/") + f + ".fis"));
   }
-  const LookupSurface surface(readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis"));
+  const LookupSurface surface(readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")));
   std::array<double, 3> out{};
   double sink = 0;
   const std::size_t before = testing::allocationCount();

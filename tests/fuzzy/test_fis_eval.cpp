@@ -17,13 +17,14 @@
 
 #include "shared/fuzzy/engine.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
+#include "tests/support/paths.hpp"
 
 namespace inspect::fuzzy {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kBin = std::string(INSPECT_BIN_DIR) + "/fis_eval";
-const std::string kPid = std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/fuzzy_pid.fis";
+const std::string kBin = inspect::test::binPath("fis_eval");
+const std::string kPid = inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis");
 
 struct Result {
   int status = -1;

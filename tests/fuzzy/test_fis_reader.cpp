@@ -9,11 +9,11 @@
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "shared/fuzzy/fis_writer.hpp"
+#include "tests/support/paths.hpp"
 
 namespace inspect::fuzzy {
 namespace {
 
-const std::string kSource = INSPECT_SOURCE_DIR;
 
 // A valid system; the comments give the line numbers the cases below use.
 const std::string kBase =
@@ -216,8 +216,8 @@ TEST(CheckComplete, NamesVariableForSystemsBuiltInCode) {
 }
 
 std::vector<std::string> fisFiles() {
-  std::vector<std::string> files{kSource + "/config/fuzzy/fuzzy_pid.fis"};
-  for (const auto& e : std::filesystem::directory_iterator(kSource + "/tests/fuzzy/data")) {
+  std::vector<std::string> files{inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")};
+  for (const auto& e : std::filesystem::directory_iterator(inspect::test::srcPath("tests/fuzzy/data"))) {
     if (e.path().extension() == ".fis") files.push_back(e.path().string());
   }
   return files;
@@ -252,7 +252,7 @@ TEST(FisRoundTrip, AwkwardNumbersSurviveExactly) {
 }
 
 TEST(FisRoundTrip, WritesAFileThatReadsBack) {
-  const Fis a = readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis");
+  const Fis a = readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis"));
   const auto path = std::filesystem::temp_directory_path() / "inspect_fuzzy_roundtrip.fis";
   writeFisFile(a, path.string());
   EXPECT_EQ(readFisFile(path.string()), a);
@@ -260,7 +260,7 @@ TEST(FisRoundTrip, WritesAFileThatReadsBack) {
 }
 
 TEST(ShippedFuzzyPid, HasThePapersStructure) {
-  const Fis f = readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis");
+  const Fis f = readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis"));
   EXPECT_EQ(f.type, FisType::kMamdani);
   EXPECT_EQ(f.and_method, AndMethod::kMin);
   EXPECT_EQ(f.or_method, OrMethod::kMax);

@@ -20,6 +20,7 @@
 
 #include "shared/fuzzy/engine.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
+#include "tests/support/paths.hpp"
 
 namespace inspect::fuzzy {
 namespace {
@@ -27,7 +28,6 @@ namespace {
 namespace fs = std::filesystem;
 using Rows = std::vector<std::vector<double>>;
 
-const std::string kSource = INSPECT_SOURCE_DIR;
 constexpr const char* kMissing =
     "the fuzzylite command-line tool is not installed (Debian package 'fuzzylite'; scripts/setup.sh installs it). "
     "The reference comparison cannot run without it.";
@@ -198,7 +198,7 @@ class FuzzyliteReference : public ::testing::TestWithParam<RefCase> {};
 TEST_P(FuzzyliteReference, AgreesWithinSamplingResolution) {
   ASSERT_TRUE(haveFuzzylite()) << kMissing;
   const RefCase& c = GetParam();
-  const std::string path = kSource + "/" + c.file;
+  const std::string path = inspect::test::srcPath("") + c.file;
   const Fis fis = readFisFile(path);
   const Rows inputs = inputGrid(fis, c.offset_only);
   const bool mamdani = fis.type == FisType::kMamdani;

@@ -11,13 +11,13 @@
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "shared/fuzzy/lookup_surface.hpp"
+#include "tests/support/paths.hpp"
 
 namespace inspect::fuzzy {
 namespace {
 
-const std::string kSource = INSPECT_SOURCE_DIR;
 
-Fis fuzzyPid() { return readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis"); }
+Fis fuzzyPid() { return readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")); }
 
 TEST(LookupSurface, MatchesEngineAtGridNodes) {
   const Fis fis = fuzzyPid();

@@ -11,7 +11,7 @@
 #include <cstdio>
 
 #include "sim/scenarios/scenario.hpp"
-#include "tests/integration/stack.hpp"
+#include "tests/support/stack.hpp"
 
 using namespace inspect;
 using namespace inspect::test;

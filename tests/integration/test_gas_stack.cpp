@@ -17,7 +17,7 @@
 
 #include "shared/config/gas_config.hpp"
 #include "shared/util/clock.hpp"
-#include "tests/integration/stack.hpp"
+#include "tests/support/stack.hpp"
 
 using namespace inspect::test;
 

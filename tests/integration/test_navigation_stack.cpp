@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "tests/integration/stack.hpp"
+#include "tests/support/stack.hpp"
 
 using namespace inspect::test;
 

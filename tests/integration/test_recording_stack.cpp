@@ -15,8 +15,8 @@
 #include <thread>
 
 #include "shared/catalog/catalog.hpp"
-#include "tests/integration/stack.hpp"
-#include "tests/test_certs.hpp"
+#include "tests/support/stack.hpp"
+#include "tests/support/test_certs.hpp"
 
 using namespace inspect::test;
 

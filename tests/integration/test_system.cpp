@@ -12,8 +12,8 @@
 #include <sstream>
 #include <tuple>
 
-#include "tests/integration/stack.hpp"
-#include "tests/test_certs.hpp"
+#include "tests/support/stack.hpp"
+#include "tests/support/test_certs.hpp"
 
 using namespace inspect::test;
 

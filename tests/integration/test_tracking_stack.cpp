@@ -10,7 +10,7 @@
 #include "shared/config/control_config.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/robot_plant.hpp"
-#include "tests/integration/stack.hpp"
+#include "tests/support/stack.hpp"
 
 using namespace inspect;
 using namespace inspect::test;

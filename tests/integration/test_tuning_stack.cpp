@@ -12,7 +12,7 @@
 #include <regex>
 #include <sstream>
 
-#include "tests/integration/stack.hpp"
+#include "tests/support/stack.hpp"
 
 using namespace inspect::test;
 

@@ -13,8 +13,8 @@
 #include <regex>
 #include <string>
 
-#include "tests/integration/stack.hpp"
-#include "tests/tools/udp_relay.hpp"
+#include "tests/support/stack.hpp"
+#include "tests/support/udp_relay.hpp"
 
 using namespace inspect::test;
 

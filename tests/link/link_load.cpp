@@ -41,10 +41,10 @@
 #include <boost/asio/io_context.hpp>
 
 #include "shared/util/clock.hpp"
-#include "tests/integration/process.hpp"
+#include "tests/support/process.hpp"
 #include "tests/link/server_harness.hpp"
 #include "tests/link/sim_robot.hpp"
-#include "tests/test_certs.hpp"
+#include "tests/support/test_certs.hpp"
 
 namespace {
 

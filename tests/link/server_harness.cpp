@@ -16,6 +16,7 @@
 
 #include "inspect/v1/link.pb.h"
 #include "shared/record/mcap_reader.hpp"
+#include "tests/support/paths.hpp"
 
 namespace inspect::linktest {
 
@@ -89,9 +90,9 @@ bool ServerUnderTest::start(const ServerStart& s) {
     error_ = "cannot open " + fifo_;
     return false;
   }
-  const std::string bin = std::string(INSPECT_BIN_DIR) + "/pc_server";
+  const std::string bin = inspect::test::binPath("pc_server");
   const std::string cfg =
-      s.config_path.empty() ? std::string(INSPECT_SOURCE_DIR) + "/config/server.yaml" : s.config_path;
+      s.config_path.empty() ? inspect::test::srcPath("config/server.yaml") : s.config_path;
   std::vector<std::string> argv = {bin,       "--config",   cfg,     "--bind",      "127.0.0.1",
                                    "--port",  "0",          "--port-file", dir_ + "/port", "--no-video",
                                    "--runs-dir", runs_dir_, "--certs", s.certs_dir};

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/integration/process.hpp"
+#include "tests/support/process.hpp"
 
 namespace inspect::linktest {
 

@@ -23,11 +23,11 @@
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
 
-#include "tests/integration/process.hpp"
+#include "tests/support/process.hpp"
 #include "tests/link/attack_conn.hpp"
 #include "tests/link/server_harness.hpp"
 #include "tests/link/sim_robot.hpp"
-#include "tests/test_certs.hpp"
+#include "tests/support/test_certs.hpp"
 
 namespace inspect::linktest {
 namespace {

@@ -10,16 +10,17 @@
 
 #include "shared/config/robot_config.hpp"
 #include "shared/navigation/navigator.hpp"
+#include "tests/navigation/nav_test_values.hpp"
 
 using namespace inspect;
 using namespace inspect::navigation;
+using inspect::test::kNaN;
+using inspect::test::kPi;
+using inspect::test::kSonar;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kDt = 0.01;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const config::UltrasonicConfig kSonar{};
+constexpr double kTickDt_s = 0.01;
 
 // Ranges with only the two front sensors echoing at range_m (a wall ahead at 0.30 + range_m).
 SonarRanges front(double range_m) { return {range_m, range_m, kNaN, kNaN}; }
@@ -28,13 +29,13 @@ const SonarRanges kNone{kNaN, kNaN, kNaN, kNaN};
 // Steps n ticks with the same input; returns the last output.
 NavigationOutput hold(Navigator& nav, const control::Pose2& pose, const SonarRanges& r, int n) {
   NavigationOutput out;
-  for (int i = 0; i < n; ++i) out = nav.step(pose, r, kDt);
+  for (int i = 0; i < n; ++i) out = nav.step(pose, r, kTickDt_s);
   return out;
 }
 
 TEST(Automaton, WithoutGoalItStops) {
   Navigator nav({}, kSonar);
-  const auto out = nav.step({0, 0, 0}, front(0.5), kDt);
+  const auto out = nav.step({0, 0, 0}, front(0.5), kTickDt_s);
   EXPECT_EQ(out.mode, Mode::kAtGoal);
   EXPECT_EQ(out.twist.v_m_s, 0.0);
   EXPECT_EQ(out.twist.w_rad_s, 0.0);
@@ -51,7 +52,7 @@ TEST(Automaton, FreeSpaceGoToGoalMatchesThePureBehaviour) {
   Navigator nav({}, kSonar);
   nav.setGoal({3.0, 1.0});
   const control::Pose2 pose{0.5, -0.2, 0.4};
-  const auto out = nav.step(pose, kNone, kDt);
+  const auto out = nav.step(pose, kNone, kTickDt_s);
   EXPECT_EQ(out.mode, Mode::kGoToGoal);
   // With ki = kd = 0 the heading PID is the P law of the pure behaviour.
   const control::Twist t = goToGoal(pose, {3.0, 1.0}, NavigationParams{});
@@ -66,31 +67,31 @@ TEST(Automaton, NonFiniteInputStopsWithoutChangingState) {
   Navigator nav({}, kSonar);
   nav.setGoal({3.0, 0.0});
   hold(nav, {0, 0, 0}, kNone, 5);
-  const auto bad_pose = nav.step({kNaN, 0, 0}, kNone, kDt);
+  const auto bad_pose = nav.step({kNaN, 0, 0}, kNone, kTickDt_s);
   EXPECT_EQ(bad_pose.twist.v_m_s, 0.0);
   EXPECT_EQ(bad_pose.twist.w_rad_s, 0.0);
   EXPECT_EQ(bad_pose.mode, Mode::kGoToGoal);
   const auto bad_dt = nav.step({0, 0, 0}, kNone, 0.0);
   EXPECT_EQ(bad_dt.twist.v_m_s, 0.0);
-  EXPECT_EQ(nav.step({0, 0, 0}, kNone, -kDt).twist.v_m_s, 0.0);
-  EXPECT_GT(nav.step({0, 0, 0}, kNone, kDt).twist.v_m_s, 0.0);  // recovers
+  EXPECT_EQ(nav.step({0, 0, 0}, kNone, -kTickDt_s).twist.v_m_s, 0.0);
+  EXPECT_GT(nav.step({0, 0, 0}, kNone, kTickDt_s).twist.v_m_s, 0.0);  // recovers
 }
 
 TEST(Automaton, ObstacleInTheWayEntersBoundaryAfterTheDwellTimeWithReset) {
   Navigator nav({}, kSonar);
   nav.setGoal({5.0, 1.0});
   // Wall ahead at 0.30 + 0.45 = 0.75 m: inside the guard (0.9), outside safety (0.6).
-  const auto first = nav.step({0, 0, 0}, front(0.45), kDt);
+  const auto first = nav.step({0, 0, 0}, front(0.45), kTickDt_s);
   EXPECT_EQ(first.mode, Mode::kGoToGoal);  // dwell time (0.3 s) not over yet
   EXPECT_FALSE(first.clear_shot);
   int k = 1;
   NavigationOutput out = first;
   while (out.mode == Mode::kGoToGoal && k < 100) {
-    out = nav.step({0, 0, 0}, front(0.45), kDt);
+    out = nav.step({0, 0, 0}, front(0.45), kTickDt_s);
     ++k;
   }
-  EXPECT_GE(k * kDt, NavigationParams{}.min_dwell_s - 1e-9);
-  EXPECT_LE(k * kDt, NavigationParams{}.min_dwell_s + 2 * kDt);
+  EXPECT_GE(k * kTickDt_s, NavigationParams{}.min_dwell_s - 1e-9);
+  EXPECT_LE(k * kTickDt_s, NavigationParams{}.min_dwell_s + 2 * kTickDt_s);
   // Goal to the left of the wall: the side heading left (clockwise round the obstacle).
   EXPECT_EQ(out.mode, Mode::kFollowCw);
   EXPECT_EQ(out.side, FollowSide::kClockwise);
@@ -103,7 +104,7 @@ TEST(Automaton, ObstacleInTheWayEntersBoundaryAfterTheDwellTimeWithReset) {
 TEST(Automaton, DangerouslyCloseIsAvoidedAtOnce) {
   Navigator nav({}, kSonar);
   nav.setGoal({5.0, 0.0});
-  const auto out = nav.step({0, 0, 0}, front(0.2), kDt);  // 0.5 m < safety 0.6 m, first tick
+  const auto out = nav.step({0, 0, 0}, front(0.2), kTickDt_s);  // 0.5 m < safety 0.6 m, first tick
   EXPECT_EQ(out.mode, Mode::kAvoid);
   EXPECT_EQ(out.switch_count, 1u);
   EXPECT_EQ(out.twist.v_m_s, 0.0);  // turns away on the spot (avoid points backward)
@@ -133,7 +134,7 @@ TEST(Automaton, LeavingTheBoundaryNeedsAClearShotAndProgress) {
   EXPECT_TRUE(out.progress);
   EXPECT_TRUE(out.mode == Mode::kFollowCw || out.mode == Mode::kFollowCcw);
   // Both: back to go-to-goal.
-  out = nav.step({2.0, 0, kPi}, front(0.5), kDt);
+  out = nav.step({2.0, 0, kPi}, front(0.5), kTickDt_s);
   EXPECT_TRUE(out.clear_shot);
   EXPECT_TRUE(out.progress);
   EXPECT_EQ(out.mode, Mode::kGoToGoal);
@@ -144,7 +145,7 @@ TEST(Automaton, AtGoalStopsWithHysteresis) {
   const NavigationParams p;
   Navigator nav(p, kSonar);
   nav.setGoal({1.0, 0.0});
-  auto out = nav.step({1.0 - p.goal_epsilon_m / 2, 0, 0}, kNone, kDt);
+  auto out = nav.step({1.0 - p.goal_epsilon_m / 2, 0, 0}, kNone, kTickDt_s);
   EXPECT_EQ(out.mode, Mode::kAtGoal);
   EXPECT_EQ(out.twist.v_m_s, 0.0);
   EXPECT_EQ(out.twist.w_rad_s, 0.0);
@@ -152,12 +153,12 @@ TEST(Automaton, AtGoalStopsWithHysteresis) {
   out = hold(nav, {1.0 - p.goal_epsilon_m - p.goal_release_m / 2, 0, 0}, kNone, 50);
   EXPECT_EQ(out.mode, Mode::kAtGoal);
   // Pushed farther: goes back to the goal.
-  out = nav.step({1.0 - p.goal_epsilon_m - 2 * p.goal_release_m, 0, 0}, kNone, kDt);
+  out = nav.step({1.0 - p.goal_epsilon_m - 2 * p.goal_release_m, 0, 0}, kNone, kTickDt_s);
   EXPECT_EQ(out.mode, Mode::kGoToGoal);
   EXPECT_EQ(out.switch_count, 2u);
   // A new goal restarts the counters.
   nav.setGoal({3.0, 0.0});
-  EXPECT_EQ(nav.step({0, 0, 0}, kNone, kDt).switch_count, 0u);
+  EXPECT_EQ(nav.step({0, 0, 0}, kNone, kTickDt_s).switch_count, 0u);
 }
 
 TEST(Automaton, MemoryKeepsAWallWhileTheSensorsLookAway) {
@@ -166,7 +167,7 @@ TEST(Automaton, MemoryKeepsAWallWhileTheSensorsLookAway) {
   nav.setGoal({5.0, 0.0});
   hold(nav, {0, 0, 0}, front(1.0), 10);
   // The sonars now see nothing (the robot turned): the wall is still known ...
-  auto out = hold(nav, {0, 0, kPi / 2}, kNone, static_cast<int>(p.memory_s / kDt) - 20);
+  auto out = hold(nav, {0, 0, kPi / 2}, kNone, static_cast<int>(p.memory_s / kTickDt_s) - 20);
   EXPECT_NEAR(out.nearest_obstacle_m, std::hypot(1.3, 0.12), 0.01);
   EXPECT_NEAR(out.nearest_bearing_rad, -kPi / 2, 0.1);  // to the robot's right now
   // ... until it is older than memory_s.
@@ -201,7 +202,7 @@ TEST_P(ChatterTable, SwitchesAroundTheSafetyDistance) {
   NavigationOutput out;
   unsigned seen = 0;
   for (int k = 0; k < 100; ++k) {
-    out = nav.step({0, 0, 0}, front(k % 2 == 0 ? 0.28 : 0.32), kDt);
+    out = nav.step({0, 0, 0}, front(k % 2 == 0 ? 0.28 : 0.32), kTickDt_s);
     if (out.switched) ++seen;
   }
   EXPECT_EQ(out.switch_count, c.expected_switches);

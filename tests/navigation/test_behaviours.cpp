@@ -12,13 +12,16 @@
 #include "shared/navigation/behaviours.hpp"
 #include "shared/navigation/guards.hpp"
 #include "shared/navigation/navigation_params.hpp"
+#include "tests/navigation/nav_test_values.hpp"
 
 using namespace inspect;
 using namespace inspect::navigation;
+using inspect::test::kNaN;
+using inspect::test::kPi;
+using inspect::test::kSonar;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 const NavigationParams kP{};
 
 // --- go-to-goal -----------------------------------------------------------------

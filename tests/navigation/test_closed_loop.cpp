@@ -21,6 +21,7 @@
 #include "sim/robot_plant.hpp"
 #include "sim/ultrasonic_model.hpp"
 #include "sim/world.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using navigation::FollowSide;
@@ -325,19 +326,19 @@ TEST(NavClosedLoop, WarehouseTwoBoundaryEpisodesAsInTheExercise) {
   EXPECT_LT(r.path_m, 25.0);
 }
 
-struct SideCase {
+struct WallSideCase {
   const char* name;
   Vec2 goal;
   FollowSide expected;
   double direction;  // +1: the robot must move to +y along the wall, -1: to -y
 };
 
-std::ostream& operator<<(std::ostream& os, const SideCase& c) { return os << c.name; }
+std::ostream& operator<<(std::ostream& os, const WallSideCase& c) { return os << c.name; }
 
-class NavSide : public ::testing::TestWithParam<SideCase> {};
+class NavSide : public ::testing::TestWithParam<WallSideCase> {};
 
 TEST_P(NavSide, FollowsOnTheSideThatHeadsTowardTheGoal) {
-  const SideCase& c = GetParam();
+  const WallSideCase& c = GetParam();
   const NavRun r = runNav({c.name, kLongWall, c.goal, {}, 6000});
   ASSERT_GE(r.sides.size(), 1u);
   EXPECT_EQ(r.sides[0], c.expected);
@@ -350,8 +351,8 @@ TEST_P(NavSide, FollowsOnTheSideThatHeadsTowardTheGoal) {
 }
 
 INSTANTIATE_TEST_SUITE_P(LongWall, NavSide,
-                         ::testing::Values(SideCase{"goal_left", {5.0, 2.0}, FollowSide::kClockwise, +1.0},
-                                           SideCase{"goal_right", {5.0, -2.0}, FollowSide::kCounterClockwise, -1.0}),
+                         ::testing::Values(WallSideCase{"goal_left", {5.0, 2.0}, FollowSide::kClockwise, +1.0},
+                                           WallSideCase{"goal_right", {5.0, -2.0}, FollowSide::kCounterClockwise, -1.0}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 TEST(NavClosedLoop, HardAndBlendedBothReachTheConvexGoal) {
@@ -456,7 +457,7 @@ INSTANTIATE_TEST_SUITE_P(
 // frame = the room's start pose) is driven in the square room: every point
 // reached, no collision.
 TEST(NavClosedLoop, ExampleRouteIsDrivableInTheSquareRoom) {
-  const auto root = config::ConfigNode::loadFile(std::string(INSPECT_SOURCE_DIR) + "/config/routes/warehouse_tour.yaml");
+  const auto root = config::ConfigNode::loadFile(inspect::test::srcPath("config/routes/warehouse_tour.yaml"));
   const std::vector<double> xy = root.numbers("waypoints_m");
   ASSERT_GE(xy.size(), 4u);
   ASSERT_EQ(xy.size() % 2, 0u);

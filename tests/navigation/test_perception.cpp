@@ -11,15 +11,16 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/navigation/obstacle_memory.hpp"
 #include "shared/serial/messages.hpp"
+#include "tests/navigation/nav_test_values.hpp"
 
 using namespace inspect;
 using namespace inspect::navigation;
+using inspect::test::kNaN;
+using inspect::test::kPi;
+using inspect::test::kSonar;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const config::UltrasonicConfig kSonar{};
 
 struct PointCase {
   int mount;

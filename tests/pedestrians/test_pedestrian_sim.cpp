@@ -18,17 +18,16 @@
 #include "sim/pedestrian_crowd.hpp"
 #include "sim/simulation.hpp"
 #include "sim/truth_log.hpp"
+#include "tests/support/paths.hpp"
+#include "tests/sim/world_text.hpp"
 
 using namespace inspect;
 using namespace inspect::sim;
 
 namespace {
 
-const std::string kSrc = INSPECT_SOURCE_DIR;
+using inspect::test::worldOf;
 
-World worldOf(const std::string& yaml) {
-  return loadWorldText(yaml, "peds.yaml");
-}
 
 struct Recorder : SimObserver {
   struct Event {
@@ -89,7 +88,7 @@ std::vector<Eigen::Vector2d> walk(double duration_s, PedestrianCrowd& crowd) {
 // --- route following ---
 
 TEST(PedestrianCrowd, AbsentBeforeStartThenWalksTheRouteAndStops) {
-  const World w = worldOf("pedestrians:\n  - {id: a, start_s: 1.5, route_m: [0, 0, 2, 0]}\n");
+  const World w = worldOf("pedestrians:\n  - {id: a, start_s: 1.5, route_m: [0, 0, 2, 0]}\n", "peds.yaml");
   Recorder rec;
   PedestrianCrowd crowd(w, &rec);
   EXPECT_FALSE(crowd.present(0));
@@ -114,7 +113,7 @@ TEST(PedestrianCrowd, AbsentBeforeStartThenWalksTheRouteAndStops) {
 
 TEST(PedestrianCrowd, PausesAtAWaypoint) {
   const auto endTime = [](const std::string& yaml, double& slowest_near_wp1) {
-    const World w = worldOf(yaml);
+    const World w = worldOf(yaml, "peds.yaml");
     Recorder rec;
     PedestrianCrowd crowd(w, &rec);
     const auto pos = walk(14.0, crowd);
@@ -136,7 +135,7 @@ TEST(PedestrianCrowd, PausesAtAWaypoint) {
 }
 
 TEST(PedestrianCrowd, LoopsForever) {
-  const World w = worldOf("pedestrians:\n  - {route_m: [0, 0, 2, 0], loop: true}\n");
+  const World w = worldOf("pedestrians:\n  - {route_m: [0, 0, 2, 0], loop: true}\n", "peds.yaml");
   Recorder rec;
   PedestrianCrowd crowd(w, &rec);
   const auto pos = walk(20.0, crowd);
@@ -152,7 +151,7 @@ TEST(PedestrianCrowd, LoopsForever) {
 
 TEST(PedestrianSim, CrossingPersonIsSeenByTheFrontSensorsWhileInTheBeam) {
   const config::RobotConfig robot;
-  Simulation sim(robot, loadWorldFile(kSrc + "/config/worlds/crossing.yaml"), 1);
+  Simulation sim(robot, loadWorldFile(inspect::test::srcPath("config/worlds/crossing.yaml")), 1);
   // The robot stays at rest (no wheel commands). Record the person at every frame.
   std::vector<Eigen::Vector2d> person;
   for (int t = 0; t < 18000; ++t) {
@@ -202,7 +201,7 @@ TEST(PedestrianSim, TruthLogHasPRowsAt10HzAndPersonEvents) {
                             ("ped_truth_" + std::to_string(::getpid()) + ".csv")).string();
   {
     TruthLog truth(path);
-    Simulation sim(config::RobotConfig{}, loadWorldFile(kSrc + "/config/worlds/crossing.yaml"), 1, &truth);
+    Simulation sim(config::RobotConfig{}, loadWorldFile(inspect::test::srcPath("config/worlds/crossing.yaml")), 1, &truth);
     sim.advanceTo(3000);
   }
   std::ifstream in(path);
@@ -246,7 +245,7 @@ TEST(PedestrianSim, TruthLogHasPRowsAt10HzAndPersonEvents) {
 }
 
 TEST(PedestrianSim, SameSeedSameTruth) {
-  const World w = loadWorldFile(kSrc + "/config/worlds/encountering.yaml");
+  const World w = loadWorldFile(inspect::test::srcPath("config/worlds/encountering.yaml"));
   Recorder a, b;
   Simulation sa(config::RobotConfig{}, w, 7, &a);
   Simulation sb(config::RobotConfig{}, w, 7, &b);
@@ -279,7 +278,7 @@ walls:
   - {points_m: [-1, 0.4,  3, 0.4,  3, -0.4,  -1, -0.4]}
 pedestrians:
   - {id: cornered, route_m: [2.6, 0]}
-)");
+)", "peds.yaml");
   Recorder rec;
   const config::RobotConfig robot;
   Simulation sim(robot, w, 1, &rec);

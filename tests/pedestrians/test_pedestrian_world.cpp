@@ -7,6 +7,7 @@
 
 #include "sim/world.hpp"
 #include "tests/sim/world_text.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect::sim;
 using inspect::config::ConfigError;
@@ -14,11 +15,8 @@ using inspect::config::ConfigNode;
 
 namespace {
 
-const std::string kSrc = INSPECT_SOURCE_DIR;
+using inspect::test::worldOf;
 
-World worldOf(const std::string& yaml) {
-  return loadWorldText(yaml, "peds.yaml");
-}
 
 std::string errorOf(const std::string& yaml) { return inspect::test::worldError(yaml, "peds.yaml"); }
 
@@ -45,7 +43,7 @@ social_force:
   walls: {strength_m_s2: 4.0}
   robot: {range_m: 0.8}
   contact: {strength_m_s2: 20.0, range_m: 0.1}
-)");
+)", "peds.yaml");
   ASSERT_EQ(w.pedestrians.size(), 1u);
   const auto& p = w.pedestrians[0];
   EXPECT_EQ(p.id, "alice");
@@ -70,7 +68,7 @@ social_force:
 }
 
 TEST(PedestrianWorld, Defaults) {
-  const World w = worldOf("pedestrians:\n  - {route_m: [1, 2]}\n  - {route_m: [3, 4, 5, 6]}\n");
+  const World w = worldOf("pedestrians:\n  - {route_m: [1, 2]}\n  - {route_m: [3, 4, 5, 6]}\n", "peds.yaml");
   ASSERT_EQ(w.pedestrians.size(), 2u);
   const auto& p = w.pedestrians[0];
   EXPECT_EQ(p.id, "person0");
@@ -85,7 +83,7 @@ TEST(PedestrianWorld, Defaults) {
   const inspect::behavior::SocialForceParams d;
   EXPECT_DOUBLE_EQ(w.social_force.relaxation_time_s, d.relaxation_time_s);
   EXPECT_DOUBLE_EQ(w.social_force.people.strength_m_s2, d.people.strength_m_s2);
-  EXPECT_TRUE(worldOf("name: x\n").pedestrians.empty());
+  EXPECT_TRUE(worldOf("name: x\n", "peds.yaml").pedestrians.empty());
 }
 
 TEST(PedestrianWorld, BadValuesNameFileKeyAndReason) {
@@ -152,7 +150,7 @@ TEST(PedestrianWorld, UnknownKeysRejected) {
 }
 
 TEST(PedestrianWorld, ShippedCrossingLoads) {
-  const World w = loadWorldFile(kSrc + "/config/worlds/crossing.yaml");
+  const World w = loadWorldFile(inspect::test::srcPath("config/worlds/crossing.yaml"));
   EXPECT_EQ(w.name, "crossing");
   EXPECT_NO_THROW(checkStartPose(w, 0.35));
   EXPECT_DOUBLE_EQ(w.start.x_m, 0.0);
@@ -182,7 +180,7 @@ TEST(PedestrianWorld, ShippedCrossingLoads) {
 }
 
 TEST(PedestrianWorld, ShippedEncounteringLoads) {
-  const World w = loadWorldFile(kSrc + "/config/worlds/encountering.yaml");
+  const World w = loadWorldFile(inspect::test::srcPath("config/worlds/encountering.yaml"));
   EXPECT_EQ(w.name, "encountering");
   EXPECT_NO_THROW(checkStartPose(w, 0.35));
   ASSERT_EQ(w.pedestrians.size(), 1u);
@@ -201,7 +199,7 @@ TEST(PedestrianWorld, ShippedEncounteringLoads) {
 TEST(PedestrianWorld, SolidEdgesMarkSharedCorners) {
   const World w = worldOf(
       "walls:\n  - {points_m: [0, 0, 4, 0, 4, 3]}\n  - {from_m: [10, 0], to_m: [11, 0]}\n"
-      "obstacles:\n  - {vertices_m: [5, 5, 6, 5, 6, 6]}\n");
+      "obstacles:\n  - {vertices_m: [5, 5, 6, 5, 6, 6]}\n", "peds.yaml");
   const auto e = solidEdges(w);
   ASSERT_EQ(e.size(), 2u + 1u + 3u);
   // Polyline: the free ends are not joined, the bend is.

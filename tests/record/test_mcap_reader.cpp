@@ -21,8 +21,15 @@
 #include "shared/record/csv_export.hpp"
 #include "shared/record/mcap_reader.hpp"
 #include "shared/record/mcap_writer.hpp"
+#include "tests/record/mcap_test_files.hpp"
 
 namespace {
+
+using inspect::test::kBase;
+using inspect::test::kMs;
+using inspect::test::kSecond;
+using inspect::test::slurp;
+using inspect::test::spit;
 
 namespace fs = std::filesystem;
 using inspect::record::exportCsv;
@@ -30,8 +37,6 @@ using inspect::record::McapReader;
 using inspect::record::McapWriter;
 using inspect::record::McapWriterOptions;
 
-constexpr uint64_t kMs = 1'000'000;
-constexpr uint64_t kBase = 1'763'800'000'000'000'000;  // log times: Unix time in ns
 constexpr int kBatches = 4;                            // one chunk each
 constexpr int kTicks = 10;                             // telemetry messages per batch
 const std::string kTelemetry = "/telemetry", kEvent = "/event", kVideo = "/camera/front";
@@ -41,15 +46,6 @@ struct Sent {
   uint64_t log = 0, publish = 0;
   std::string data, debug;  // serialized, ShortDebugString
 };
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-void spit(const fs::path& p, std::string_view bytes) {
-  std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
 
 std::vector<std::string> lines(const fs::path& p) {
   std::ifstream in(p);

@@ -32,8 +32,15 @@
 #include "foxglove/CompressedVideo.pb.h"
 #include "inspect/v1/link.pb.h"
 #include "shared/record/mcap_writer.hpp"
+#include "tests/record/mcap_test_files.hpp"
 
 namespace {
+
+using inspect::test::kBase;
+using inspect::test::kMs;
+using inspect::test::kSecond;
+using inspect::test::slurp;
+using inspect::test::spit;
 
 namespace fs = std::filesystem;
 using inspect::record::McapWriter;
@@ -41,9 +48,6 @@ using inspect::record::McapWriterOptions;
 using inspect::record::repairMcap;
 using Counts = std::map<std::string, uint64_t>;  // topic -> messages
 
-constexpr uint64_t kMs = 1'000'000;
-constexpr uint64_t kSecond = 1'000 * kMs;
-constexpr uint64_t kBase = 1'763'800'000 * kSecond;  // log times: Unix time in ns
 const std::string kMagic("\x89MCAP0\r\n", 8);
 
 // ------------------------------------------------------------ test reader
@@ -345,16 +349,6 @@ Counts readIndexed(std::string_view file) {
     }
   }
   return counts;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-void spit(const fs::path& p, std::string_view bytes) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 // ------------------------------------------------------------ a run to record

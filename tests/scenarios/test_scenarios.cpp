@@ -9,13 +9,14 @@
 #include <map>
 
 #include "sim/scenarios/scenario.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using behavior::SpeedPolicy;
 
 namespace {
 
-std::string src(const std::string& rel) { return std::string(INSPECT_SOURCE_DIR) + "/" + rel; }
+std::string src(const std::string& rel) { return inspect::test::srcPath(rel); }
 
 const sim::ScenarioContext& context() {
   static const sim::ScenarioContext ctx = sim::loadScenarioContext(

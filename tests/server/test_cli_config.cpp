@@ -3,6 +3,7 @@
 
 #include "pc_server/cli_options.hpp"
 #include "pc_server/server_config.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using namespace inspect::server;
@@ -53,7 +54,7 @@ TEST(Cli, VideoFlags) {
 }
 
 TEST(ServerConfig, Video) {
-  const auto c = loadServerConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/server.yaml");
+  const auto c = loadServerConfigFile(inspect::test::srcPath("config/server.yaml"));
   const VideoServerConfig d;
   EXPECT_EQ(c.video.enabled, d.enabled);
   EXPECT_EQ(c.video.port, 5600);
@@ -101,7 +102,7 @@ TEST(ServerConfig, EmptyFileGivesDefaults) {
 }
 
 TEST(ServerConfig, ShippedFileLoadsWithDefaults) {
-  const auto c = loadServerConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/server.yaml");
+  const auto c = loadServerConfigFile(inspect::test::srcPath("config/server.yaml"));
   const ServerConfig d;
   EXPECT_EQ(c.bind_address, d.bind_address);
   EXPECT_EQ(c.port, d.port);

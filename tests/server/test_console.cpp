@@ -21,9 +21,12 @@
 #include "pc_server/route_file.hpp"
 #include "pc_server/status_line.hpp"
 #include "shared/util/clock.hpp"
+#include "tests/server/manual_clock.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using namespace inspect::server;
+using inspect::test::ManualClock;
 
 namespace {
 
@@ -32,9 +35,9 @@ constexpr uint64_t kSerial = 1;
 /// Records commands; acks them through the registry as a robot would (or not).
 class FakeSink : public CommandSink {
  public:
-  explicit FakeSink(RobotRegistry& r) : registry_(r) {}
+  FakeSink(RobotRegistry& r, ConsoleClock& clock) : registry_(r), clock_(clock) {}
   uint64_t setTeleop(const std::string& robot, double v, double w) override {
-    if (!registry_.snapshot(robot, monoNowNs()) || !registry_.snapshot(robot, monoNowNs())->connected) return 0;
+    if (!connected(robot)) return 0;
     teleop_active = true;
     last_v = v;
     last_w = w;
@@ -45,7 +48,7 @@ class FakeSink : public CommandSink {
   void clearTeleop(const std::string&) override { teleop_active = false; }
   void consoleAlive() override { ++alive_calls; }
   uint64_t sendCommand(const std::string& robot, v1::Command cmd) override {
-    if (!registry_.snapshot(robot, monoNowNs()) || !registry_.snapshot(robot, monoNowNs())->connected) return 0;
+    if (!connected(robot)) return 0;
     if (cmd.has_stop() || cmd.has_estop()) teleop_active = false;
     sent.push_back(cmd);
     return answer(robot, cmd);
@@ -70,26 +73,28 @@ class FakeSink : public CommandSink {
     }
     return id;
   }
+  bool connected(const std::string& robot) {
+    const auto snap = registry_.snapshot(robot, clock_.nowNs());
+    return snap && snap->connected;
+  }
   RobotRegistry& registry_;
+  ConsoleClock& clock_;
   uint64_t next_id_ = 0;
 };
 
 class ConsoleTest : public ::testing::Test {
  protected:
-  ConsoleTest() : sink_(registry_), console_(registry_, sink_, out_, stop_, fastOptions()) {}
-
-  static Console::Options fastOptions() {
-    Console::Options o;
-    o.ack_timeout_s = 0.1;
-    o.poll_period_s = 0.005;
-    return o;
+  // The console's default options (1 s Ack timeout, 20 ms polls) on a clock
+  // that moves only while it waits: exact timings, no real time.
+  ConsoleTest() : clock_(stop_), sink_(registry_, clock_), console_(registry_, sink_, out_, stop_) {
+    console_.setClock(clock_);
   }
 
   /// A robot as the link would register it; `settle` lets the console auto-select it now.
   void connectRobot(const std::string& id = "robot1", bool settle = true) {
     v1::Hello h;
     h.set_robot_id(id);
-    registry_.onConnected(id, "127.0.0.1:1", kSerial, h, monoNowNs());
+    registry_.onConnected(id, "127.0.0.1:1", kSerial, h, now());
     if (settle) (void)console_.background();
   }
   void telemetry(double x, v1::Mode mode = v1::IDLE, const std::string& id = "robot1") {
@@ -97,7 +102,7 @@ class ConsoleTest : public ::testing::Test {
     t.mutable_pose()->set_x_m(x);
     t.set_mode(mode);
     t.set_faults(v1::FAULT_SENSOR_STALE);
-    registry_.onTelemetry(id, kSerial, t, monoNowNs());
+    registry_.onTelemetry(id, kSerial, t, now());
   }
   /// Runs a line and returns (ok, output).
   std::pair<bool, std::string> run(const std::string& line, int line_no = 7) {
@@ -106,10 +111,13 @@ class ConsoleTest : public ::testing::Test {
     return {ok, out_.str()};
   }
 
+  int64_t now() { return clock_.nowNs(); }
+
+  StopFlag stop_;
+  ManualClock clock_;  // the console's: it moves only while the console waits
   RobotRegistry registry_;
   FakeSink sink_;
   std::ostringstream out_;
-  StopFlag stop_;
   Console console_;
 };
 
@@ -235,11 +243,13 @@ TEST_F(ConsoleTest, EstopResumeAckMessages) {
   EXPECT_FALSE(ok);
   EXPECT_EQ(out, "robot1: resume rejected: fault still active\n");
   sink_.reply = std::nullopt;
-  const auto t0 = std::chrono::steady_clock::now();
+  const double t0 = clock_.elapsedS();
   std::tie(ok, out) = run("stop");
   EXPECT_FALSE(ok);
-  EXPECT_EQ(out, "robot1: stop: no ack within 0.1 s\n");
-  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(100));
+  EXPECT_EQ(out, "robot1: stop: no ack within 1 s\n");
+  // It waited the Ack timeout, polling every millisecond: no more, no less.
+  EXPECT_NEAR(clock_.elapsedS() - t0, 1.0, 1e-6);
+  EXPECT_EQ(clock_.sleeps(), 1000);
 }
 
 TEST_F(ConsoleTest, RobotsTableAndStatusLine) {
@@ -265,25 +275,28 @@ TEST_F(ConsoleTest, EchoPrintsTheRestOfTheLine) {
 }
 
 TEST_F(ConsoleTest, WaitSleepsAndQuitIsRecorded) {
-  const auto t0 = std::chrono::steady_clock::now();
   EXPECT_TRUE(run("wait 0.05").first);
-  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(50));
+  EXPECT_NEAR(clock_.elapsedS(), 0.05, 1e-6);
+  EXPECT_TRUE(run("wait 10").first);  // on the console's clock: no real time
+  EXPECT_NEAR(clock_.elapsedS(), 10.05, 1e-6);
   EXPECT_FALSE(console_.quitRequested());
   EXPECT_TRUE(run("exit").first);
   EXPECT_TRUE(console_.quitRequested());
 }
 
 TEST_F(ConsoleTest, ConsoleReportsItIsAliveWhileWaiting) {
-  EXPECT_TRUE(run("wait 0.5").first);  // polls every 5 ms: about 100 signs (5 leave room for a shared machine)
-  EXPECT_GE(sink_.alive_calls, 5) << "the console watchdog needs a sign of life every poll";
+  // Polls every 20 ms: a sign of life as the line starts, before each of the 25 sleeps and at the end.
+  EXPECT_TRUE(run("wait 0.5").first);
+  EXPECT_EQ(clock_.sleeps(), 25);
+  EXPECT_EQ(sink_.alive_calls, 27) << "the console watchdog needs a sign of life every poll";
 }
 
 TEST_F(ConsoleTest, WaitIsInterruptedByStop) {
-  stop_.request();
-  const auto t0 = std::chrono::steady_clock::now();
+  clock_.at(0.25, [this] { stop_.request(); });
   const auto [ok, out] = run("wait 10");
   EXPECT_FALSE(ok);
-  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(1));
+  EXPECT_EQ(out, "wait: interrupted (server stopping)\n");
+  EXPECT_NEAR(clock_.elapsedS(), 0.25, 1e-6) << "the wait ends with the stop, not at 10 s";
 }
 
 TEST_F(ConsoleTest, EventsArePrintedAsTheyCome) {
@@ -344,30 +357,21 @@ TEST_F(ConsoleTest, ExpectWithoutTelemetrySaysSo) {
 TEST_F(ConsoleTest, ExpectWithinPollsUntilTrue) {
   connectRobot();
   telemetry(0.0);
-  std::thread mover([this] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    telemetry(2.01);
-  });
-  const auto t0 = std::chrono::steady_clock::now();
+  clock_.at(0.1, [this] { telemetry(2.01); });
   const auto [ok, out] = run("expect x ~ 2 0.05 within 2");
-  const auto dt = std::chrono::steady_clock::now() - t0;
-  mover.join();
   EXPECT_TRUE(ok) << out;
   EXPECT_HAS(out, "x = 2.01");
-  EXPECT_GE(dt, std::chrono::milliseconds(90));
-  EXPECT_LT(dt, std::chrono::milliseconds(1900));  // before the 2 s `within` ran out
+  // Held at the first poll after the telemetry came (20 ms polls), long before the 2 s ran out.
+  EXPECT_NEAR(clock_.elapsedS(), 0.1, 1e-6);
 }
 
 TEST_F(ConsoleTest, ExpectWithinTimesOut) {
   connectRobot();
   telemetry(0.5);
-  const auto t0 = std::chrono::steady_clock::now();
   const auto [ok, out] = run("expect x >= 1 within 0.2", 4);
-  const auto dt = std::chrono::steady_clock::now() - t0;
   EXPECT_FALSE(ok);
   EXPECT_EQ(out, "EXPECT FAILED (line 4): x = 0.5, wanted >= 1 within 0.2 s\n");
-  EXPECT_GE(dt, std::chrono::milliseconds(200));
-  EXPECT_LT(dt, std::chrono::milliseconds(1500));  // 0.2 s + room for a shared machine
+  EXPECT_NEAR(clock_.elapsedS(), 0.2, 1e-6) << "it gave up when the 0.2 s ran out";
 }
 
 TEST_F(ConsoleTest, ExpectRobotsWorksWithoutSelection) {
@@ -397,7 +401,7 @@ struct TempFile {
   }
 };
 
-void navTelemetry(RobotRegistry& registry, const std::string& nav_mode) {
+void navTelemetry(RobotRegistry& registry, const std::string& nav_mode, int64_t now_ns) {
   v1::Telemetry t;
   t.set_mode(nav_mode.empty() ? v1::IDLE : v1::NAVIGATING);
   t.set_nav_mode(nav_mode);
@@ -405,7 +409,7 @@ void navTelemetry(RobotRegistry& registry, const std::string& nav_mode) {
   t.set_goal_index(1);
   t.set_goal_count(3);
   t.set_nav_switches(4);
-  registry.onTelemetry("robot1", kSerial, t, monoNowNs());
+  registry.onTelemetry("robot1", kSerial, t, now_ns);
 }
 
 }  // namespace
@@ -484,7 +488,7 @@ TEST_F(ConsoleTest, RouteFileIsSentAsOneGoTo) {
 }
 
 TEST_F(ConsoleTest, ShippedExampleRouteLoads) {
-  const Route r = loadRouteFile(std::string(INSPECT_SOURCE_DIR) + "/config/routes/warehouse_tour.yaml");
+  const Route r = loadRouteFile(inspect::test::srcPath("config/routes/warehouse_tour.yaml"));
   EXPECT_EQ(r.name, "warehouse_tour");
   EXPECT_GE(r.waypointsM().size(), 4u);
   EXPECT_EQ(r.waypointsM().size() % 2, 0u);
@@ -527,7 +531,7 @@ TEST_F(ConsoleTest, BadRouteFileIsOneLineNamingFileAndKey) {
 
 TEST_F(ConsoleTest, ExpectNavigationFieldsAndStatusLine) {
   connectRobot();
-  navTelemetry(registry_, "FOLLOW_CW");
+  navTelemetry(registry_, "FOLLOW_CW", now());
   auto [ok, out] = run("expect nav_mode == FOLLOW_CW");
   EXPECT_TRUE(ok) << out;
   EXPECT_HAS(out, "nav_mode = FOLLOW_CW");
@@ -545,7 +549,7 @@ TEST_F(ConsoleTest, ExpectNavigationFieldsAndStatusLine) {
   std::tie(ok, out) = run("status");
   EXPECT_HAS(out, "robot1 | NAVIGATING | ");
   EXPECT_HAS(out, " | nav FOLLOW_CW goal 2/3 1.25 m sw 4 | ");
-  navTelemetry(registry_, "");
+  navTelemetry(registry_, "", now());
   std::tie(ok, out) = run("expect nav_mode == NONE");
   EXPECT_TRUE(ok) << out;
   std::tie(ok, out) = run("status");
@@ -606,7 +610,7 @@ TEST_F(ConsoleTest, VideoStatsWithoutAServerStreamSaysSo) {
   t.mutable_video()->set_enabled(true);
   t.mutable_video()->set_ssrc(42);
   t.mutable_video()->set_frames_encoded(300);
-  registry_.onTelemetry("robot1", kSerial, t, monoNowNs());
+  registry_.onTelemetry("robot1", kSerial, t, now());
   const auto [ok, out] = run("video stats");
   EXPECT_TRUE(ok) << out;
   EXPECT_HAS(out, "SSRC 42");
@@ -657,7 +661,7 @@ TEST_F(ConsoleTest, InspectSendsAnInspectionGoToWithDwellPresetsAndLabels) {
 }
 
 TEST_F(ConsoleTest, ShippedInspectionRouteLoadsWithItsMap) {
-  const Route r = loadRouteFile(std::string(INSPECT_SOURCE_DIR) + "/config/routes/gas_lab_inspection.yaml");
+  const Route r = loadRouteFile(inspect::test::srcPath("config/routes/gas_lab_inspection.yaml"));
   EXPECT_EQ(r.name, "gas_lab_inspection");
   EXPECT_EQ(r.points.size(), 7u);
   EXPECT_EQ(r.inspectionPoints(), 2);
@@ -707,7 +711,7 @@ TEST_F(ConsoleTest, AlarmsAreListedAndAcknowledged) {
   a->set_unit("ppm");
   a->mutable_pose()->set_x_m(2.35);
   a->mutable_pose()->set_y_m(3.02);
-  registry_.onEvent("robot1", kSerial, e, monoNowNs());
+  registry_.onEvent("robot1", kSerial, e, now());
   // Printed at once (plain text here; red with a bell on a terminal).
   EXPECT_EQ(console_.background(),
             "[robot1] ALARM_RAISED: gas H2S HIGH alarm raised: 12.30 ppm (threshold 10.00) at (2.35, 3.02)\n");
@@ -738,7 +742,7 @@ TEST_F(ConsoleTest, StatusLineNamesGasChannelsAndShowsAlarms) {
   v1::Hello h;
   h.set_robot_id("robot1");
   for (const char* n : {"CH4", "H2S"}) h.add_gas_channels()->set_name(n);
-  registry_.onConnected("robot1", "127.0.0.1:1", kSerial, h, monoNowNs());
+  registry_.onConnected("robot1", "127.0.0.1:1", kSerial, h, now());
   (void)console_.background();
   v1::Telemetry t;
   t.set_mode(v1::NAVIGATING);
@@ -753,11 +757,11 @@ TEST_F(ConsoleTest, StatusLineNamesGasChannelsAndShowsAlarms) {
   f->set_channel_name("H2S");
   f->set_level(v1::GasAlarm::SENSOR_FAULT);
   f->set_fault("no_data");
-  registry_.onTelemetry("robot1", kSerial, t, monoNowNs());
+  registry_.onTelemetry("robot1", kSerial, t, now());
   const std::string s = console_.statusText("robot1");
   EXPECT_NE(s.find("| gas CH4 25 H2S -- |"), std::string::npos) << s;
   EXPECT_NE(s.find("| ALARM CH4 HIGH 25 %LEL | SENSOR FAULT H2S no_data"), std::string::npos) << s;
-  EXPECT_TRUE(statusIsAlarm(registry_.snapshot("robot1", monoNowNs())));
+  EXPECT_TRUE(statusIsAlarm(registry_.snapshot("robot1", now())));
 }
 
 TEST(LineReader, ALineOverTheLimitIsDroppedAndReportedOnce) {

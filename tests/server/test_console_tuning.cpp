@@ -14,6 +14,7 @@
 #include "shared/config/control_config.hpp"
 #include "shared/net/gains_proto.hpp"
 #include "shared/util/clock.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using namespace inspect::server;
@@ -21,8 +22,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr uint64_t kSerial = 1;
-std::string src(const std::string& rel) { return std::string(INSPECT_SOURCE_DIR) + "/" + rel; }
+constexpr uint64_t kTuningSerial = 1;
+std::string src(const std::string& rel) { return inspect::test::srcPath(rel); }
 
 /// The robot's decision core behind the sink: one 100 Hz tick after each command.
 class CoreSink : public CommandSink {
@@ -41,7 +42,7 @@ class CoreSink : public CommandSink {
     net::toProto(core_->gains(), *h.mutable_gains());
     h.set_gains_version(core_->gainsVersion());
     h.set_fis_name("fuzzy_pid");
-    registry_.onConnected("robot1", "127.0.0.1:1", kSerial, h, monoNowNs());
+    registry_.onConnected("robot1", "127.0.0.1:1", kTuningSerial, h, monoNowNs());
   }
   uint64_t setTeleop(const std::string&, double, double) override { return 0; }
   void clearTeleop(const std::string&) override {}
@@ -50,7 +51,7 @@ class CoreSink : public CommandSink {
     const auto s = registry_.snapshot(robot, monoNowNs());
     if (!s || !s->connected) return 0;
     cmd.set_id(++next_id_);
-    registry_.onAck(robot, kSerial, core_->onCommand(cmd, t_));
+    registry_.onAck(robot, kTuningSerial, core_->onCommand(cmd, t_));
     tick();
     return next_id_;
   }
@@ -67,7 +68,7 @@ class CoreSink : public CommandSink {
         *ev.mutable_gains() = *e.gains;
         ev.set_gains_version(e.gains_version);
       }
-      registry_.onEvent("robot1", kSerial, ev, monoNowNs());
+      registry_.onEvent("robot1", kTuningSerial, ev, monoNowNs());
     }
   }
   client::RobotCore& core() { return *core_; }

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "test_robot.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using namespace inspect::test;
@@ -21,8 +22,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kBinary = std::string(INSPECT_BIN_DIR) + "/pc_server";
-const std::string kConfig = std::string(INSPECT_SOURCE_DIR) + "/config/server.yaml";
+const std::string kBinary = inspect::test::binPath("pc_server");
+const std::string kConfig = inspect::test::srcPath("config/server.yaml");
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);

@@ -1,7 +1,7 @@
 #pragma once
 // A minimal robot for the link tests: a blocking POSIX socket with TLS on top
 // (OpenSSL directly, with the certificate of the robot id it says Hello with,
-// from tests/test_certs.hpp), the shared delimited framing and an optional
+// from tests/support/test_certs.hpp), the shared delimited framing and an optional
 // background pump (heartbeats, telemetry, automatic Acks). Every wait is
 // bounded in time.
 #include <arpa/inet.h>
@@ -30,7 +30,7 @@
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/link_version.hpp"
 #include "shared/net/robot_id.hpp"
-#include "tests/test_certs.hpp"
+#include "tests/support/test_certs.hpp"
 
 namespace inspect::test {
 

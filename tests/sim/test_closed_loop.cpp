@@ -13,6 +13,7 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/control/reference_path.hpp"
 #include "sim/closed_loop.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using control::WheelControl;
@@ -29,7 +30,7 @@ struct Setup {
 const Setup& setup() {
   static const Setup s = [] {
     Setup out;
-    const std::string root = INSPECT_SOURCE_DIR;
+    const std::string root = inspect::test::sourceDir();
     out.robot = config::loadRobotConfigFile(root + "/config/robot.yaml");
     out.control = config::loadControlConfigFile(root + "/config/control.yaml");
     config::applyRobot(out.control, out.robot);

@@ -28,15 +28,16 @@
 #include "sim/truth_log.hpp"
 #include "sim/world.hpp"
 #include "tests/sim/world_text.hpp"
+#include "tests/support/paths.hpp"
+#include "tests/sim/sensor_frames.hpp"
 
 using namespace inspect;
 using namespace inspect::sim;
 
 namespace {
 
-const std::string kSrc = INSPECT_SOURCE_DIR;
+using inspect::test::worldOf;
 
-World worldOf(const std::string& yaml) { return loadWorldText(yaml, "gas_world.yaml"); }
 
 // A closed square room of half-size `half_m` round the origin, plus `gas` lines (indented 2).
 std::string room(double half_m, const std::string& gas, const std::string& extra = "") {
@@ -62,20 +63,11 @@ config::RobotConfig gasRobot() {
 
 std::string simError(const std::string& yaml) {
   try {
-    Simulation sim(gasRobot(), worldOf(yaml), 1);
+    Simulation sim(gasRobot(), worldOf(yaml, "gas_world.yaml"), 1);
   } catch (const config::ConfigError& e) {
     return e.what();
   }
   return "";
-}
-
-std::vector<serial::SensorFrame> decodeFrames(const std::vector<uint8_t>& bytes) {
-  serial::FrameDecoder dec;
-  std::vector<serial::SensorFrame> out;
-  dec.feed(bytes, [&](const serial::Message& m, uint8_t) {
-    if (auto* s = std::get_if<serial::SensorFrame>(&m)) out.push_back(*s);
-  });
-  return out;
 }
 
 config::GasChannel channel(double t90_s, double noise, double scale = 0.01) {
@@ -96,7 +88,7 @@ TEST(GasModel, FreeSpaceSteadyStateIsSymmetricAndMatchesBesselK0) {
   // Source at a cell centre, walls 8 decay lengths away: effectively free space.
   constexpr double q = 5.0, d = 0.05, k = 0.05;
   const World w = worldOf(room(8.0, "  diffusivity_m2_s: 0.05\n  ventilation_per_s: 0.05\n  cell_m: 0.1\n"
-                                    "  sources: [{gas: CH4, x_m: 0.05, y_m: 0.05, rate: 5, start_s: -1e5}]\n"));
+                                    "  sources: [{gas: CH4, x_m: 0.05, y_m: 0.05, rate: 5, start_s: -1e5}]\n"), "gas_world.yaml");
   const GasModel g(w);
   ASSERT_EQ(g.gases().size(), 1u);
   const int f = g.field("CH4");
@@ -137,8 +129,8 @@ TEST(GasModel, ExplicitStepsConvergeToTheSteadyState) {
   };
   for (const auto& c : cases) {
     const std::string gas = std::string(c.params) + "  sources: [{gas: CH4, x_m: -0.5, y_m: 0.3, rate: 4, start_s: ";
-    const GasModel steady(worldOf(room(3.0, gas + "-1e5}]\n")));
-    GasModel run(worldOf(room(3.0, gas + "0}]\n")));
+    const GasModel steady(worldOf(room(3.0, gas + "-1e5}]\n"), "gas_world.yaml"));
+    GasModel run(worldOf(room(3.0, gas + "0}]\n"), "gas_world.yaml"));
     EXPECT_EQ(run.mass(0), 0.0);
     const int n = static_cast<int>(c.run_s / 0.05);
     for (int i = 1; i <= n; ++i) run.advanceTo(i * 0.05);
@@ -151,9 +143,9 @@ TEST(GasModel, SteadyFieldsAreLeftAloneUntilALeakStartsOrStops) {
   // Linearity: both leaks together = each alone, whether a field is stepped or left steady.
   const std::string old_leak = "    - {gas: CH4, x_m: -1.0, y_m: 0.5, rate: 3, start_s: -1e5}\n";
   const std::string new_leak = "    - {gas: CH4, x_m: 1.0, y_m: -0.5, rate: 2, start_s: 5, end_s: 12}\n";
-  GasModel both(worldOf(room(3.0, "  airflow_m_s: [0.02, 0.01]\n  sources:\n" + old_leak + new_leak)));
-  GasModel first(worldOf(room(3.0, "  airflow_m_s: [0.02, 0.01]\n  sources:\n" + old_leak)));
-  GasModel second(worldOf(room(3.0, "  airflow_m_s: [0.02, 0.01]\n  sources:\n" + new_leak)));
+  GasModel both(worldOf(room(3.0, "  airflow_m_s: [0.02, 0.01]\n  sources:\n" + old_leak + new_leak), "gas_world.yaml"));
+  GasModel first(worldOf(room(3.0, "  airflow_m_s: [0.02, 0.01]\n  sources:\n" + old_leak), "gas_world.yaml"));
+  GasModel second(worldOf(room(3.0, "  airflow_m_s: [0.02, 0.01]\n  sources:\n" + new_leak), "gas_world.yaml"));
   EXPECT_TRUE(both.steady(0));
   EXPECT_TRUE(second.steady(0));  // nothing yet
   EXPECT_FALSE(both.steady(1));
@@ -177,7 +169,7 @@ TEST(GasModel, SteadyFieldsAreLeftAloneUntilALeakStartsOrStops) {
   EXPECT_GT(second.mass(0), 1.0);
   // Still steady after the fact: a stepped steady state stays put (to the solver's tolerance).
   GasModel stepped(worldOf(room(3.0, "  airflow_m_s: [0.02, 0.01]\n  sources:\n" + old_leak +
-                                       "    - {gas: CH4, x_m: 1.0, y_m: -0.5, rate: 2, start_s: 1e8}\n")));
+                                       "    - {gas: CH4, x_m: 1.0, y_m: -0.5, rate: 2, start_s: 1e8}\n"), "gas_world.yaml"));
   stepped.advanceTo(1e8 - 1.0);
   EXPECT_TRUE(stepped.steady(0));
   stepped.advanceTo(1e8 + 0.05);
@@ -185,7 +177,7 @@ TEST(GasModel, SteadyFieldsAreLeftAloneUntilALeakStartsOrStops) {
 }
 
 TEST(GasModel, SubstepCountHoldsLongJumps) {
-  const GasModel g(worldOf(room(3.0, "  sources: [{gas: CH4, x_m: 0.0, y_m: 0.0, rate: 1, start_s: 0}]\n")));
+  const GasModel g(worldOf(room(3.0, "  sources: [{gas: CH4, x_m: 0.0, y_m: 0.0, rate: 1, start_s: 0}]\n"), "gas_world.yaml"));
   const double step = GasModel::kStabilityFactor * g.maxStableStepS();
   EXPECT_EQ(g.substeps(0.0), 0);
   EXPECT_EQ(g.substeps(-1.0), 0);
@@ -205,7 +197,7 @@ TEST(GasModel, SubstepCountHoldsLongJumps) {
 TEST(GasModel, WallBlocksGas) {
   // A 6 m wall 1 m east of the source: behind it the gas must go round the ends.
   const World w = worldOf(room(6.0, "  sources: [{gas: CH4, x_m: 0.05, y_m: 0.05, rate: 5, start_s: -1e5}]\n",
-                                "  - {from_m: [1.0, -3.0], to_m: [1.0, 3.0]}\n"));
+                                "  - {from_m: [1.0, -3.0], to_m: [1.0, 3.0]}\n"), "gas_world.yaml");
   const GasModel g(w);
   const double open = g.concentration(0, {-1.95, 0.05});
   const double behind = g.concentration(0, {2.05, 0.05});
@@ -224,8 +216,8 @@ TEST(GasModel, AirflowShiftsThePlumeDownwind) {
     return room(6.0, std::string("  airflow_m_s: ") + u +
                          "\n  sources: [{gas: H2S, x_m: 0.05, y_m: 0.05, rate: 5, start_s: -1e5}]\n");
   };
-  const GasModel still(worldOf(yaml("[0, 0]")));
-  const GasModel east(worldOf(yaml("[0.1, 0]")));
+  const GasModel still(worldOf(yaml("[0, 0]"), "gas_world.yaml"));
+  const GasModel east(worldOf(yaml("[0.1, 0]"), "gas_world.yaml"));
   const double up = east.concentration(0, {-0.95, 0.05}), down = east.concentration(0, {1.05, 0.05});
   // Analytic: c = q/(2 pi D) exp(u x / 2D) K0(r sqrt(u^2/4D^2 + k/D)): down/up = exp(u r / D) = e^2 at r = 1 m.
   std::printf("GAS airflow 0.1 m/s: 1 m downwind %.4f, 1 m upwind %.4f, ratio %.2f (analytic %.2f); still air %.4f\n",
@@ -241,7 +233,7 @@ TEST(GasModel, MassBalanceWithoutVentilation) {
   // Closed room, no removal, a draught pushing the gas into a corner: every emitted unit stays.
   const World w = worldOf(room(2.0, "  ventilation_per_s: 0\n  airflow_m_s: [0.05, 0.02]\n  sources:\n"
                                     "    - {gas: CH4, x_m: -1.0, y_m: 0.5, rate: 2.0}\n"
-                                    "    - {gas: CH4, x_m: 1.0, y_m: -0.5, rate: 1.0, start_s: 5, end_s: 12}\n"));
+                                    "    - {gas: CH4, x_m: 1.0, y_m: -0.5, rate: 1.0, start_s: 5, end_s: 12}\n"), "gas_world.yaml");
   GasModel g(w);
   for (int i = 1; i <= 400; ++i) g.advanceTo(i * 0.05);  // 20 s
   const double expected = 2.0 * 20.0 + 1.0 * 7.0;
@@ -253,7 +245,7 @@ TEST(GasModel, PreIntegratedLeaksCarryTheRightMass) {
   // Closed room with ventilation: total mass obeys dM/dt = q - k M exactly.
   constexpr double q = 3.0, k = 0.05;
   const auto massOf = [](const std::string& times) {
-    return GasModel(worldOf(room(3.0, "  sources: [{gas: CO, x_m: 0.3, y_m: 0.2, rate: 3, " + times + "}]\n")))
+    return GasModel(worldOf(room(3.0, "  sources: [{gas: CO, x_m: 0.3, y_m: 0.2, rate: 3, " + times + "}]\n"), "gas_world.yaml"))
         .mass(0);
   };
   EXPECT_NEAR(massOf("start_s: -1e6") / (q / k), 1.0, 2e-3);  // steady state solved directly
@@ -266,7 +258,7 @@ TEST(GasModel, PreIntegratedLeaksCarryTheRightMass) {
 
 TEST(GasModel, ConcentrationIsZeroInsideObstaclesAndOffTheGrid) {
   const World w = worldOf(room(3.0, "  sources: [{gas: CH4, x_m: 0.0, y_m: 0.45, rate: 5, start_s: -1e5}]\n",
-                               "obstacles:\n  - {vertices_m: [-1, -0.3, 1, -0.3, 1, 0.3, -1, 0.3]}\n"));
+                               "obstacles:\n  - {vertices_m: [-1, -0.3, 1, -0.3, 1, 0.3, -1, 0.3]}\n"), "gas_world.yaml");
   const GasModel g(w);
   EXPECT_GT(g.concentration(0, {0.0, 0.5}), 1.0);
   EXPECT_EQ(g.concentration(0, {0.0, 0.0}), 0.0);
@@ -371,7 +363,7 @@ TEST(GasSimulation, CrossSensitivityAndBackground) {
   // Default channels: CO reads 0.1 x H2S, O2 reads 20.9 - 0.0105 x CH4.
   Simulation sim(gasRobot(),
                  worldOf(room(4.0, "  sources:\n    - {gas: H2S, x_m: 1.0, y_m: 1.0, rate: 5, start_s: -1e5}\n"
-                                   "    - {gas: CH4, x_m: -1.0, y_m: -1.0, rate: 20, start_s: -1e5}\n")),
+                                   "    - {gas: CH4, x_m: -1.0, y_m: -1.0, rate: 20, start_s: -1e5}\n"), "gas_world.yaml"),
                  1);
   for (Vec2 p : {Vec2{1.5, 1.0}, Vec2{0.0, 0.0}, Vec2{-1.3, -0.8}}) {
     const double ch4 = sim.trueConcentration(0, p), h2s = sim.trueConcentration(1, p);
@@ -405,12 +397,12 @@ TEST(GasSimulation, FramesCarryReadingsAndDropoutSetsTheMcuFault) {
   Simulation sim(robot,
                  worldOf(room(4.0, "  sources: [{name: v1, gas: CH4, x_m: 0.8, y_m: 0.0, rate: 20, start_s: -1e5}]\n"
                                    "  faults:\n    - {channel: H2S, kind: dropout, start_s: 0.5, end_s: 1.0}\n"
-                                   "    - {channel: CO, kind: stuck, start_s: 0.2}\n")),
+                                   "    - {channel: CO, kind: stuck, start_s: 0.2}\n"), "gas_world.yaml"),
                  3, &rec);
   sim.advanceTo(1500);
   std::vector<uint8_t> tx;
   sim.takeTx(tx);
-  const auto frames = decodeFrames(tx);
+  const auto frames = inspect::test::decodeSensorFrames(tx);
   ASSERT_EQ(frames.size(), 150u);
   const double ch4_true = sim.trueConcentration(0, sim.gasInlet());
   for (const auto& f : frames) {
@@ -446,7 +438,7 @@ TEST(GasSimulation, FewerChannelsLeaveTheOtherSlotsZero) {
   sim.advanceTo(100);
   std::vector<uint8_t> tx;
   sim.takeTx(tx);
-  const auto frames = decodeFrames(tx);
+  const auto frames = inspect::test::decodeSensorFrames(tx);
   ASSERT_EQ(frames.size(), 10u);
   for (const auto& f : frames) {
     EXPECT_EQ(f.gas_raw[2], 0);
@@ -465,7 +457,7 @@ TEST(GasSimulation, RobotWithoutGasChannelsSendsZerosAndNoGasRows) {
   sim.advanceTo(500);
   std::vector<uint8_t> tx;
   sim.takeTx(tx);
-  for (const auto& f : decodeFrames(tx)) {
+  for (const auto& f : inspect::test::decodeSensorFrames(tx)) {
     EXPECT_EQ(f.gas_raw, (std::array<uint16_t, 4>{}));
     EXPECT_EQ(f.faults & serial::kFaultGasSensor, 0);
   }
@@ -473,7 +465,7 @@ TEST(GasSimulation, RobotWithoutGasChannelsSendsZerosAndNoGasRows) {
   EXPECT_EQ(rec.gas_events, 0);
   // A world with leaks needs channels to sense them.
   try {
-    Simulation bad(config::RobotConfig{}, loadWorldFile(kSrc + "/config/worlds/gas_lab.yaml"), 1);
+    Simulation bad(config::RobotConfig{}, loadWorldFile(inspect::test::srcPath("config/worlds/gas_lab.yaml")), 1);
     ADD_FAILURE() << "no error";
   } catch (const config::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("gas.sources[0].gas: 'CH4' is not a gas channel of the robot (robot config "
@@ -484,14 +476,14 @@ TEST(GasSimulation, RobotWithoutGasChannelsSendsZerosAndNoGasRows) {
 }
 
 TEST(GasSimulation, SameSeedSameReadings) {
-  const World w = loadWorldFile(kSrc + "/config/worlds/gas_lab.yaml");
+  const World w = loadWorldFile(inspect::test::srcPath("config/worlds/gas_lab.yaml"));
   auto run = [&](uint64_t seed) {
     Simulation sim(gasRobot(), w, seed);
     sim.advanceTo(500);
     std::vector<uint8_t> tx;
     sim.takeTx(tx);
     std::vector<std::array<uint16_t, 4>> out;
-    for (const auto& f : decodeFrames(tx)) out.push_back(f.gas_raw);
+    for (const auto& f : inspect::test::decodeSensorFrames(tx)) out.push_back(f.gas_raw);
     return out;
   };
   EXPECT_EQ(run(5), run(5));
@@ -565,7 +557,7 @@ TEST(GasWorld, GasNamesMustBeRobotChannels) {
 }
 
 TEST(GasWorld, DocsExampleLoadsAndRuns) {
-  std::ifstream in(kSrc + "/docs/world-format.md");
+  std::ifstream in(inspect::test::srcPath("docs/world-format.md"));
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string doc = ss.str();
@@ -583,8 +575,8 @@ TEST(GasWorld, DocsExampleLoadsAndRuns) {
 // --- the shipped gas_lab world ---
 
 TEST(GasLab, SteadyPlumesRaiseAndClearAlarmsAlongTheRoute) {
-  const config::RobotConfig robot = config::loadRobotConfigFile(kSrc + "/config/robot.yaml");
-  const World w = loadWorldFile(kSrc + "/config/worlds/gas_lab.yaml");
+  const config::RobotConfig robot = config::loadRobotConfigFile(inspect::test::srcPath("config/robot.yaml"));
+  const World w = loadWorldFile(inspect::test::srcPath("config/worlds/gas_lab.yaml"));
   const auto t0 = std::chrono::steady_clock::now();
   Simulation sim(robot, w, 1);
   const double build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -644,14 +636,14 @@ TEST(GasLab, SteadyPlumesRaiseAndClearAlarmsAlongTheRoute) {
 
 TEST(GasLab, DrivingTheSouthAisleTheCh4AlarmWouldRaiseAndClear) {
   // Straight along y = 1.5 at 0.4 m/s past valve_A, the sensors' lag included (CH4 t90 = 6 s).
-  const config::RobotConfig robot = config::loadRobotConfigFile(kSrc + "/config/robot.yaml");
+  const config::RobotConfig robot = config::loadRobotConfigFile(inspect::test::srcPath("config/robot.yaml"));
   struct Rec : SimObserver {
     std::vector<std::array<double, 4>> rows;  // x of the inlet, true CH4, read CH4, read H2S
     void onGas(const GasSample& s) override {
       rows.push_back({s.inlet_x_m, s.true_value[0], s.reading[0], s.reading[1]});
     }
   } rec;
-  Simulation sim(robot, loadWorldFile(kSrc + "/config/worlds/gas_lab.yaml"), 1, &rec);
+  Simulation sim(robot, loadWorldFile(inspect::test::srcPath("config/worlds/gas_lab.yaml")), 1, &rec);
   serial::FrameEncoder enc;
   while (sim.state().pose.x_m < 9.0 && sim.timeMs() < 40000) {
     sim.receive(enc.encode(serial::WheelCommand{2000, 2000, serial::WheelCommand::kEnable}).span());
@@ -681,7 +673,7 @@ TEST(GasLab, DrivingTheSouthAisleTheCh4AlarmWouldRaiseAndClear) {
 }
 
 TEST(GasLab, GasUpdateCost) {
-  const World w = loadWorldFile(kSrc + "/config/worlds/gas_lab.yaml");
+  const World w = loadWorldFile(inspect::test::srcPath("config/worlds/gas_lab.yaml"));
   const auto tb = std::chrono::steady_clock::now();
   GasModel g(w);
   std::printf("GAS gas_lab: GasModel built (grid + steady states) in %.1f ms\n",
@@ -726,7 +718,7 @@ TEST(GasLab, TruthLogHasGasRowsAndSourceEvents) {
       (std::filesystem::temp_directory_path() / ("gas_truth_" + std::to_string(::getpid()) + ".csv")).string();
   {
     TruthLog truth(path);
-    Simulation sim(gasRobot(), loadWorldFile(kSrc + "/config/worlds/gas_lab.yaml"), 1, &truth);
+    Simulation sim(gasRobot(), loadWorldFile(inspect::test::srcPath("config/worlds/gas_lab.yaml")), 1, &truth);
     sim.advanceTo(1000);
   }
   std::ifstream in(path);

@@ -10,6 +10,7 @@
 #include "shared/serial/frame_codec.hpp"
 #include "sim/mcu_emulator.hpp"
 #include "sim/simulation.hpp"
+#include "tests/sim/sensor_frames.hpp"
 
 using namespace inspect;
 using namespace inspect::sim;
@@ -42,17 +43,6 @@ std::vector<uint8_t> frameBytes(serial::FrameEncoder& enc, const serial::Message
 }
 
 World emptyWorld() { return World{}; }
-
-std::vector<serial::SensorFrame> decodeFrames(const std::vector<uint8_t>& bytes) {
-  serial::FrameDecoder dec;
-  std::vector<serial::SensorFrame> out;
-  dec.feed(bytes, [&](const serial::Message& m, uint8_t) {
-    if (auto* s = std::get_if<serial::SensorFrame>(&m)) out.push_back(*s);
-  });
-  EXPECT_EQ(dec.counters().errors(), 0u);
-  EXPECT_EQ(dec.counters().seq_gaps, 0u);
-  return out;
-}
 
 }  // namespace
 
@@ -201,7 +191,7 @@ TEST(Simulation, HundredHzFramesWithConsistentContents) {
     sim.takeTx(tx);
     all.insert(all.end(), tx.begin(), tx.end());
   }
-  const auto frames = decodeFrames(all);
+  const auto frames = inspect::test::decodeSensorFrames(all);
   ASSERT_EQ(frames.size(), 100u);
   EXPECT_EQ(rec.samples.size(), 100u);
   for (std::size_t i = 0; i < frames.size(); ++i) EXPECT_EQ(frames[i].mcu_time_ms, 10 * i);

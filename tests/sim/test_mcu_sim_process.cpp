@@ -23,13 +23,13 @@
 
 #include "shared/serial/frame_codec.hpp"
 #include "shared/util/clock.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 
 namespace {
 
-const std::string kBin = std::string(INSPECT_BIN_DIR) + "/mcu_sim";
-const std::string kSrc = INSPECT_SOURCE_DIR;
+const std::string kBin = inspect::test::binPath("mcu_sim");
 
 struct Captured {
   int exit_code = -1;
@@ -176,7 +176,7 @@ TEST(McuSimProgram, HelpAndCommandLineErrors) {
   EXPECT_EQ(bad_rate.exit_code, 2);
   EXPECT_NE(bad_rate.out.find("--rate"), std::string::npos);
 
-  const auto missing = runQuick("--world /nonexistent.yaml --robot " + kSrc + "/config/robot.yaml");
+  const auto missing = runQuick("--world /nonexistent.yaml --robot " + inspect::test::srcPath("config/robot.yaml"));
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.out.find("/nonexistent.yaml"), std::string::npos) << missing.out;
 }
@@ -185,7 +185,7 @@ TEST(McuSimProgram, BadWorldFileIsOneLineNamingFileAndKey) {
   TempDir dir;
   const std::string world = dir.path() + "/bad.yaml";
   std::ofstream(world) << "name: bad\nwals: []\n";
-  const auto r = runQuick("--world " + world + " --robot " + kSrc + "/config/robot.yaml --duration 1");
+  const auto r = runQuick("--world " + world + " --robot " + inspect::test::srcPath("config/robot.yaml --duration 1"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.out, "mcu_sim: " + world + ": wals: unknown key (misspelt, or not used by this program)\n");
 }
@@ -197,7 +197,7 @@ TEST(McuSimProgram, RealPtyFramesCommandsAndWatchdog) {
   const std::string truth = dir.path() + "/truth.csv";
   constexpr double kRate = 5.0;
   // 6 s of sim time = 1.2 s of wall time: room for the three phases below on a busy machine.
-  SimProcess sim({"--world", kSrc + "/config/worlds/empty.yaml", "--robot", kSrc + "/config/robot.yaml", "--rate", "5",
+  SimProcess sim({"--world", inspect::test::srcPath("config/worlds/empty.yaml"), "--robot", inspect::test::srcPath("config/robot.yaml"), "--rate", "5",
                   "--duration", "6", "--pty-link", link, "--truth", truth});
   ASSERT_TRUE(sim.started());
   const std::string dev_line = sim.readLine(5000);
@@ -350,7 +350,7 @@ TEST(McuSimProgram, RealPtyFramesCommandsAndWatchdog) {
 TEST(McuSimProgram, SigtermPrintsFinalPoseAndCleansUp) {
   TempDir dir;
   const std::string link = dir.path() + "/mcu";
-  SimProcess sim({"--world", kSrc + "/config/worlds/square_room.yaml", "--robot", kSrc + "/config/robot.yaml",
+  SimProcess sim({"--world", inspect::test::srcPath("config/worlds/square_room.yaml"), "--robot", inspect::test::srcPath("config/robot.yaml"),
                   "--pty-link", link});
   ASSERT_TRUE(sim.started());
   ASSERT_EQ(sim.readLine(5000).rfind("mcu_sim: serial device ", 0), 0u);

@@ -8,19 +8,18 @@
 #include "shared/config/robot_config.hpp"
 #include "sim/robot_plant.hpp"
 #include "sim/simulation.hpp"
+#include "tests/sim/world_text.hpp"
 
 using namespace inspect;
 using namespace inspect::sim;
 
 namespace {
 
+using inspect::test::worldOf;
+
 constexpr double kDt_s = 0.001;
 
 config::RobotConfig paperRobot() { return config::RobotConfig{}; }
-
-World worldOf(const std::string& yaml) {
-  return loadWorldText(yaml, "w.yaml");
-}
 
 PlantState run(const RobotPlant& p, PlantState s, control::WheelSpeeds sp, double t_s) {
   const int n = static_cast<int>(std::lround(t_s / kDt_s));
@@ -106,7 +105,7 @@ TEST(RobotPlant, QuarterCircleArc) {
 
 TEST(RobotPlant, WallBlocksPenetration) {
   const auto robot = paperRobot();
-  const World w = worldOf("walls:\n  - {from_m: [1.0, -2], to_m: [1.0, 2]}\n");
+  const World w = worldOf("walls:\n  - {from_m: [1.0, -2], to_m: [1.0, 2]}\n", "w.yaml");
   const RobotPlant p(robot, w);
   const double wheel = 1.0 / robot.geometry.wheel_radius_m;
   PlantState s;
@@ -128,7 +127,7 @@ TEST(RobotPlant, WallBlocksPenetration) {
 TEST(RobotPlant, ConcaveObstacleBlocksInsideTheNotch) {
   const auto robot = paperRobot();
   // U opening to -x; the robot drives into the 1.2 m wide notch and stops at its end.
-  const World w = worldOf("obstacles:\n  - {vertices_m: [2,-1.6, 5,-1.6, 5,1.6, 2,1.6, 2,0.6, 4,0.6, 4,-0.6, 2,-0.6]}\n");
+  const World w = worldOf("obstacles:\n  - {vertices_m: [2,-1.6, 5,-1.6, 5,1.6, 2,1.6, 2,0.6, 4,0.6, 4,-0.6, 2,-0.6]}\n", "w.yaml");
   const RobotPlant p(robot, w);
   const double wheel = 0.8 / robot.geometry.wheel_radius_m;
   PlantState s;
@@ -145,7 +144,7 @@ TEST(Simulation, CollisionEventLoggedOncePerContact) {
     void onEvent(double, std::string_view e, std::string_view) override { collisions += e == "collision"; }
   } events;
   const auto robot = paperRobot();
-  Simulation sim(robot, worldOf("walls:\n  - {from_m: [1.0, -2], to_m: [1.0, 2]}\n"), 1, &events);
+  Simulation sim(robot, worldOf("walls:\n  - {from_m: [1.0, -2], to_m: [1.0, 2]}\n", "w.yaml"), 1, &events);
   // Drive into the wall with commands every 10 ms for 3 s, then back off, then again.
   serial::FrameEncoder enc;
   auto drive = [&](int16_t mrad_s, int ms) {

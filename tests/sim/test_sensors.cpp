@@ -8,22 +8,21 @@
 #include "shared/serial/messages.hpp"
 #include "sim/grayscale_model.hpp"
 #include "sim/ultrasonic_model.hpp"
+#include "tests/sim/world_text.hpp"
 
 using namespace inspect;
 using namespace inspect::sim;
 
 namespace {
 
-World worldOf(const std::string& yaml) {
-  return loadWorldText(yaml, "w.yaml");
-}
+using inspect::test::worldOf;
 
 }  // namespace
 
 TEST(Ultrasonic, WallAtOneMetreReadsWithinPaperAccuracy) {
   const config::UltrasonicConfig cfg;
   // Front-left sensor at (0.30, 0.12) facing +x; wall 1.0 m ahead of it.
-  const World w = worldOf("walls:\n  - {from_m: [1.30, -5], to_m: [1.30, 5]}\n");
+  const World w = worldOf("walls:\n  - {from_m: [1.30, -5], to_m: [1.30, 5]}\n", "w.yaml");
   UltrasonicModel us(cfg, 42);
   const control::Pose2 pose{};
   ASSERT_TRUE(us.trueRange(w, pose, serial::kFrontLeft));
@@ -46,7 +45,7 @@ TEST(Ultrasonic, WallAtOneMetreReadsWithinPaperAccuracy) {
 
 TEST(Ultrasonic, SameSeedSameReadings) {
   const config::UltrasonicConfig cfg;
-  const World w = worldOf("walls:\n  - {from_m: [2, -5], to_m: [2, 5]}\n");
+  const World w = worldOf("walls:\n  - {from_m: [2, -5], to_m: [2, 5]}\n", "w.yaml");
   UltrasonicModel a(cfg, 7), b(cfg, 7), c(cfg, 8);
   bool differs = false;
   for (int i = 0; i < 20; ++i) {
@@ -61,9 +60,9 @@ TEST(Ultrasonic, NoEchoBeyondMaxRangeAndClampedBelowMin) {
   config::UltrasonicConfig cfg;
   cfg.noise_m = 0.0;
   UltrasonicModel us(cfg, 1);
-  const World far = worldOf("walls:\n  - {from_m: [5.0, -0.1], to_m: [5.0, 0.1]}\n");
+  const World far = worldOf("walls:\n  - {from_m: [5.0, -0.1], to_m: [5.0, 0.1]}\n", "w.yaml");
   EXPECT_EQ(us.measureMm(far, {}, serial::kFrontLeft), serial::kNoEcho);
-  const World near = worldOf("walls:\n  - {from_m: [0.31, -1], to_m: [0.31, 1]}\n");
+  const World near = worldOf("walls:\n  - {from_m: [0.31, -1], to_m: [0.31, 1]}\n", "w.yaml");
   EXPECT_EQ(us.measureMm(near, {}, serial::kFrontLeft), 20);  // min_range_m
 }
 
@@ -73,7 +72,7 @@ TEST(Ultrasonic, BeamConeSeesObliqueTargets) {
   UltrasonicModel us(cfg, 1);
   // A post 2 m ahead, 0.4 m to the left of the front-left sensor axis: inside
   // the 30 degree cone (atan(0.4/2) = 11 deg) but off the axis.
-  const World w = worldOf("obstacles:\n  - {vertices_m: [2.3,0.45, 2.35,0.45, 2.35,0.6, 2.3,0.6]}\n");
+  const World w = worldOf("obstacles:\n  - {vertices_m: [2.3,0.45, 2.35,0.45, 2.35,0.6, 2.3,0.6]}\n", "w.yaml");
   const auto r = us.trueRange(w, {}, serial::kFrontLeft);
   ASSERT_TRUE(r);
   EXPECT_GT(*r, 2.0);
@@ -89,7 +88,7 @@ TEST(Ultrasonic, SideSensorsFollowTheRobotHeading) {
   UltrasonicModel us(cfg, 1);
   // Wall along y = 2; robot at the origin facing +x: the left sensor (0, 0.25,
   // +90 deg) sees it at 1.75 m; turned to face -x, the right sensor does.
-  const World w = worldOf("walls:\n  - {from_m: [-10, 2], to_m: [10, 2]}\n");
+  const World w = worldOf("walls:\n  - {from_m: [-10, 2], to_m: [10, 2]}\n", "w.yaml");
   EXPECT_EQ(us.measureMm(w, {}, serial::kLeft), 1750);
   EXPECT_EQ(us.measureMm(w, {}, serial::kRight), serial::kNoEcho);
   EXPECT_EQ(us.measureMm(w, {0, 0, std::numbers::pi}, serial::kRight), 1750);
@@ -100,7 +99,7 @@ TEST(Grayscale, ChannelsAcrossTheFront) {
   EXPECT_DOUBLE_EQ(GrayscaleModel::spotInRobot(7).y_m, -0.07);
   EXPECT_DOUBLE_EQ(GrayscaleModel::spotInRobot(3).x_m, GrayscaleModel::kRowX_m);
   // A 2.5 cm line along x under the robot's centre: the middle channels see it.
-  const World w = worldOf("floor_lines:\n  - {from_m: [-1, 0], to_m: [1, 0], width_m: 0.025}\n");
+  const World w = worldOf("floor_lines:\n  - {from_m: [-1, 0], to_m: [1, 0], width_m: 0.025}\n", "w.yaml");
   EXPECT_EQ(GrayscaleModel::read(w, {}), 0b00011000);
   // Robot 5 cm to the right of the line (-y): only channel 1 (left side) sees it.
   EXPECT_EQ(GrayscaleModel::read(w, {0, -0.05, 0}), 0b00000010);

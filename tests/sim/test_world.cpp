@@ -10,6 +10,7 @@
 
 #include "sim/world.hpp"
 #include "tests/sim/world_text.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect::sim;
 using inspect::config::ConfigError;
@@ -17,18 +18,15 @@ using inspect::config::ConfigNode;
 
 namespace {
 
-const std::string kSrc = INSPECT_SOURCE_DIR;
+using inspect::test::worldOf;
 
-World worldOf(const std::string& yaml) {
-  return loadWorldText(yaml, "test_world.yaml");
-}
 
 std::string errorOf(const std::string& yaml) { return inspect::test::worldError(yaml, "test_world.yaml"); }
 
 }  // namespace
 
 TEST(WorldFile, ShippedSquareRoomLoads) {
-  const World w = loadWorldFile(kSrc + "/config/worlds/square_room.yaml");
+  const World w = loadWorldFile(inspect::test::srcPath("config/worlds/square_room.yaml"));
   EXPECT_EQ(w.name, "square_room");
   EXPECT_EQ(w.walls.size(), 4u);  // closed polyline of 4 points
   ASSERT_EQ(w.obstacles.size(), 1u);
@@ -42,7 +40,7 @@ TEST(WorldFile, ShippedSquareRoomLoads) {
 }
 
 TEST(WorldFile, ShippedEmptyLoads) {
-  const World w = loadWorldFile(kSrc + "/config/worlds/empty.yaml");
+  const World w = loadWorldFile(inspect::test::srcPath("config/worlds/empty.yaml"));
   EXPECT_EQ(w.name, "empty");
   EXPECT_TRUE(w.walls.empty());
   EXPECT_TRUE(w.obstacles.empty());
@@ -103,14 +101,14 @@ TEST(WorldFile, MissingFileIsAConfigError) {
 }
 
 TEST(WorldFile, StartInsideObstacleIsRejected) {
-  const World w = worldOf("start: {x_m: 0.5, y_m: 0.5}\nobstacles:\n  - {vertices_m: [0, 0, 1, 0, 1, 1, 0, 1]}\n");
+  const World w = worldOf("start: {x_m: 0.5, y_m: 0.5}\nobstacles:\n  - {vertices_m: [0, 0, 1, 0, 1, 1, 0, 1]}\n", "test_world.yaml");
   try {
     checkStartPose(w, 0.35);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("test_world.yaml: start"), std::string::npos) << e.what();
   }
-  const World near_wall = worldOf("start: {x_m: 0.2}\nwalls:\n  - {from_m: [0.5, -1], to_m: [0.5, 1]}\n");
+  const World near_wall = worldOf("start: {x_m: 0.2}\nwalls:\n  - {from_m: [0.5, -1], to_m: [0.5, 1]}\n", "test_world.yaml");
   EXPECT_THROW(checkStartPose(near_wall, 0.35), ConfigError);
   EXPECT_NO_THROW(checkStartPose(near_wall, 0.25));
 }
@@ -131,7 +129,7 @@ class RayCast : public ::testing::TestWithParam<RayCase> {};
 
 TEST_P(RayCast, FirstHitDistance) {
   const auto& c = GetParam();
-  const World w = worldOf(c.world_yaml);
+  const World w = worldOf(c.world_yaml, "test_world.yaml");
   const auto hit = castRay(w, c.origin, c.yaw_rad, 10.0);
   if (!c.expect_m) {
     EXPECT_FALSE(hit) << c.name << " hit at " << *hit;
@@ -175,7 +173,7 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(Clearance, SegmentsAndPolygons) {
-  const World w = worldOf(kUShape);
+  const World w = worldOf(kUShape, "test_world.yaml");
   EXPECT_DOUBLE_EQ(clearance(w, {-1, 1.5}), std::sqrt(1.25));  // to the notch corners (0, 1), (0, 2)
   EXPECT_DOUBLE_EQ(clearance(w, {1.0, 1.5}), 0.5);  // inside the notch: 0.5 to its floor and ceiling
   EXPECT_DOUBLE_EQ(clearance(w, {2.5, 0.5}), 0.0);  // inside the solid part
@@ -183,7 +181,7 @@ TEST(Clearance, SegmentsAndPolygons) {
 }
 
 TEST(FloorLines, WidthIsRespected) {
-  const World w = worldOf("floor_lines:\n  - {from_m: [0, 0], to_m: [2, 0], width_m: 0.04}\n");
+  const World w = worldOf("floor_lines:\n  - {from_m: [0, 0], to_m: [2, 0], width_m: 0.04}\n", "test_world.yaml");
   EXPECT_TRUE(onFloorLine(w, {1.0, 0.0}));
   EXPECT_TRUE(onFloorLine(w, {1.0, 0.019}));
   EXPECT_FALSE(onFloorLine(w, {1.0, 0.021}));

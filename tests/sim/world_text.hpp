@@ -6,6 +6,11 @@
 
 namespace inspect::test {
 
+/// The world of `yaml` (a test's own world text; throws ConfigError when it is bad).
+inline sim::World worldOf(const std::string& yaml, const std::string& name = "world.yaml") {
+  return sim::loadWorldText(yaml, name);
+}
+
 /// The ConfigError message of loading `yaml` as a world named `name`; "" when it loads.
 inline std::string worldError(const std::string& yaml, const std::string& name) {
   try {

@@ -14,6 +14,8 @@
 
 #include "shared/config/gains_file.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
+#include "tests/support/paths.hpp"
+#include "tests/support/process.hpp"
 
 using namespace inspect;
 using config::ConfigError;
@@ -21,7 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kSource = INSPECT_SOURCE_DIR;
 
 // The ConfigError message of `f`, "" if it does not throw one.
 template <class F>
@@ -32,13 +33,6 @@ std::string errorOf(F&& f) {
     return e.what();
   }
   return "";
-}
-
-std::string readText(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // Gains whose decimal forms are long: only an exact writer brings them back.
@@ -160,12 +154,12 @@ TEST_F(GainsFileTest, MissingFileIsAnErrorNamingIt) {
 }
 
 TEST_F(GainsFileTest, ExportWritesTheFisBesideAndImportReadsBoth) {
-  const fuzzy::Fis fis = fuzzy::readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis");
+  const fuzzy::Fis fis = fuzzy::readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis"));
   const control::GainSet g = awkwardGains();
   const std::string yaml = (dir_ / "gains_tuned.yaml").string();
   config::exportGains(g, fis, yaml, "from a test");
   ASSERT_TRUE(fs::exists(dir_ / "gains_tuned.fis"));
-  const std::string text = readText(yaml);
+  const std::string text = inspect::test::readFile(yaml);
   EXPECT_EQ(text.rfind("# from a test\n", 0), 0u) << text;
   EXPECT_NE(text.find("fis: \"gains_tuned.fis\""), std::string::npos) << text;
 
@@ -181,7 +175,7 @@ TEST_F(GainsFileTest, ExportWritesTheFisBesideAndImportReadsBoth) {
 }
 
 TEST_F(GainsFileTest, AbsoluteFisPathIsKept) {
-  const std::string fis = kSource + "/config/fuzzy/fuzzy_pid.fis";
+  const std::string fis = inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis");
   const std::string yaml = write("g.yaml", config::gainsYaml(defaults_, "", fis));
   fuzzy::Fis back;
   const auto loaded = config::importGains(yaml, defaults_, &back);
@@ -191,7 +185,7 @@ TEST_F(GainsFileTest, AbsoluteFisPathIsKept) {
 
 TEST_F(GainsFileTest, ImportRefusesAFisWithTheWrongShape) {
   // The speed strategy's system: 3 inputs, 1 output.
-  fs::copy_file(kSource + "/config/fuzzy/speed_strategy.fis", dir_ / "speed.fis");
+  fs::copy_file(inspect::test::srcPath("config/fuzzy/speed_strategy.fis"), dir_ / "speed.fis");
   const std::string yaml = write("g.yaml", config::gainsYaml(defaults_, "", "speed.fis"));
   fuzzy::Fis untouched;
   untouched.name = "sentinel";
@@ -214,7 +208,7 @@ TEST_F(GainsFileTest, ImportNamesAMissingOrBrokenFis) {
 }
 
 TEST_F(GainsFileTest, ExportRefusesInvalidGainsAndWritesNothing) {
-  const fuzzy::Fis fis = fuzzy::readFisFile(kSource + "/config/fuzzy/fuzzy_pid.fis");
+  const fuzzy::Fis fis = fuzzy::readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis"));
   control::GainSet g = defaults_;
   g.fuzzy.base.kp = -1.0;
   const std::string yaml = (dir_ / "g.yaml").string();

@@ -99,7 +99,7 @@ std::string identifyError(const WheelSeries& left, const WheelSeries& right) {
 }
 
 template <typename F>
-std::string errorOf(F&& f) {
+std::string exceptionText(F&& f) {
   try {
     f();
   } catch (const std::exception& e) {
@@ -241,7 +241,7 @@ TEST(PlantId, BadInputIsRefusedWithTheReason) {
 
   tuning::IdentifyOptions bad;
   bad.max_gap_s = 0.0;
-  EXPECT_EQ(errorOf([&] { tuning::identifyPlant(good.left, good.right, bad); }), "options: max_gap_s must be positive");
+  EXPECT_EQ(exceptionText([&] { tuning::identifyPlant(good.left, good.right, bad); }), "options: max_gap_s must be positive");
 }
 
 class PlantIdFiles : public ::testing::Test {
@@ -318,15 +318,15 @@ TEST_F(PlantIdFiles, FilesWithoutTelemetryAreRefusedNamingTheFile) {
     w.write(ch, 1, 1, c);
     w.close();
   }
-  const std::string e1 = errorOf([&] { tuning::readRunWheelSeries(no_tm); });
+  const std::string e1 = exceptionText([&] { tuning::readRunWheelSeries(no_tm); });
   EXPECT_EQ(e1, no_tm + ": no /telemetry channel (channels: /command)");
 
   const std::string text = file("notes.mcap", "not a recording\n");
-  const std::string e2 = errorOf([&] { tuning::readRunWheelSeries(text); });
+  const std::string e2 = exceptionText([&] { tuning::readRunWheelSeries(text); });
   EXPECT_TRUE(contains(e2, text) && contains(e2, "is not an MCAP file")) << e2;
 
   const std::string missing = (dir_ / "missing.mcap").string();
-  EXPECT_TRUE(contains(errorOf([&] { tuning::readRunWheelSeries(missing); }), missing));
+  EXPECT_TRUE(contains(exceptionText([&] { tuning::readRunWheelSeries(missing); }), missing));
 }
 
 TEST_F(PlantIdFiles, PlantFileRoundTripsAndNamesBadKeys) {
@@ -362,7 +362,7 @@ TEST_F(PlantIdFiles, PlantFileRoundTripsAndNamesBadKeys) {
     EXPECT_NE(at, std::string::npos) << from;
     t.replace(at, from.size(), to);
     const std::string p = file("edited.yaml", t);
-    return errorOf([&] { tuning::loadPlantFile(p); });
+    return exceptionText([&] { tuning::loadPlantFile(p); });
   };
   const std::string edited_path = (dir_ / "edited.yaml").string();
   EXPECT_EQ(edited("gain: 0.853217", "gain: 7"), edited_path + ": plant.left.gain: 7 is out of range [0.2, 5]");
@@ -372,7 +372,7 @@ TEST_F(PlantIdFiles, PlantFileRoundTripsAndNamesBadKeys) {
             edited_path + ": plant.left.dead_time_s: required value is missing");
   EXPECT_EQ(edited("fit:", "fit:\n  colour: red"),
             edited_path + ": fit.colour: unknown key (misspelt, or not used by this program)");
-  EXPECT_TRUE(contains(errorOf([&] { tuning::loadPlantFile((dir_ / "none.yaml").string()); }), "cannot open file"));
+  EXPECT_TRUE(contains(exceptionText([&] { tuning::loadPlantFile((dir_ / "none.yaml").string()); }), "cannot open file"));
   EXPECT_THROW(tuning::loadPlantFile((dir_ / "none.yaml").string()), config::ConfigError);
 }
 

@@ -17,6 +17,8 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "sim/robot_plant.hpp"
+#include "tests/support/paths.hpp"
+#include "tests/tuning/paper_gains.hpp"
 
 using namespace inspect;
 using namespace inspect::tuning;
@@ -26,8 +28,8 @@ namespace {
 /// The repository's configs, the nominal plant, the paper's circle; small scenario counts.
 TuneSetup baseSetup() {
   TuneSetup s;
-  s.robot = config::loadRobotConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/robot.yaml");
-  s.control = config::loadControlConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/control.yaml");
+  s.robot = config::loadRobotConfigFile(inspect::test::srcPath("config/robot.yaml"));
+  s.control = config::loadControlConfigFile(inspect::test::srcPath("config/control.yaml"));
   config::applyRobot(s.control, s.robot);
   s.fis = fuzzy::readFisFile(s.control.fis_path);
   s.plant = sim::nominalPlant(s.robot);
@@ -37,13 +39,7 @@ TuneSetup baseSetup() {
   return s;
 }
 
-/// The paper's gains (config/control.yaml).
-control::GainSet paperGains(const TuneSetup& s) {
-  control::GainSet g;
-  g.fuzzy = s.control.tracker.fuzzy;
-  g.aux = s.control.tracker.aux;
-  return g;
-}
+using inspect::test::paperGains;
 
 /// A worn robot: weaker, slower, delayed and unequal wheels.
 control::PlantModel wornPlant(control::PlantModel p) {

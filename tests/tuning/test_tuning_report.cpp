@@ -24,6 +24,9 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "sim/robot_plant.hpp"
+#include "tests/support/paths.hpp"
+#include "tests/support/process.hpp"
+#include "tests/tuning/paper_gains.hpp"
 
 using namespace inspect;
 using namespace inspect::tuning;
@@ -32,12 +35,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kSource = INSPECT_SOURCE_DIR;
 
 TuneSetup repoSetup() {
   TuneSetup s;
-  s.robot = config::loadRobotConfigFile(kSource + "/config/robot.yaml");
-  s.control = config::loadControlConfigFile(kSource + "/config/control.yaml");
+  s.robot = config::loadRobotConfigFile(inspect::test::srcPath("config/robot.yaml"));
+  s.control = config::loadControlConfigFile(inspect::test::srcPath("config/control.yaml"));
   config::applyRobot(s.control, s.robot);
   s.fis = fuzzy::readFisFile(s.control.fis_path);
   s.plant = sim::nominalPlant(s.robot);
@@ -49,12 +51,7 @@ TuneSetup repoSetup() {
   return s;
 }
 
-control::GainSet paperGains(const TuneSetup& s) {
-  control::GainSet g;
-  g.fuzzy = s.control.tracker.fuzzy;
-  g.aux = s.control.tracker.aux;
-  return g;
-}
+using inspect::test::paperGains;
 
 control::GainSet changedGains(const TuneSetup& s) {
   control::GainSet g = paperGains(s);
@@ -66,14 +63,7 @@ control::GainSet changedGains(const TuneSetup& s) {
   return g;
 }
 
-std::string readText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-bool isPng(const fs::path& p) { return readText(p).rfind("\x89PNG\r\n\x1a\n", 0) == 0; }
+bool isPng(const fs::path& p) { return inspect::test::readFile(p).rfind("\x89PNG\r\n\x1a\n", 0) == 0; }
 
 // One comparison for every test (the closed-loop runs are the slow part).
 class TuningReportTest : public ::testing::Test {
@@ -208,7 +198,7 @@ TEST_F(TuningReportTest, SessionDirectoryHasEveryFile) {
   }
 
   // results.json parses and has the rows and the history.
-  const auto j = nlohmann::json::parse(readText(dir_ / "results.json"));
+  const auto j = nlohmann::json::parse(inspect::test::readFile(dir_ / "results.json"));
   ASSERT_EQ(j["comparison"].size(), 3u);
   EXPECT_EQ(j["comparison"][0]["label"], "PID");
   EXPECT_EQ(j["comparison"][0]["controller"], "pid");
@@ -236,7 +226,7 @@ TEST_F(TuningReportTest, SessionDirectoryHasEveryFile) {
   EXPECT_EQ(fis, setup_->fis);
 
   // summary.md: set-up, the comparison table, initial vs best gains, the plots.
-  const std::string md = readText(dir_ / "summary.md");
+  const std::string md = inspect::test::readFile(dir_ / "summary.md");
   const auto [kp_lo, kp_hi] = defaultTuneBounds("kp");
   char kp_row[96];
   std::snprintf(kp_row, sizeof kp_row, "| kp | %g | %g | 9 | 14 |", kp_lo, kp_hi);
@@ -250,7 +240,7 @@ TEST_F(TuningReportTest, SessionDirectoryHasEveryFile) {
   }
 
   // traces.csv: a header and one line a tick.
-  const std::string csv = readText(dir_ / "traces.csv");
+  const std::string csv = inspect::test::readFile(dir_ / "traces.csv");
   EXPECT_EQ(csv.rfind("t_s,ref_x_m,ref_y_m,PID_x_m,PID_y_m,PID_pos_err_m,PID_ang_err_rad,fuzzy_PID__paper__x_m", 0), 0u)
       << csv.substr(0, 200);
   EXPECT_EQ(static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n')),
@@ -286,13 +276,13 @@ TEST_F(TuningReportTest, WithoutGnuplotKeepsTheDataAndSaysSo) {
   }
   for (const char* f : {"summary.md", "results.json", "gains_tuned.yaml", "gains_tuned.fis", "traces.csv"})
     EXPECT_TRUE(fs::exists(dir_ / f)) << f;
-  const std::string md = readText(dir_ / "summary.md");
+  const std::string md = inspect::test::readFile(dir_ / "summary.md");
   const auto [kp_lo, kp_hi] = defaultTuneBounds("kp");
   char kp_row[96];
   std::snprintf(kp_row, sizeof kp_row, "| kp | %g | %g | 9 | 14 |", kp_lo, kp_hi);
   EXPECT_NE(md.find("No plots were drawn."), std::string::npos) << md;
   EXPECT_NE(md.find("trajectory.png not drawn"), std::string::npos) << md;
-  const auto j = nlohmann::json::parse(readText(dir_ / "results.json"));
+  const auto j = nlohmann::json::parse(inspect::test::readFile(dir_ / "results.json"));
   EXPECT_EQ(j["notes"].size(), 4u);
   EXPECT_TRUE(j["plots"].empty());
 }

@@ -2,11 +2,12 @@
 #include <gtest/gtest.h>
 
 #include "robot_client/client_config.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 
 namespace {
-std::string errorOf(const std::string& yaml) {
+std::string clientConfigError(const std::string& yaml) {
   try {
     const auto root = config::ConfigNode::loadString(yaml, "client.yaml");
     (void)client::loadClientConfig(root);
@@ -19,19 +20,19 @@ std::string errorOf(const std::string& yaml) {
 }  // namespace
 
 TEST(ClientConfig, ShippedFileLoads) {
-  const auto c = client::loadClientConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/client.yaml");
+  const auto c = client::loadClientConfigFile(inspect::test::srcPath("config/client.yaml"));
   EXPECT_EQ(c.server_port, 7600);
   EXPECT_DOUBLE_EQ(c.safety.link_timeout_s, 0.25);  // docs/failsafes.md
   EXPECT_EQ(c.baud, 115200);
 }
 
 TEST(ClientConfig, Errors) {
-  EXPECT_NE(errorOf("robot_id: 'bad id!'").find("robot_id"), std::string::npos);
-  EXPECT_NE(errorOf("server:\n  port: 70000\n").find("server.port: 70000 is out of range"), std::string::npos);
-  EXPECT_NE(errorOf("serial:\n  baud: 115201\n").find("not a standard rate"), std::string::npos);
-  EXPECT_NE(errorOf("safety:\n  link_timeout_s: 0\n").find("safety.link_timeout_s"), std::string::npos);
-  EXPECT_NE(errorOf("server:\n  prot: 1\n").find("server.prot: unknown key"), std::string::npos);
-  EXPECT_NE(errorOf("server:\n  port: 7600.5\n").find("not a whole number"), std::string::npos);
+  EXPECT_NE(clientConfigError("robot_id: 'bad id!'").find("robot_id"), std::string::npos);
+  EXPECT_NE(clientConfigError("server:\n  port: 70000\n").find("server.port: 70000 is out of range"), std::string::npos);
+  EXPECT_NE(clientConfigError("serial:\n  baud: 115201\n").find("not a standard rate"), std::string::npos);
+  EXPECT_NE(clientConfigError("safety:\n  link_timeout_s: 0\n").find("safety.link_timeout_s"), std::string::npos);
+  EXPECT_NE(clientConfigError("server:\n  prot: 1\n").find("server.prot: unknown key"), std::string::npos);
+  EXPECT_NE(clientConfigError("server:\n  port: 7600.5\n").find("not a whole number"), std::string::npos);
 }
 
 TEST(ClientConfig, RobotIds) {
@@ -42,7 +43,7 @@ TEST(ClientConfig, RobotIds) {
 }
 
 TEST(ClientConfig, Video) {
-  const auto c = client::loadClientConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/client.yaml");
+  const auto c = client::loadClientConfigFile(inspect::test::srcPath("config/client.yaml"));
   const client::VideoParams d;
   EXPECT_EQ(c.video.enabled, d.enabled);
   EXPECT_EQ(c.video.source, "synthetic");
@@ -50,14 +51,14 @@ TEST(ClientConfig, Video) {
   EXPECT_EQ(c.video.port, 5600);
   EXPECT_EQ(c.video.mtu, 1200);
   EXPECT_EQ(c.video.encoder, "libx264");
-  EXPECT_NE(errorOf("video:\n  width: 641\n").find("video.width: width and height must be even"), std::string::npos);
-  EXPECT_NE(errorOf("video:\n  fps: 0\n").find("video.fps: 0 is out of range"), std::string::npos);
-  EXPECT_NE(errorOf("video:\n  encoder: h265\n").find("video.encoder: 'h265' is not one of"), std::string::npos);
-  EXPECT_NE(errorOf("video:\n  preset: slow\n").find("video.preset: 'slow'"), std::string::npos);
-  EXPECT_NE(errorOf("video:\n  bitrate_kbps: 10\n").find("video.bitrate_kbps: 10 is out of range"), std::string::npos);
-  EXPECT_NE(errorOf("video:\n  mtu: 100\n").find("video.mtu: 100 is out of range"), std::string::npos);
-  EXPECT_NE(errorOf("video:\n  pixel_format: MJPEG\n").find("video.pixel_format: a FOURCC is 4 characters"),
+  EXPECT_NE(clientConfigError("video:\n  width: 641\n").find("video.width: width and height must be even"), std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  fps: 0\n").find("video.fps: 0 is out of range"), std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  encoder: h265\n").find("video.encoder: 'h265' is not one of"), std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  preset: slow\n").find("video.preset: 'slow'"), std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  bitrate_kbps: 10\n").find("video.bitrate_kbps: 10 is out of range"), std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  mtu: 100\n").find("video.mtu: 100 is out of range"), std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  pixel_format: MJPEG\n").find("video.pixel_format: a FOURCC is 4 characters"),
             std::string::npos);
-  EXPECT_NE(errorOf("video:\n  source: ''\n").find("video.source: must not be empty"), std::string::npos);
-  EXPECT_NE(errorOf("video:\n  gopp: 3\n").find("video.gopp: unknown key"), std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  source: ''\n").find("video.source: must not be empty"), std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  gopp: 3\n").find("video.gopp: unknown key"), std::string::npos);
 }

@@ -2,11 +2,12 @@
 #include <gtest/gtest.h>
 
 #include "shared/config/robot_config.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect::config;
 
 namespace {
-std::string errorOf(const std::string& yaml) {
+std::string robotConfigError(const std::string& yaml) {
   try {
     const auto root = ConfigNode::loadString(yaml, "robot.yaml");
     (void)loadRobotConfig(root);
@@ -25,42 +26,42 @@ TEST(Config, EmptyFileGivesPaperDefaults) {
 }
 
 TEST(Config, ShippedRobotYamlLoads) {
-  const auto c = loadRobotConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/robot.yaml");
+  const auto c = loadRobotConfigFile(inspect::test::srcPath("config/robot.yaml"));
   EXPECT_DOUBLE_EQ(c.geometry.l3_m, 0.046);
   EXPECT_NEAR(c.ultrasonic.mounts[2].yaw_rad, 1.5708, 1e-9);
 }
 
 TEST(Config, OutOfRangeNamesFileKeyAndRange) {
-  const auto e = errorOf("geometry:\n  track_m: -1\n");
+  const auto e = robotConfigError("geometry:\n  track_m: -1\n");
   EXPECT_NE(e.find("robot.yaml"), std::string::npos) << e;
   EXPECT_NE(e.find("geometry.track_m"), std::string::npos) << e;
   EXPECT_NE(e.find("out of range"), std::string::npos) << e;
 }
 
 TEST(Config, NotANumber) {
-  const auto e = errorOf("limits:\n  max_v_m_s: fast\n");
+  const auto e = robotConfigError("limits:\n  max_v_m_s: fast\n");
   EXPECT_NE(e.find("limits.max_v_m_s"), std::string::npos) << e;
   EXPECT_NE(e.find("'fast' is not a number"), std::string::npos) << e;
 }
 
 TEST(Config, UnknownKeyIsReported) {
-  const auto e = errorOf("geometry:\n  wheel_radus_m: 0.2\n");
+  const auto e = robotConfigError("geometry:\n  wheel_radus_m: 0.2\n");
   EXPECT_NE(e.find("geometry.wheel_radus_m: unknown key"), std::string::npos) << e;
 }
 
 TEST(Config, SyntaxErrorNamesLine) {
-  const auto e = errorOf("geometry:\n  track_m: [1,\n");
+  const auto e = robotConfigError("geometry:\n  track_m: [1,\n");
   EXPECT_NE(e.find("robot.yaml:"), std::string::npos) << e;
   EXPECT_NE(e.find("syntax"), std::string::npos) << e;
 }
 
 TEST(Config, WrongMountCount) {
-  const auto e = errorOf("ultrasonic:\n  mounts:\n    - {x_m: 0, y_m: 0, yaw_rad: 0}\n");
+  const auto e = robotConfigError("ultrasonic:\n  mounts:\n    - {x_m: 0, y_m: 0, yaw_rad: 0}\n");
   EXPECT_NE(e.find("exactly 4"), std::string::npos) << e;
 }
 
 TEST(GasConfig, ShippedChannelsAreTheDefaults) {
-  const auto c = loadRobotConfigFile(std::string(INSPECT_SOURCE_DIR) + "/config/robot.yaml");
+  const auto c = loadRobotConfigFile(inspect::test::srcPath("config/robot.yaml"));
   const auto d = defaultGasConfig();
   ASSERT_EQ(c.gas.channels.size(), d.channels.size());
   for (std::size_t i = 0; i < d.channels.size(); ++i) {
@@ -112,7 +113,7 @@ TEST(GasConfig, BadChannelsNameTheKey) {
                 "cross_sensitivity: [{gas: NO2, factor: 1}]}")
                 .find("NO2"),
             std::string::npos);
-  EXPECT_NE(errorOf("gas:\n  channels:\n    - {name: CH4, unit: x, range_max: 100, alarm_low: 10, alarm_high: 20, "
+  EXPECT_NE(robotConfigError("gas:\n  channels:\n    - {name: CH4, unit: x, range_max: 100, alarm_low: 10, alarm_high: 20, "
                     "colour: red}\n")
                 .find("colour"),
             std::string::npos);

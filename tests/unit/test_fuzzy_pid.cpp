@@ -15,25 +15,19 @@
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "shared/fuzzy/lookup_surface.hpp"
+#include "tests/support/paths.hpp"
+#include "tests/unit/first_order.hpp"
 
 using namespace inspect::control;
 namespace fz = inspect::fuzzy;
 
 namespace {
 
-fz::Fis paperFis() { return fz::readFisFile(std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/fuzzy_pid.fis"); }
+fz::Fis paperFis() { return fz::readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")); }
 
-// Exact discretisation of tau y' = u - y (the simulator's hub motor).
-struct FirstOrder {
-  double tau_s;
-  double y = 0;
-  void step(double u, double dt_s) {
-    const double a = std::exp(-dt_s / tau_s);
-    y = a * y + (1 - a) * u;
-  }
-};
+using inspect::test::FirstOrder;
 
-constexpr double kDt = 0.01;
+constexpr double kControlDt_s = 0.01;
 constexpr double kTau = 0.2;
 
 // Raw (e, ec) points over and beyond the scaled universes [-3, 3]: e in
@@ -173,7 +167,7 @@ TEST(FuzzyPid, ClosedLoopOnAHubMotorConvergesWithoutOffset) {
     int settled_at = -1;
     double overshoot = 0;
     for (int k = 0; k < 4000; ++k) {
-      motor.step(fuzzyPidStep(sched, p, cfg, s, setpoint, motor.y, kDt), kDt);
+      motor.step(fuzzyPidStep(sched, p, cfg, s, setpoint, motor.y, kControlDt_s), kControlDt_s);
       overshoot = std::max(overshoot, motor.y - setpoint);
       const bool inside = std::abs(motor.y - setpoint) < 0.025;
       if (inside && settled_at < 0) settled_at = k;
@@ -181,7 +175,7 @@ TEST(FuzzyPid, ClosedLoopOnAHubMotorConvergesWithoutOffset) {
     }
     EXPECT_NEAR(motor.y, setpoint, 1e-3) << "integral action removes the offset";
     EXPECT_GE(settled_at, 0);
-    EXPECT_LT(settled_at * kDt, 20.0) << "within 1 % by 20 s (slow integral mode, docs/controllers.md)";
+    EXPECT_LT(settled_at * kControlDt_s, 20.0) << "within 1 % by 20 s (slow integral mode, docs/controllers.md)";
     EXPECT_LT(overshoot, 0.25);
     EXPECT_GT(s.gains.kp, 0.0);
   }
@@ -192,20 +186,20 @@ TEST(FuzzyPid, NonFiniteInputHoldsTheOutput) {
   const FuzzyPidParams p;
   PidConfig cfg;
   FuzzyPidState s;
-  fuzzyPidStep(sched, p, cfg, s, 2.0, 0.0, kDt);
-  const double u = fuzzyPidStep(sched, p, cfg, s, 2.0, 0.3, kDt);
+  fuzzyPidStep(sched, p, cfg, s, 2.0, 0.0, kControlDt_s);
+  const double u = fuzzyPidStep(sched, p, cfg, s, 2.0, 0.3, kControlDt_s);
   const FuzzyPidState before = s;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_DOUBLE_EQ(fuzzyPidStep(sched, p, cfg, s, nan, 0.3, kDt), u);
-  EXPECT_DOUBLE_EQ(fuzzyPidStep(sched, p, cfg, s, 2.0, nan, kDt), u);
-  EXPECT_DOUBLE_EQ(fuzzyPidStep(sched, p, cfg, s, 2.0, INFINITY, kDt), u);
+  EXPECT_DOUBLE_EQ(fuzzyPidStep(sched, p, cfg, s, nan, 0.3, kControlDt_s), u);
+  EXPECT_DOUBLE_EQ(fuzzyPidStep(sched, p, cfg, s, 2.0, nan, kControlDt_s), u);
+  EXPECT_DOUBLE_EQ(fuzzyPidStep(sched, p, cfg, s, 2.0, INFINITY, kControlDt_s), u);
   EXPECT_DOUBLE_EQ(fuzzyPidStep(sched, p, cfg, s, 2.0, 0.3, 0.0), u);
   EXPECT_DOUBLE_EQ(fuzzyPidStep(sched, p, cfg, s, 2.0, 0.3, nan), u);
   // The state is untouched: the next good step is the one that would have come.
   EXPECT_DOUBLE_EQ(s.prev_error, before.prev_error);
   EXPECT_DOUBLE_EQ(s.pid.integral, before.pid.integral);
   EXPECT_DOUBLE_EQ(s.pid.prev_measurement, before.pid.prev_measurement);
-  EXPECT_TRUE(std::isfinite(fuzzyPidStep(sched, p, cfg, s, 2.0, 0.4, kDt)));
+  EXPECT_TRUE(std::isfinite(fuzzyPidStep(sched, p, cfg, s, 2.0, 0.4, kControlDt_s)));
 }
 
 TEST(FuzzyPid, PaperGainsNeedTheDerivativeFilterAt100Hz) {
@@ -230,8 +224,8 @@ TEST(FuzzyPid, PaperGainsNeedTheDerivativeFilterAt100Hz) {
     FirstOrder motor{kTau};
     double lo = INFINITY, hi = -INFINITY, ulo = INFINITY, uhi = -INFINITY;
     for (int k = 0; k < 1000; ++k) {
-      const double u = fuzzyPidStep(sched, p, cfg, s, 2.5, motor.y, kDt);
-      motor.step(u, kDt);
+      const double u = fuzzyPidStep(sched, p, cfg, s, 2.5, motor.y, kControlDt_s);
+      motor.step(u, kControlDt_s);
       if (k >= 900) {
         lo = std::min(lo, motor.y);
         hi = std::max(hi, motor.y);

@@ -5,19 +5,11 @@
 #include <limits>
 
 #include "shared/control/pid_controller.hpp"
+#include "tests/unit/first_order.hpp"
 
 using namespace inspect::control;
 
-namespace {
-// Exact discretisation of tau y' = u - y.
-struct FirstOrder {
-  double tau, y = 0;
-  void step(double u, double dt) {
-    const double a = std::exp(-dt / tau);
-    y = a * y + (1 - a) * u;
-  }
-};
-}  // namespace
+using inspect::test::FirstOrder;
 
 TEST(Pid, ClosedLoopConvergesWithoutOffset) {
   PidConfig cfg;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "robot_client/robot_core.hpp"
+#include "tests/unit/core_harness.hpp"
 
 using namespace inspect;
 using client::RobotCore;
@@ -26,37 +27,7 @@ v1::Command simple(uint64_t id, char kind) {
   return c;
 }
 
-// Drives the core with sensor frames at 100 Hz; the frames report whatever
-// the core commanded (an ideal MCU), so odometry integrates the commands.
-struct Harness {
-  config::RobotConfig robot;
-  client::SafetyParams safety;
-  RobotCore core{robot, safety};
-  serial::SensorFrame f;
-  double t = 0.0;
-  double disp_l = 0, disp_r = 0;
-  serial::WheelCommand last;
-
-  Harness() {
-    f.ultrasonic_mm.fill(serial::kNoEcho);  // nothing in range unless a test says so
-    core.onSerialState(true, 0.0);
-    core.onLinkUp(0.0);
-  }
-  void step(bool heartbeat = true) {
-    t += 0.01;
-    if (heartbeat) core.onLinkActivity(t);
-    f.mcu_time_ms = static_cast<uint32_t>(std::lround(t * 1000));
-    disp_l += last.left_mrad_s * 1e-3 * robot.geometry.wheel_radius_m * 0.01;
-    disp_r += last.right_mrad_s * 1e-3 * robot.geometry.wheel_radius_m * 0.01;
-    f.wheel_disp_0p1mm = {static_cast<int32_t>(std::lround(disp_l * 1e4)), static_cast<int32_t>(std::lround(disp_r * 1e4))};
-    f.wheel_speed_mrad_s = {last.left_mrad_s, last.right_mrad_s};
-    last = core.onSensorFrame(f, t);
-  }
-  void run(double seconds, bool heartbeat = true) {
-    const int n = static_cast<int>(std::lround(seconds / 0.01));
-    for (int i = 0; i < n; ++i) step(heartbeat);
-  }
-};
+using Harness = inspect::test::CoreHarness;
 
 }  // namespace
 

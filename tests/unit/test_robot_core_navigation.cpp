@@ -15,13 +15,14 @@
 #include "robot_client/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
 #include "sim/world.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using client::RobotCore;
 
 namespace {
 
-constexpr double kDt = 0.01;
+constexpr double kFrameDt_s = 0.01;
 
 v1::Command goTo(uint64_t id, const std::vector<std::pair<double, double>>& points, double speed = 0.0,
                  const std::string& name = "") {
@@ -83,12 +84,12 @@ struct KinematicRobot {
     core.onLinkUp(0.0);
   }
   void step() {
-    t += kDt;
+    t += kFrameDt_s;
     core.onLinkActivity(t);
     const double enable = (last.flags & serial::WheelCommand::kEnable) ? 1.0 : 0.0;
     const double r = robot.geometry.wheel_radius_m;
-    const double dl = enable * last.left_mrad_s * 1e-3 * r * kDt;
-    const double dr = enable * last.right_mrad_s * 1e-3 * r * kDt;
+    const double dl = enable * last.left_mrad_s * 1e-3 * r * kFrameDt_s;
+    const double dr = enable * last.right_mrad_s * 1e-3 * r * kFrameDt_s;
     const double ds = (dl + dr) / 2.0, dth = (dr - dl) / robot.geometry.track_m;
     x += ds * std::cos(theta + dth / 2.0);
     y += ds * std::sin(theta + dth / 2.0);
@@ -112,13 +113,13 @@ struct KinematicRobot {
     for (auto& e : core.takeEvents()) events.push_back(e);
   }
   void run(double seconds) {
-    const int n = static_cast<int>(std::lround(seconds / kDt));
+    const int n = static_cast<int>(std::lround(seconds / kFrameDt_s));
     for (int i = 0; i < n; ++i) step();
   }
   // Runs until an Ack arrives or `max_s` passes; true if one did.
   bool runUntilAck(double max_s) {
     const std::size_t before = acks.size();
-    for (double s = 0; s < max_s && acks.size() == before; s += kDt) step();
+    for (double s = 0; s < max_s && acks.size() == before; s += kFrameDt_s) step();
     return acks.size() > before;
   }
   double distanceTo(double gx, double gy) const { return std::hypot(gx - x, gy - y); }
@@ -357,7 +358,7 @@ TEST(RobotCoreNavigation, PeopleSlowAndStopTheRobotOnItsWayEq9) {
   behavior::AwarenessConfig acfg;
   r.core.setAwareness(std::make_unique<behavior::HumanAwareness>(
       r.robot.ultrasonic, acfg,
-      behavior::loadSpeedStrategy(std::string(INSPECT_SOURCE_DIR) + "/config/fuzzy/speed_strategy.fis", acfg.speed)));
+      behavior::loadSpeedStrategy(inspect::test::srcPath("config/fuzzy/speed_strategy.fis"), acfg.speed)));
   r.run(0.05);
   ASSERT_EQ(r.core.onCommand(goTo(1, {{10.0, 0.0}}), r.t).status(), v1::Ack::ACCEPTED);
   // A person (0.25 m radius) walks straight at the robot at 0.6 m/s from 5 m

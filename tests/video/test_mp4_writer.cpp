@@ -44,7 +44,7 @@ constexpr int kFps = 30;
 constexpr const char* kFfprobe = "/usr/bin/ffprobe";
 
 // Capture time of frame i: 30 fps on an arbitrary clock.
-uint64_t captureUs(uint32_t i) { return 7'000'000'000ull + uint64_t{i} * 1'000'000 / kFps; }
+uint64_t mp4CaptureUs(uint32_t i) { return 7'000'000'000ull + uint64_t{i} * 1'000'000 / kFps; }
 
 // `n` frames of the synthetic scene, encoded (cached per size and GOP).
 const std::vector<EncodedFrame>& stream(int width, int height, int gop, int n = 300) {
@@ -59,9 +59,9 @@ const std::vector<EncodedFrame>& stream(int width, int height, int gop, int n = 
   SyntheticSource src(width, height);
   for (uint32_t i = 0; i < static_cast<uint32_t>(n); ++i) {
     cv::Mat bgr;
-    src.read(bgr, captureUs(i), i);
+    src.read(bgr, mp4CaptureUs(i), i);
     EncodedFrame f;
-    if (!enc.encode(bgr, captureUs(i), i, false, f)) throw std::runtime_error("encoder gave no frame");
+    if (!enc.encode(bgr, mp4CaptureUs(i), i, false, f)) throw std::runtime_error("encoder gave no frame");
     frames.push_back(std::move(f));
   }
   return frames;
@@ -337,8 +337,8 @@ TEST_F(Mp4File, SkipsUntilKeyframeAndSurvivesGarbage) {
   fake_idr.insert(fake_idr.end(), noise.begin() + 60, noise.end());
 
   Mp4Writer w(path_);
-  EXPECT_FALSE(w.write(noise.data(), noise.size(), true, captureUs(0)));
-  EXPECT_FALSE(w.write(fake_idr.data(), fake_idr.size(), true, captureUs(1)));
+  EXPECT_FALSE(w.write(noise.data(), noise.size(), true, mp4CaptureUs(0)));
+  EXPECT_FALSE(w.write(fake_idr.data(), fake_idr.size(), true, mp4CaptureUs(1)));
   for (int i = 5; i < 30; ++i) EXPECT_FALSE(put(w, frames[i]));  // the stream joined mid-GOP
   EXPECT_TRUE(w.files().empty());
   EXPECT_FALSE(fs::exists(path_));
@@ -347,9 +347,9 @@ TEST_F(Mp4File, SkipsUntilKeyframeAndSurvivesGarbage) {
   for (int i = 30; i < 300; ++i) {
     ASSERT_TRUE(put(w, frames[i]));
     if (i == 100) {  // no NAL unit in these: dropped
-      EXPECT_FALSE(w.write(noise.data(), noise.size(), false, captureUs(i) + 1));
-      EXPECT_FALSE(w.write(nullptr, 0, false, captureUs(i) + 2));
-      EXPECT_FALSE(w.write(noise.data(), 0, true, captureUs(i) + 3));
+      EXPECT_FALSE(w.write(noise.data(), noise.size(), false, mp4CaptureUs(i) + 1));
+      EXPECT_FALSE(w.write(nullptr, 0, false, mp4CaptureUs(i) + 2));
+      EXPECT_FALSE(w.write(noise.data(), 0, true, mp4CaptureUs(i) + 3));
     }
   }
   w.close();
@@ -358,7 +358,7 @@ TEST_F(Mp4File, SkipsUntilKeyframeAndSurvivesGarbage) {
   EXPECT_EQ(c.frames_skipped, 27u);
   EXPECT_EQ(c.frames_dropped, 3u);
   EXPECT_TRUE(w.error().empty());
-  EXPECT_FALSE(w.write(frames[0].annexb.data(), frames[0].annexb.size(), true, captureUs(400)));  // closed
+  EXPECT_FALSE(w.write(frames[0].annexb.data(), frames[0].annexb.size(), true, mp4CaptureUs(400)));  // closed
   expectReadable(path_, 270, 320, 240, 30);
 }
 
@@ -389,7 +389,7 @@ TEST_F(Mp4File, PictureSizeChangeContinuesInNextFile) {
   for (int i = 0; i < 60; ++i) ASSERT_TRUE(put(w, large[i]));
   for (int i = 0; i < 60; ++i) {
     EncodedFrame f = small[i];
-    f.capture_us = captureUs(60 + i);
+    f.capture_us = mp4CaptureUs(60 + i);
     ASSERT_TRUE(put(w, f));
   }
   w.close();

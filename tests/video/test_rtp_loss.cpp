@@ -18,7 +18,7 @@
 #include <thread>
 
 #include "shared/video/rtp_h264.hpp"
-#include "tests/tools/udp_relay.hpp"
+#include "tests/support/udp_relay.hpp"
 
 using namespace inspect;
 using namespace inspect::video;

@@ -35,7 +35,7 @@
 #include "shared/video/timecode.hpp"
 #include "shared/video/video_receiver.hpp"
 #include "shared/video/video_sender.hpp"
-#include "tests/tools/udp_relay.hpp"
+#include "tests/support/udp_relay.hpp"
 
 using namespace inspect;
 using namespace inspect::video;
@@ -44,7 +44,7 @@ using SteadyClock = std::chrono::steady_clock;
 namespace {
 
 constexpr const char* kStream = "robot";
-constexpr uint64_t kMask48 = (uint64_t{1} << 48) - 1;
+constexpr uint64_t kTimecodeMask = (uint64_t{1} << 48) - 1;
 constexpr auto kPoll = std::chrono::milliseconds(20);
 
 /// Polls `pred` every 20 ms; false when it did not hold within `timeout_s`.
@@ -284,7 +284,7 @@ class StreamRig {
       p.height = bgr.rows;
       p.latency_ms = (static_cast<double>(monoNowUs()) - static_cast<double>(capture_us)) / 1000.0;
       const auto code = readTimecode(bgr);
-      p.code_ok = code && code->capture_us == (capture_us & kMask48);
+      p.code_ok = code && code->capture_us == (capture_us & kTimecodeMask);
       p.index = code ? code->frame_index : 0;
       std::lock_guard lk(mu_);
       pictures_.push_back(p);

@@ -1,4 +1,4 @@
-#include "tests/tools/udp_relay.hpp"
+#include "tests/support/udp_relay.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

@@ -1,5 +1,5 @@
-#include "tests/integration/stack.hpp"
-#include "tests/test_certs.hpp"
+#include "tests/support/stack.hpp"
+#include "tests/support/test_certs.hpp"
 
 #include <algorithm>
 
@@ -9,8 +9,6 @@
 
 namespace inspect::test {
 
-std::string binPath(const std::string& prog) { return std::string(INSPECT_BIN_DIR) + "/" + prog; }
-std::string srcPath(const std::string& rel) { return std::string(INSPECT_SOURCE_DIR) + "/" + rel; }
 
 Truth readTruth(const std::string& path) {
   Truth t;

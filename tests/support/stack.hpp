@@ -6,7 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "tests/integration/process.hpp"
+#include "tests/support/paths.hpp"
+#include "tests/support/process.hpp"
 
 namespace inspect::test {
 
@@ -49,8 +50,6 @@ struct Truth {
 };
 Truth readTruth(const std::string& path);
 
-std::string binPath(const std::string& prog);
-std::string srcPath(const std::string& rel);
 
 /// A simulated robot: mcu_sim + robot_client.
 struct RobotProcs {

@@ -1,11 +1,13 @@
 #pragma once
 // Certificates for the tests' TLS links: scripts/make_certs.sh into
 // <build>/test_certs (made once, then only missing robot ids are added; the
-// script serialises concurrent callers). Needs INSPECT_BIN_DIR and INSPECT_SOURCE_DIR.
+// script serialises concurrent callers).
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "tests/support/paths.hpp"
 
 namespace inspect::test {
 
@@ -13,8 +15,8 @@ namespace inspect::test {
 /// `dir_name` other than "test_certs" makes an unrelated CA (for "wrong CA" tests).
 inline std::string testCertsDir(const std::vector<std::string>& robot_ids = {},
                                 const std::string& dir_name = "test_certs") {
-  const std::string dir = std::string(INSPECT_BIN_DIR) + "/../" + dir_name;
-  std::string cmd = "bash '" + std::string(INSPECT_SOURCE_DIR) + "/scripts/make_certs.sh' --out '" + dir + "'";
+  const std::string dir = binDir() + "/../" + dir_name;
+  std::string cmd = "bash '" + srcPath("scripts/make_certs.sh") + "' --out '" + dir + "'";
   for (const auto& id : robot_ids) cmd += " '" + id + "'";
   cmd += " >/dev/null";
   if (std::system(cmd.c_str()) != 0) throw std::runtime_error("scripts/make_certs.sh failed: " + cmd);

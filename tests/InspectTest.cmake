@@ -1,0 +1,167 @@
+# How the project's tests are built and registered (docs/testing.md). Every
+# test program and every ctest test goes through these functions, so that
+# each one has a label, a TIMEOUT and the scheduling properties that let
+# `ctest -j` run the suite in parallel without starving the real-time tests.
+#
+# Labels (the first argument of LABELS is the test's kind):
+#   unit      one test program in-process (sockets, a pty or a child program
+#             at most); runs at low CPU priority (`nice`) so that it only takes
+#             CPU the real-time tests leave. `scripts/test.sh --quick` runs these.
+#   stack     the real programs together (mcu_sim, robot_client, pc_server) in
+#             real time or a few times faster.
+#   long      not in CI: the long forms of measurements (by hand or -L long).
+#   bench     the smoke runs of the benchmarks (timing figures: run alone).
+#   fuzz, sanitize   the second stage of scripts/test.sh (build-asan/).
+# Further labels name an area (faults, link, load, record ...).
+#
+# Scheduling: scripts/test.sh runs `ctest -j <3 x cores>`. A unit test takes one
+# slot, a stack test PROCESSORS 2 (so that at most three run at once on two
+# cores), a stack test with video or a CPU-heavy step 3; SERIAL (RUN_SERIAL)
+# is for tests that measure latencies or saturate the machine on purpose.
+# COST (expected seconds) starts the long tests first on a clean tree, where
+# ctest has no timings of its own yet.
+
+# The test programs' own code is compiled with less optimisation than the
+# libraries it tests (which keep the build type's): -O1, and -O0 under the
+# sanitizers, where it halves the test programs' compile time (clang 14).
+if(INSPECT_SANITIZE)
+  set(INSPECT_TEST_OPT "-O0" CACHE STRING "Optimisation of the test programs' own code")
+else()
+  set(INSPECT_TEST_OPT "-O1" CACHE STRING "Optimisation of the test programs' own code")
+endif()
+# libFuzzer's coverage instrumentation (INSPECT_FUZZ) only serves code a
+# harness runs: not the test programs' own.
+set(INSPECT_TEST_COMPILE_OPTIONS ${INSPECT_TEST_OPT})
+if(INSPECT_FUZZ)
+  list(APPEND INSPECT_TEST_COMPILE_OPTIONS -fno-sanitize=fuzzer-no-link)
+endif()
+# Unit-level tests yield the CPU to the real-time processes of stack tests.
+set(INSPECT_UNIT_TEST_LAUNCHER nice -n 10)
+
+# Paths to the source tree and the programs, for every test program
+# (tests/support/paths.hpp); only paths.cpp sees the absolute paths.
+add_library(inspect_test_paths STATIC ${PROJECT_SOURCE_DIR}/tests/support/paths.cpp)
+target_include_directories(inspect_test_paths PUBLIC ${PROJECT_SOURCE_DIR})
+target_compile_definitions(inspect_test_paths PRIVATE INSPECT_BIN_DIR="${CMAKE_RUNTIME_OUTPUT_DIRECTORY}"
+                                                      INSPECT_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+
+# Child processes, temp dirs, the three programs wired together, the ground
+# truth reader, the UDP relay, test certificates (tests/support).
+add_library(inspect_test_support STATIC
+  ${PROJECT_SOURCE_DIR}/tests/support/process.cpp
+  ${PROJECT_SOURCE_DIR}/tests/support/stack.cpp
+  ${PROJECT_SOURCE_DIR}/tests/support/udp_relay.cpp)
+target_link_libraries(inspect_test_support PUBLIC inspect_test_paths Threads::Threads)
+target_compile_options(inspect_test_support PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})
+
+
+# inspect_test_program(<name> SOURCES <files...> [LIBS <libs...>] [PROGRAMS <targets...>] [NO_UNITY])
+# A test program: its sources (one translation unit unless NO_UNITY), the
+# libraries it links, the support library and gtest_main, and the programs
+# it starts (built before it).
+function(inspect_test_program name)
+  cmake_parse_arguments(A "NO_UNITY;NO_GTEST_MAIN" "" "SOURCES;LIBS;PROGRAMS" ${ARGN})
+  add_executable(${name} ${A_SOURCES})
+  target_link_libraries(${name} PRIVATE ${A_LIBS} inspect_test_support)
+  if(NOT A_NO_GTEST_MAIN)
+    target_link_libraries(${name} PRIVATE GTest::gtest_main)
+  endif()
+  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR})
+  target_compile_options(${name} PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})
+  foreach(prog IN LISTS A_PROGRAMS)
+    if(TARGET ${prog})
+      add_dependencies(${name} ${prog})
+    endif()
+  endforeach()
+  if(NOT A_NO_UNITY)
+    inspect_unity(${name})
+  endif()
+endfunction()
+
+# The ctest properties of a test kind, into <out>: TIMEOUT and the scheduling
+# (not LABELS, which may be a list), from the parsed arguments A_* of the
+# caller (inspect_gtests, inspect_test); _kind is the first label.
+macro(_inspect_test_properties out)
+  if(NOT A_LABELS)
+    message(FATAL_ERROR "a test needs LABELS (unit, stack, long, bench, ...): tests/InspectTest.cmake")
+  endif()
+  if(NOT A_TIMEOUT)
+    message(FATAL_ERROR "a test needs a TIMEOUT: tests/InspectTest.cmake")
+  endif()
+  list(GET A_LABELS 0 _kind)
+  set(${out} TIMEOUT ${A_TIMEOUT})
+  if(A_SERIAL)
+    list(APPEND ${out} RUN_SERIAL TRUE)
+  elseif(A_PROCESSORS)
+    list(APPEND ${out} PROCESSORS ${A_PROCESSORS})
+  elseif(_kind STREQUAL "stack")
+    list(APPEND ${out} PROCESSORS 2)
+  endif()
+  if(A_COST)
+    list(APPEND ${out} COST ${A_COST})
+  endif()
+  list(APPEND ${out} ${A_PROPERTIES})
+endmacro()
+
+# inspect_gtests(<program> LABELS <kind> TIMEOUT <s> [SERIAL] [PROCESSORS n] [COST s]
+#                [FILTER <gtest filter>] [SANITIZE] [PROPERTIES <ctest properties...>])
+# One ctest test per gtest test of <program> (gtest_discover_tests; its
+# PROPERTIES cannot carry a list, hence one label). SANITIZE: the program is
+# also part of the sanitizer stage. The sanitizer build (INSPECT_FUZZ, see
+# tests/fuzz/CMakeLists.txt) registers only those programs, with the label
+# `sanitize`, and builds them in its target sanitize_tests; the others can be
+# built and run there by hand.
+function(inspect_gtests program)
+  cmake_parse_arguments(A "SERIAL;SANITIZE" "TIMEOUT;PROCESSORS;COST;FILTER" "LABELS;PROPERTIES" ${ARGN})
+  list(LENGTH A_LABELS n)
+  if(NOT n EQUAL 1)
+    message(FATAL_ERROR "inspect_gtests(${program}): one label (the kind), got '${A_LABELS}'")
+  endif()
+  if(INSPECT_FUZZ)
+    if(NOT A_SANITIZE)
+      return()
+    endif()
+    set_property(GLOBAL APPEND PROPERTY INSPECT_SANITIZE_PROGRAMS ${program})
+    set(A_LABELS sanitize)
+  endif()
+  _inspect_test_properties(props)
+  if(_kind STREQUAL "unit")
+    set_property(TARGET ${program} PROPERTY CROSSCOMPILING_EMULATOR ${INSPECT_UNIT_TEST_LAUNCHER})
+  endif()
+  set(filter)
+  if(A_FILTER)
+    set(filter TEST_FILTER "${A_FILTER}")
+  endif()
+  gtest_discover_tests(${program} DISCOVERY_TIMEOUT 30 ${filter} PROPERTIES LABELS ${A_LABELS} ${props})
+endfunction()
+
+# inspect_test(NAME <name> COMMAND <command...> LABELS <kind> [<area>...] TIMEOUT <s>
+#              [SERIAL] [PROCESSORS n] [COST s] [WORKING_DIRECTORY dir]
+#              [FIXTURES_REQUIRED <fixture>...] [PROPERTIES <single-valued ctest properties...>])
+# One ctest test running a command (a program of the build with arguments, a script).
+function(inspect_test)
+  cmake_parse_arguments(A "SERIAL" "NAME;TIMEOUT;PROCESSORS;COST;WORKING_DIRECTORY"
+                        "COMMAND;LABELS;FIXTURES_REQUIRED;PROPERTIES" ${ARGN})
+  if(INSPECT_FUZZ)
+    return()  # the sanitizer build runs the SANITIZE programs and the fuzz harnesses only
+  endif()
+  _inspect_test_properties(props)
+  set(cmd ${A_COMMAND})
+  list(GET A_COMMAND 0 first)
+  if(TARGET ${first})
+    list(SUBLIST A_COMMAND 1 -1 rest)
+    set(cmd $<TARGET_FILE:${first}> ${rest})
+  endif()
+  if(_kind STREQUAL "unit")
+    set(cmd ${INSPECT_UNIT_TEST_LAUNCHER} ${cmd})
+  endif()
+  set(wd)
+  if(A_WORKING_DIRECTORY)
+    set(wd WORKING_DIRECTORY ${A_WORKING_DIRECTORY})
+  endif()
+  add_test(NAME ${A_NAME} COMMAND ${cmd} ${wd})
+  set_tests_properties(${A_NAME} PROPERTIES LABELS "${A_LABELS}" ${props})
+  if(A_FIXTURES_REQUIRED)
+    set_tests_properties(${A_NAME} PROPERTIES FIXTURES_REQUIRED "${A_FIXTURES_REQUIRED}")
+  endif()
+endfunction()
