@@ -4,7 +4,7 @@
 # pc_server on loopback running scripts/demo/gas_inspection.console (a
 # recorded gas inspection round, alarms, report), then prints what happened.
 #
-#   scripts/run_demo.sh [--interactive|--batch] [--port N] [--tuning]
+#   scripts/run_demo.sh [--interactive|--batch] [--port N] [--tuning] [--out DIR]
 #
 # --tuning runs the fuzzy-PID tuning job instead (scripts/demo/tuning.console
 # on config/worlds/tuning_floor.yaml, whose robot has worn, slower motors):
@@ -13,19 +13,22 @@
 #
 # --interactive (default when stdin is a terminal) leaves you in the console
 # after the script; --batch exits when the script ends. --port 0 picks a free
-# port (the default is 7600).
+# port (the default is 7600). --out DIR keeps the logs, ground truth, runs and
+# video there (default: a new folder under $TMPDIR); the demo's test reads them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${BUILD_DIR:-build}/bin
 PORT=7600
 MODE=auto
 JOB=gas
+OUT=
 while [ $# -gt 0 ]; do
   case "$1" in
     --interactive) MODE=interactive ;;
     --batch) MODE=batch ;;
     --port) PORT=$2; shift ;;
     --tuning) JOB=tuning ;;
+    --out) OUT=${2:?--out needs a folder}; shift ;;
     -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "run_demo: unknown option $1" >&2; exit 2 ;;
   esac
@@ -35,7 +38,7 @@ if [ "$MODE" = auto ]; then
   if [ -t 0 ] && [ -t 1 ]; then MODE=interactive; else MODE=batch; fi
 fi
 
-OUT=$(mktemp -d "${TMPDIR:-/tmp}/inspect-demo-XXXXXX")
+if [ -n "${OUT:-}" ]; then mkdir -p "$OUT"; else OUT=$(mktemp -d "${TMPDIR:-/tmp}/inspect-demo-XXXXXX"); fi
 PIDS=()
 cleanup() {
   for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done

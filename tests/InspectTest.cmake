@@ -5,8 +5,7 @@
 #
 # Labels (the first argument of LABELS is the test's kind):
 #   unit      one test program in-process (sockets, a pty or a child program
-#             at most); runs at low CPU priority (`nice`) so that it only takes
-#             CPU the real-time tests leave. `scripts/test.sh --quick` runs these.
+#             at most). `scripts/test.sh --quick` runs these.
 #   stack     the real programs together (mcu_sim, robot_client, pc_server) in
 #             real time or a few times faster.
 #   long      not in CI: the long forms of measurements (by hand or -L long).
@@ -14,12 +13,21 @@
 #   fuzz, sanitize   the second stage of scripts/test.sh (build-asan/).
 # Further labels name an area (faults, link, load, record ...).
 #
-# Scheduling: scripts/test.sh runs `ctest -j <3 x cores>`. A unit test takes one
-# slot, a stack test PROCESSORS 2 (so that at most three run at once on two
-# cores), a stack test with video or a CPU-heavy step 3; SERIAL (RUN_SERIAL)
-# is for tests that measure latencies or saturate the machine on purpose.
-# COST (expected seconds) starts the long tests first on a clean tree, where
-# ctest has no timings of its own yet.
+# Scheduling: scripts/test.sh runs the unit tests first (ctest -j <2 x cores>),
+# then the stack and bench tests with the resource spec
+# tests/ctest_resources.json, which has 3 `stack` slots: a stack test takes
+# one (RESOURCE_GROUPS stack:1), so at most three run at once. They never
+# share the machine with CPU-bound tests: on this 2-core virtual machine two
+# busy cores stall every process for 100-250 ms whatever its priority (nice,
+# SCHED_IDLE: measured, docs/testing.md), and a robot takes that for a dead
+# sensor line. LOCK names a RESOURCE_LOCK: tests holding the same lock never
+# overlap (`cores`: the tuning host's optimiser takes both cores for seconds,
+# and the tracking comparison needs them free to hold its band of link
+# latency). SERIAL
+# (RUN_SERIAL) is for tests that measure latencies or saturate the machine on
+# purpose. COST (expected seconds) starts the long tests first on a clean
+# tree, where ctest has no timings of its own yet. Without the resource spec
+# (plain `ctest -j N`) the stack tests are limited by -j and the locks only.
 
 # The test programs' own code is compiled with less optimisation than the
 # libraries it tests (which keep the build type's): -O1, and -O0 under the
@@ -35,8 +43,6 @@ set(INSPECT_TEST_COMPILE_OPTIONS ${INSPECT_TEST_OPT})
 if(INSPECT_FUZZ)
   list(APPEND INSPECT_TEST_COMPILE_OPTIONS -fno-sanitize=fuzzer-no-link)
 endif()
-# Unit-level tests yield the CPU to the real-time processes of stack tests.
-set(INSPECT_UNIT_TEST_LAUNCHER nice -n 10)
 
 # Paths to the source tree and the programs, for every test program
 # (tests/support/paths.hpp); only paths.cpp sees the absolute paths.
@@ -89,13 +95,17 @@ macro(_inspect_test_properties out)
     message(FATAL_ERROR "a test needs a TIMEOUT: tests/InspectTest.cmake")
   endif()
   list(GET A_LABELS 0 _kind)
+  if(NOT _kind MATCHES "^(unit|stack|bench|long|sanitize)$")
+    message(FATAL_ERROR "a test's first label is its kind: unit, stack, bench or long, not '${_kind}'")
+  endif()
   set(${out} TIMEOUT ${A_TIMEOUT})
   if(A_SERIAL)
     list(APPEND ${out} RUN_SERIAL TRUE)
-  elseif(A_PROCESSORS)
-    list(APPEND ${out} PROCESSORS ${A_PROCESSORS})
   elseif(_kind STREQUAL "stack")
-    list(APPEND ${out} PROCESSORS 2)
+    list(APPEND ${out} RESOURCE_GROUPS stack:1)
+  endif()
+  if(A_LOCK)
+    list(APPEND ${out} RESOURCE_LOCK ${A_LOCK})
   endif()
   if(A_COST)
     list(APPEND ${out} COST ${A_COST})
@@ -103,16 +113,19 @@ macro(_inspect_test_properties out)
   list(APPEND ${out} ${A_PROPERTIES})
 endmacro()
 
-# inspect_gtests(<program> LABELS <kind> TIMEOUT <s> [SERIAL] [PROCESSORS n] [COST s]
+# inspect_gtests(<program> LABELS <kind> TIMEOUT <s> [SERIAL] [LOCK name] [COST s]
 #                [FILTER <gtest filter>] [SANITIZE] [PROPERTIES <ctest properties...>])
 # One ctest test per gtest test of <program> (gtest_discover_tests; its
 # PROPERTIES cannot carry a list, hence one label). SANITIZE: the program is
 # also part of the sanitizer stage. The sanitizer build (INSPECT_FUZZ, see
-# tests/fuzz/CMakeLists.txt) registers only those programs, with the label
-# `sanitize`, and builds them in its target sanitize_tests; the others can be
-# built and run there by hand.
+# tests/fuzz/CMakeLists.txt) builds those programs in its target
+# sanitize_tests and runs each call's tests as one ctest test, one process,
+# labelled `sanitize`: a process start under ASan costs up to 0.5 s (the video
+# libraries' initialisation), 0.28 s a test on average, and LeakSanitizer then
+# checks the whole run at its exit. The other programs can be built and run
+# there by hand.
 function(inspect_gtests program)
-  cmake_parse_arguments(A "SERIAL;SANITIZE" "TIMEOUT;PROCESSORS;COST;FILTER" "LABELS;PROPERTIES" ${ARGN})
+  cmake_parse_arguments(A "SERIAL;SANITIZE" "TIMEOUT;LOCK;COST;FILTER" "LABELS;PROPERTIES" ${ARGN})
   list(LENGTH A_LABELS n)
   if(NOT n EQUAL 1)
     message(FATAL_ERROR "inspect_gtests(${program}): one label (the kind), got '${A_LABELS}'")
@@ -122,12 +135,29 @@ function(inspect_gtests program)
       return()
     endif()
     set_property(GLOBAL APPEND PROPERTY INSPECT_SANITIZE_PROGRAMS ${program})
+    get_property(calls GLOBAL PROPERTY INSPECT_SANITIZE_CALLS_${program})
+    math(EXPR calls "${calls} + 1")
+    set_property(GLOBAL PROPERTY INSPECT_SANITIZE_CALLS_${program} ${calls})
+    set(name ${program})
+    if(calls GREATER 1)
+      set(name ${program}_${calls})
+    endif()
+    set(filter)
+    if(A_FILTER)
+      set(filter "--gtest_filter=${A_FILTER}")
+    endif()
+    add_test(NAME ${name} COMMAND ${program} ${filter} WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})
     set(A_LABELS sanitize)
+    set(A_TIMEOUT 900)  # the whole program
+    if(NOT A_COST)
+      set(A_COST 60)  # before the fuzz harnesses' 20 s runs
+    endif()
+    _inspect_test_properties(props)
+    list(REMOVE_ITEM props RESOURCE_GROUPS stack:1)
+    set_tests_properties(${name} PROPERTIES LABELS sanitize ${props})
+    return()
   endif()
   _inspect_test_properties(props)
-  if(_kind STREQUAL "unit")
-    set_property(TARGET ${program} PROPERTY CROSSCOMPILING_EMULATOR ${INSPECT_UNIT_TEST_LAUNCHER})
-  endif()
   set(filter)
   if(A_FILTER)
     set(filter TEST_FILTER "${A_FILTER}")
@@ -136,11 +166,11 @@ function(inspect_gtests program)
 endfunction()
 
 # inspect_test(NAME <name> COMMAND <command...> LABELS <kind> [<area>...] TIMEOUT <s>
-#              [SERIAL] [PROCESSORS n] [COST s] [WORKING_DIRECTORY dir]
+#              [SERIAL] [LOCK name] [COST s] [WORKING_DIRECTORY dir]
 #              [FIXTURES_REQUIRED <fixture>...] [PROPERTIES <single-valued ctest properties...>])
 # One ctest test running a command (a program of the build with arguments, a script).
 function(inspect_test)
-  cmake_parse_arguments(A "SERIAL" "NAME;TIMEOUT;PROCESSORS;COST;WORKING_DIRECTORY"
+  cmake_parse_arguments(A "SERIAL" "NAME;TIMEOUT;LOCK;COST;WORKING_DIRECTORY"
                         "COMMAND;LABELS;FIXTURES_REQUIRED;PROPERTIES" ${ARGN})
   if(INSPECT_FUZZ)
     return()  # the sanitizer build runs the SANITIZE programs and the fuzz harnesses only
@@ -151,9 +181,6 @@ function(inspect_test)
   if(TARGET ${first})
     list(SUBLIST A_COMMAND 1 -1 rest)
     set(cmd $<TARGET_FILE:${first}> ${rest})
-  endif()
-  if(_kind STREQUAL "unit")
-    set(cmd ${INSPECT_UNIT_TEST_LAUNCHER} ${cmd})
   endif()
   set(wd)
   if(A_WORKING_DIRECTORY)

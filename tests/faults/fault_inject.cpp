@@ -70,6 +70,7 @@ struct Options {
   bool ber = false;
   std::vector<double> ber_rates = {1e-4, 1e-3};
   double ber_seconds = 45;
+  double garbage_per_s = 0;  // serial_relay --garbage-per-s in the BER test
   bool verbose = false;
 };
 
@@ -942,7 +943,9 @@ BerResult runBer(double ber, const Options& o, unsigned seed) {
   // robot_client's frame log is its debug log (INSPECT_LOG=debug): set for the processes of this robot only.
   ::setenv("INSPECT_LOG", "debug", 1);
   auto& r = s.startRobot("robot1", "square_room.yaml",
-                         {"--ber-up", b, "--ber-down", b, "--seed", std::to_string(seed)}, {"--frame-log", frames});
+                         {"--ber-up", b, "--ber-down", b, "--seed", std::to_string(seed), "--garbage-per-s",
+                          fmt("%g", o.garbage_per_s)},
+                         {"--frame-log", frames});
   ::unsetenv("INSPECT_LOG");
   const int64_t t0 = nowNs();
   const auto rc = s.server().wait(o.ber_seconds + 90);
@@ -1066,14 +1069,16 @@ BerResult runBer(double ber, const Options& o, unsigned seed) {
   return res;
 }
 
-bool printBer(const std::vector<BerResult>& rs, std::string& json) {
+bool printBer(const std::vector<BerResult>& rs, const Options& o, std::string& json) {
   bool ok = true;
-  std::printf("\nSerial bit errors between mcu_sim and robot_client (serial_relay --ber-up/--ber-down)\n");
+  std::printf("\nSerial bit errors between mcu_sim and robot_client (serial_relay --ber-up/--ber-down)");
+  if (o.garbage_per_s > 0) std::printf(", and %g bursts of garbage bytes per second each way", o.garbage_per_s);
+  std::printf("\n");
   std::printf("lost = frames sent and never accepted (between the first and last accepted); expected = 1-(1-BER)^bits\n"
               "of one frame on the wire; foreign = accepted frames that were not sent unmodified (must be 0)\n\n");
   std::printf("| BER | direction | run (s) | sent | accepted | lost | loss %% | expected %% | foreign |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
-  json = "{\n  \"ber\": [\n";
+  json = "{\n  \"garbage_per_s\": " + fmt("%g", o.garbage_per_s) + ",\n  \"ber\": [\n";
   for (std::size_t i = 0; i < rs.size(); ++i) {
     const auto& r = rs[i];
     auto expected = [&](std::size_t bytes, double ber) { return 100.0 * (1.0 - std::pow(1.0 - ber, 8.0 * static_cast<double>(bytes))); };
@@ -1088,7 +1093,8 @@ bool printBer(const std::vector<BerResult>& rs, std::string& json) {
                 r.up_frame_bytes, r.seconds, static_cast<unsigned long long>(r.up_sent),
                 static_cast<unsigned long long>(r.up_applied - r.up_foreign), static_cast<unsigned long long>(r.up_lost),
                 ul, expected(r.up_frame_bytes, r.ber), static_cast<unsigned long long>(r.up_foreign));
-    const bool this_ok = r.error.empty() && r.down_foreign == 0 && r.up_foreign == 0 && r.down_lost > 0;
+    // Frames were damaged both ways (and dropped), none became a wheel command or a sensor frame.
+    const bool this_ok = r.error.empty() && r.down_foreign == 0 && r.up_foreign == 0 && r.down_lost > 0 && r.up_lost > 0;
     if (!this_ok) ok = false;
     json += "    {\"ber\": " + fmt("%g", r.ber) + ", \"seconds\": " + fmt("%.1f", r.seconds) +
             ", \"measured_ber_down\": " + fmt("%.3g", r.measured_ber_down) + ", \"measured_ber_up\": " +
@@ -1111,6 +1117,7 @@ bool printBer(const std::vector<BerResult>& rs, std::string& json) {
                 r.failsafes, r.watchdog_trips);
     if (!r.error.empty()) std::printf("  ERROR: %s\n", r.error.c_str());
     if (r.down_lost == 0) std::printf("  ERROR: no sensor frame was lost: were bit errors injected?\n");
+    if (r.up_lost == 0) std::printf("  ERROR: no wheel command was lost: were bit errors injected?\n");
   }
   std::printf("\n0 wheel commands derived from corrupted frames: %s (MCU-applied commands not sent by robot_client: %s);\n"
               "0 sensor frames accepted that mcu_sim did not send unmodified: %s\n",
@@ -1149,6 +1156,7 @@ options:
   --ber               instead: the serial bit-error test
   --ber-rates LIST    bit error rates (default 1e-4,1e-3)
   --ber-seconds S     seconds per rate (default 45)
+  --garbage-per-s N   with --ber: also bursts of 1-24 random bytes per second each way (default 0)
   --json FILE         write the figures as JSON
   --seed N            random seed (fault timing, bit errors; default 1)
   --verbose           progress and logs of failed trials on stderr
@@ -1210,6 +1218,8 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--ber-seconds") {
       o.ber_seconds = number(5, 3600);
+    } else if (a == "--garbage-per-s") {
+      o.garbage_per_s = number(0, 1000);
     } else if (a == "--json") {
       o.json = value();
     } else if (a == "--seed") {
@@ -1230,7 +1240,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "fault_inject: BER %g for %.0f s ...\n", b, o.ber_seconds);
       rs.push_back(runBer(b, o, seed++));
     }
-    ok = printBer(rs, json);
+    ok = printBer(rs, o, json);
   } else {
     std::mt19937 rng(o.seed);
     std::vector<FaultResult> results;

@@ -2,15 +2,11 @@
 // pc_server driven by a console script. Ground truth comes from mcu_sim.
 #include <gtest/gtest.h>
 
-#include <signal.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
-#include <set>
 #include <sstream>
-#include <tuple>
 
 #include "tests/support/stack.hpp"
 #include "tests/support/test_certs.hpp"
@@ -54,14 +50,6 @@ std::vector<TruthRow> restPoses(const Truth& t) {
   return out;
 }
 
-// First truth row at or after `after_ns` satisfying pred; nullptr if none.
-template <class P>
-const TruthRow* firstAfter(const Truth& t, int64_t after_ns, P pred) {
-  for (const auto& r : t.rows)
-    if (r.mono_ns >= after_ns && pred(r)) return &r;
-  return nullptr;
-}
-
 bool atSpeed(const std::string& truth, double wheel_rad_s) {
   const auto t = readTruth(truth);
   if (t.rows.size() < 20) return false;
@@ -78,14 +66,16 @@ TEST(System, ScriptedSquareDriveReachesExpectedPoses) {
   Stack s("square");
   std::ostringstream script;
   script << kConnect << "wait 1\n";
-  // Four legs of 1.0 m (0.4 m/s for 2.5 s) and four left turns of 90 deg
-  // (0.8 rad/s for pi/2/0.8 s), stopping in between.
-  const double turn_s = kPi / 2 / 0.8;
+  // Four legs of 1.0 m (0.5 m/s for 2 s) and four left turns of 90 deg
+  // (1 rad/s for pi/2 s), stopping in between; 1.5 s to come to rest (a
+  // rest counts from 0.3 s below 0.02 rad/s: ~1.1 s after the stop, with the
+  // set-point's slew and the wheels' 0.2 s time constant).
+  const double turn_s = kPi / 2 / 1.0;
   const double corners[4][3] = {{1, 0, 0}, {1, 1, kPi / 2}, {0, 1, kPi}, {0, 0, -kPi / 2}};
   for (int leg = 0; leg < 4; ++leg) {
-    script << "drive 0.4 0\nwait 2.5\nstop\nwait 1.5\n";
+    script << "drive 0.5 0\nwait 2\nstop\nwait 1.5\n";
     script << "expect x ~ " << corners[leg][0] << " 0.05\nexpect y ~ " << corners[leg][1] << " 0.05\n";
-    script << "drive 0 0.8\nwait " << turn_s << "\nstop\nwait 1.5\n";
+    script << "drive 0 1.0\nwait " << turn_s << "\nstop\nwait 1.5\n";
   }
   script << "expect x ~ 0 0.05\nexpect y ~ 0 0.05\nexpect theta ~ 0 0.05\nstatus\n";
   ASSERT_TRUE(s.startServer(script.str())) << s.logs();
@@ -130,87 +120,12 @@ TEST(System, EStopHoldsUntilResume) {
   EXPECT_EQ(*rc, 0) << s.serverOutput();
 }
 
-TEST(System, KillingTheServerStopsTheWheels) {
-  Stack s("killserver");
-  ASSERT_TRUE(s.startServer(std::string(kConnect) + "drive 0.3 0\nwait 60\n")) << s.logs();
-  auto& r = s.startRobot("robot1");
-  ASSERT_TRUE(waitUntil([&] { return atSpeed(r.truth, 1.4); }, 20)) << s.logs();
-  const int64_t t_kill = nowNs();
-  s.server().signal(SIGKILL);
-  sleepS(1.5);
-  const auto truth = readTruth(r.truth);
-  const auto* zero = firstAfter(truth, t_kill, [](const TruthRow& x) { return x.set_l == 0 && x.set_r == 0; });
-  const auto* still = firstAfter(truth, t_kill, [](const TruthRow& x) {
-    return std::abs(x.wheel_l) < 0.05 && std::abs(x.wheel_r) < 0.05;
-  });
-  ASSERT_NE(zero, nullptr) << s.logs();
-  ASSERT_NE(still, nullptr) << s.logs();
-  const double set_ms = (zero->mono_ns - t_kill) / 1e6, still_ms = (still->mono_ns - t_kill) / 1e6;
-  std::printf("LINK_LOSS_STOP server SIGKILL -> wheel set-points zero %.1f ms, wheels < 0.05 rad/s %.1f ms\n", set_ms,
-              still_ms);
-  EXPECT_LE(set_ms, 300.0);
-  // The robot latched a failsafe: it must not restart by itself.
-  EXPECT_NE(readFile(s.dir() / "robot1-client.err").find("FAILSAFE"), std::string::npos);
-  const auto later = readTruth(r.truth);
-  EXPECT_LT(std::abs(later.rows.back().set_l), 1e-9);
-}
 
-TEST(System, KillingTheClientTripsTheMcuWatchdog) {
-  Stack s("killclient");
-  ASSERT_TRUE(s.startServer(std::string(kConnect) + "drive 0.3 0\nwait 60\n")) << s.logs();
-  auto& r = s.startRobot("robot1");
-  ASSERT_TRUE(waitUntil([&] { return atSpeed(r.truth, 1.4); }, 20)) << s.logs();
-  const int64_t t_kill = nowNs();
-  r.client.signal(SIGKILL);
-  sleepS(1.0);
-  const auto truth = readTruth(r.truth);
-  const auto* zero = firstAfter(truth, t_kill, [](const TruthRow& x) { return x.set_l == 0 && x.set_r == 0; });
-  ASSERT_NE(zero, nullptr) << s.logs();
-  const double ms = (zero->mono_ns - t_kill) / 1e6;
-  const TruthEvent* trip = nullptr;
-  for (const auto& e : truth.events)
-    if (e.name == "watchdog_trip" && e.mono_ns >= t_kill - 20'000'000) trip = &e;
-  ASSERT_NE(trip, nullptr) << s.logs();
-  std::printf("MCU_WATCHDOG client SIGKILL -> set-points zero %.1f ms (trip %s ms after the last command)\n", ms,
-              trip->detail.c_str());
-  // The watchdog's own time is exact in sim time; the wall-clock figure gets
-  // the 100 ms margin of fault_inject_short (tests/faults/CMakeLists.txt):
-  // structurally at most about 210 ms, and a shared CI machine can schedule
-  // mcu_sim a few ms late. The target itself is judged by fault_inject.
-  EXPECT_LE(std::stod(trip->detail), 201.0);
-  EXPECT_LE(ms, 200.0 + 10.0 + 100.0);  // 200 ms + one 10 ms frame + the margin
-}
 
-TEST(System, SerialGarbageNeverBecomesAWheelCommand) {
-  Stack s("garbage");
-  std::string script = kConnect;
-  script += "drive 0.2 0.3\nwait 5\nexpect serial_bad_crc > 0\nstop\nwait 0.5\n";
-  ASSERT_TRUE(s.startServer(script)) << s.logs();
-  auto& r = s.startRobot("robot1", "square_room.yaml",
-                         {"--garbage-per-s", "30", "--ber-up", "2e-4", "--ber-down", "2e-4", "--seed", "7"});
-  const auto rc = s.server().wait(60);
-  ASSERT_TRUE(rc.has_value()) << s.logs();
-  EXPECT_EQ(*rc, 0) << s.serverOutput();
-  s.relay("robot1").terminate();
 
-  std::set<std::tuple<int, int, int, int>> sent;
-  std::istringstream in(readFile(r.cmd_log));
-  std::string line;
-  while (std::getline(in, line)) {
-    int seq, l, rr, f;
-    if (std::sscanf(line.c_str(), "%d,%d,%d,%d", &seq, &l, &rr, &f) == 4) sent.insert({seq, l, rr, f});
-  }
-  const auto truth = readTruth(r.truth);
-  ASSERT_GT(sent.size(), 100u);
-  ASSERT_GT(truth.commands.size(), 100u);
-  std::size_t foreign = 0;
-  for (const auto& c : truth.commands)
-    if (!sent.count({c.seq, c.left, c.right, c.flags})) ++foreign;
-  std::printf("GARBAGE %zu commands sent, %zu applied by the MCU, %zu not sent by robot_client\n%s", sent.size(),
-              truth.commands.size(), foreign, readFile(s.dir() / "robot1-relay.out").c_str());
-  EXPECT_EQ(foreign, 0u);
-  EXPECT_LT(truth.commands.size(), sent.size()) << "some commands must have been corrupted and dropped";
-}
+// Killing the server or the client mid-drive, and garbage and bit errors on
+// the serial line, are fault_inject's (tests/faults: fault_inject_short, every
+// fault through these same programs against ground truth; fault_inject_ber).
 
 TEST(System, SecondRobotConnectsWhileFirstDrives) {
   Stack s("tworobots");

@@ -90,8 +90,9 @@ TEST(TuningStack, IdentifyTunePushAndTheCircleIsTrackedBetter) {
          << "gains revert\nexpect gains_version == 2 within 2\ngains show\n";
   Stack s("tuning");
   ASSERT_TRUE(s.startServer(script.str())) << s.logs();
-  // 2x real time: the robot's loop runs on the MCU clock, so the control is the same.
-  auto& robot = s.startRobot("robot1", "tuning_floor.yaml", {}, {"--rate", "2"});
+  // 3x real time: the robot's loop runs on the MCU clock, so the control is the same (telemetry
+  // at 50 Hz of wall time is 17 Hz of sim time: enough to identify a 50 ms dead time).
+  auto& robot = s.startRobot("robot1", "tuning_floor.yaml", {}, {"--rate", "3"});
   const auto rc = s.server().wait(170);
   ASSERT_TRUE(rc.has_value()) << s.logs();
   const std::string out = s.serverOutput();
