@@ -3,7 +3,8 @@
 # translation unit's compile time here is parsing the same heavy headers
 # (generated protobuf, Boost.Asio, OpenCV, Eigen, gtest); a batch parses them
 # once. Measured on this tree (2 cores, g++ -O2 -g1): the whole build 656 s
-# -> 349 s with the tests in unity and line tables, -> see docs/testing.md with the libraries too.
+# -> 349 s with the tests in unity and line tables, -> 283 s with the libraries
+# too (docs/testing.md).
 #
 # CMake's own UNITY_BUILD includes the sources by absolute path, so a
 # second clone of the tree would miss every compiler-cache entry; these

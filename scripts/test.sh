@@ -48,6 +48,7 @@ report_failures() {
       $0 ~ "^[0-9]+/[0-9]+ Test: " && substr($0, index($0, "Test: ") + 6) == name { on = 1; n = 0; next }
       on && /^<end of output>$/ { on = 0; next }
       on && /^(Running main|Note: Google Test filter|\[(==========|----------|  PASSED  )\]|$)/ { next }
+      on && /^(Command: |Directory: |"[^"]*" start time: |Output:$|-+$)/ { next }
       on { buf[n++ % 25] = $0 }
       END { for (i = (n > 25 ? n - 25 : 0); i < n; ++i) print "  " buf[i % 25] }
     ' "$log" || true
