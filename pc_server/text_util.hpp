@@ -1,9 +1,12 @@
 #pragma once
-// Small text helpers of the console: strict number parsing, word splitting, number formatting.
+// Small text helpers of the console: strict number parsing, word splitting
+// (number formatting: shared/util/number_text.hpp).
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "shared/util/number_text.hpp"
 
 namespace inspect::server {
 
@@ -15,11 +18,8 @@ std::optional<long long> parseInteger(std::string_view text);
 std::vector<std::string> splitWords(std::string_view text);
 /// Removes leading and trailing blanks (and a trailing '\r').
 std::string trim(std::string_view text);
-/// Fixed-point with `decimals`, trailing zeros removed ("1.93", "2", "-0.5").
-std::string fmtShort(double v, int decimals = 3);
-/// Fixed-point with sign ("+0.30", "-1.20").
-std::string fmtSigned(double v, int decimals = 2);
-/// Fixed-point ("1.20").
-std::string fmtFixed(double v, int decimals = 2);
+using util::fmtFixed;
+using util::fmtShort;
+using util::fmtSigned;
 
 }  // namespace inspect::server

@@ -45,7 +45,8 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   c.safety.obstacle_stop_m = sa.number("obstacle_stop_m", c.safety.obstacle_stop_m, 0, 5);
   c.safety.obstacle_slow_m = sa.number("obstacle_slow_m", c.safety.obstacle_slow_m, 0, 10);
   c.safety.nav_stall_s = sa.number("nav_stall_s", c.safety.nav_stall_s, 1, 3600);
-  c.safety.gas_reaction = sa.oneOf("gas_reaction", c.safety.gas_reaction, {"continue", "stop", "retreat"});
+  c.safety.gas_reaction = *robot::gasReactionOf(
+      sa.oneOf("gas_reaction", robot::gasReactionName(c.safety.gas_reaction), {"continue", "stop", "retreat"}));
   if (c.safety.obstacle_slow_m <= c.safety.obstacle_stop_m && c.safety.obstacle_slow_m > 0)
     sa.fail("obstacle_slow_m", "must be above obstacle_stop_m (or 0 to turn the obstacle stop off)");
   c.map_file = root.string("map", c.map_file);

@@ -3,28 +3,9 @@
 #include <string>
 
 #include "shared/config/config_node.hpp"
+#include "shared/robot/safety_params.hpp"
 
 namespace inspect::client {
-
-/// Safety timeouts of the control core.
-struct SafetyParams {
-  double link_timeout_s = 0.25;
-  double command_timeout_s = 0.3;
-  double sensor_timeout_s = 0.1;
-  // Tracking only: the nearest front-sonar range scales the speed down from
-  // obstacle_slow_m to a stop at obstacle_stop_m (like the MCU's own
-  // anti-collision stop), whatever the obstacle; people get Eq 9 as well.
-  double obstacle_stop_m = 0.35;
-  double obstacle_slow_m = 0.9;
-  // Navigation: a goal whose distance has not shrunk by 0.1 m in this much
-  // time allowed to move (time scaled by the Eq 9 factor, so waiting for
-  // people does not count) is given up: Ack FAILED, IDLE.
-  double nav_stall_s = 120.0;
-  // Reaction to a gas HIGH (A2) alarm while on a route (goto/route/inspect):
-  // "continue", "stop" (stop and hold; `resume` goes on, `stop` ends the
-  // route) or "retreat" (back along the route's points to its start).
-  std::string gas_reaction = "stop";
-};
 
 /// Camera stream (docs/video.md); becomes video::SenderSettings.
 struct VideoParams {
@@ -66,7 +47,7 @@ struct ClientConfig {
   int baud = 115200;
   double serial_reopen_period_s = 1.0;
   double mcu_heartbeat_period_s = 0.1;
-  SafetyParams safety;
+  robot::SafetyParams safety;
   VideoParams video;
   TlsParams tls;
   std::string map_file;  // world file whose walls people tracking ignores ("" = no map); --map overrides

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 
 #include <boost/asio/io_context.hpp>
@@ -12,8 +13,9 @@
 
 #include "robot_client/client_config.hpp"
 #include "robot_client/robot_app.hpp"
-#include "robot_client/robot_map.hpp"
+#include "sim/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
+#include "shared/robot/awareness.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/config/config_node.hpp"
@@ -77,7 +79,8 @@ int main(int argc, char** argv) {
   std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
   std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
   std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
-  std::string serial_dev, server, id, cmd_log, map_path, video_source, video_port, gas_reaction;
+  std::string serial_dev, server, id, cmd_log, map_path, video_source, video_port;
+  std::optional<robot::GasReaction> gas_reaction;
   bool no_video = false, plaintext = false;
   std::string certs_dir;
   for (int i = 1; i < argc; ++i) {
@@ -121,9 +124,9 @@ int main(int argc, char** argv) {
     } else if (a == "--no-video") {
       no_video = true;
     } else if (a == "--gas-reaction") {
-      gas_reaction = value();
-      if (gas_reaction != "continue" && gas_reaction != "stop" && gas_reaction != "retreat")
-        usageError("--gas-reaction '" + gas_reaction + "' must be continue, stop or retreat");
+      const std::string r = value();
+      gas_reaction = robot::gasReactionOf(r);
+      if (!gas_reaction) usageError("--gas-reaction '" + r + "' must be continue, stop or retreat");
     } else {
       usageError("unknown option '" + a + "'");
     }
@@ -136,7 +139,7 @@ int main(int argc, char** argv) {
     if (!robot_path.empty()) robot = config::loadRobotConfigFile(robot_path);
     if (!serial_dev.empty()) cfg.serial_device = serial_dev;
     if (!map_path.empty()) cfg.map_file = map_path;
-    if (!gas_reaction.empty()) cfg.safety.gas_reaction = gas_reaction;
+    if (gas_reaction) cfg.safety.gas_reaction = *gas_reaction;
     if (!id.empty()) {
       if (!client::validRobotId(id)) usageError("--id '" + id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
       cfg.robot_id = id;
@@ -182,19 +185,13 @@ int main(int argc, char** argv) {
 
     std::vector<behavior::MapSegment> map;
     if (!cfg.map_file.empty()) {
-      map = client::mapFromWorld(sim::loadWorldFile(cfg.map_file));
+      map = sim::mapFromWorld(sim::loadWorldFile(cfg.map_file));
       log::info("main", "map ", cfg.map_file, ": ", map.size(), " wall segments");
     }
     std::unique_ptr<behavior::HumanAwareness> awareness;
     if (!behavior_path.empty()) {
-      auto acfg = behavior::loadAwarenessConfigFile(behavior_path);
-      acfg.robot_radius_m = robot.geometry.body_radius_m;
-      try {
-        awareness = std::make_unique<behavior::HumanAwareness>(
-            robot.ultrasonic, acfg, behavior::loadSpeedStrategy(acfg.speed_fis, acfg.speed), std::move(map));
-      } catch (const fuzzy::FisError& e) {
-        throw config::ConfigError(behavior_path + ": awareness.speed_fis: " + e.what());
-      }
+      awareness = robot::makeAwareness(robot, behavior::loadAwarenessConfigFile(behavior_path), std::move(map),
+                                       behavior_path);
     } else {
       log::warn("main", "no behaviour config: people are not tracked and do not slow the robot",
                 map.empty() ? "" : " (the map is not used)");

@@ -226,7 +226,8 @@ void RobotApp::flushEvents() {
   for (const auto& p : core_.takePtz()) {
     if (const std::string why = applyPtz(p); !why.empty()) log::warn("core", "inspection point camera preset: ", why);
   }
-  for (auto& e : core_.takeEvents()) {
+  core_.takeEvents(events_);
+  for (auto& e : events_) {
     log::info("core", v1::Event::Kind_Name(e.kind), ": ", e.text);
     v1::Envelope env;
     auto* ev = env.mutable_event();

@@ -9,7 +9,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "robot_client/client_config.hpp"
-#include "robot_client/robot_core.hpp"
+#include "shared/robot/robot_core.hpp"
 #include "robot_client/serial_link.hpp"
 #include "robot_client/server_link.hpp"
 #include "shared/config/control_config.hpp"
@@ -45,7 +45,7 @@ class RobotApp {
 
   boost::asio::io_context& io_;
   ClientConfig cfg_;
-  RobotCore core_;
+  robot::RobotCore core_;
   SerialLink serial_;
   ServerLink link_;
   boost::asio::steady_timer tick_timer_;
@@ -56,6 +56,7 @@ class RobotApp {
   std::unique_ptr<video::VideoSender> video_;  // null when the stream could not be set up
   double ptz_pan_rad_ = 0, ptz_tilt_rad_ = 0;
   v1::Envelope telemetry_env_;  // reused to avoid reallocating repeated fields
+  std::vector<robot::CoreEvent> events_;  // flushEvents' buffer, swapped with the core's
 };
 
 }  // namespace inspect::client

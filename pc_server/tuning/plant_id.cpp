@@ -1,7 +1,7 @@
 // Plant identification (method in plant_id.hpp), the run reader and the plant file.
 #include "pc_server/tuning/plant_id.hpp"
 
-#include "pc_server/tuning/number_text.hpp"
+#include "shared/util/number_text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +18,7 @@
 #include "shared/record/mcap_reader.hpp"
 
 namespace inspect::tuning {
+using util::significant;
 namespace {
 
 constexpr std::size_t kMinSamples = 50;        // 1 s of 50 Hz telemetry

@@ -2,7 +2,7 @@
 // worker pool and the two-phase NLopt search.
 #include "pc_server/tuning/tuner.hpp"
 
-#include "pc_server/tuning/number_text.hpp"
+#include "shared/util/number_text.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -23,6 +23,7 @@
 #include "shared/fuzzy/fis_error.hpp"
 
 namespace inspect::tuning {
+using util::significant;
 
 namespace {
 

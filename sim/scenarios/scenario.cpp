@@ -6,8 +6,9 @@
 #include <map>
 
 #include "inspect/v1/link.pb.h"
-#include "robot_client/robot_core.hpp"
-#include "robot_client/robot_map.hpp"
+#include "shared/robot/awareness.hpp"
+#include "shared/robot/robot_core.hpp"
+#include "sim/robot_map.hpp"
 #include "shared/behavior/pattern_classifier.hpp"
 #include "shared/behavior/speed_strategy.hpp"
 #include "shared/serial/frame_codec.hpp"
@@ -134,8 +135,7 @@ ScenarioContext loadScenarioContext(const std::string& robot_yaml, const std::st
   config::applyRobot(c.control, c.robot);
   c.scheduler = config::loadScheduler(c.control);
   c.awareness = behavior::loadAwarenessConfigFile(behavior_yaml);
-  c.speed_fis = c.awareness.speed_fis;
-  (void)behavior::loadSpeedStrategy(c.speed_fis, c.awareness.speed);  // a bad rule base fails here, not mid-run
+  (void)behavior::loadSpeedStrategy(c.awareness.speed_fis, c.awareness.speed);  // a bad rule base fails here, not mid-run
   return c;
 }
 
@@ -151,13 +151,11 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
   Simulation sim(ctx.robot, world, opt.seed);
   sim.setPeopleWaitForMotion(true);  // as mcu_sim --people-wait-motion in the full-stack test
 
-  client::RobotCore core(ctx.robot, client::SafetyParams{}, ctx.control, ctx.scheduler);
+  robot::RobotCore core(ctx.robot, robot::SafetyParams{}, ctx.control, ctx.scheduler);
   behavior::AwarenessConfig acfg = ctx.awareness;
   acfg.enabled = true;
   acfg.policy = opt.policy;
-  acfg.robot_radius_m = ctx.robot.geometry.body_radius_m;
-  auto awareness = std::make_unique<behavior::HumanAwareness>(
-      ctx.robot.ultrasonic, acfg, behavior::loadSpeedStrategy(ctx.speed_fis, acfg.speed), client::mapFromWorld(world));
+  auto awareness = robot::makeAwareness(ctx.robot, acfg, sim::mapFromWorld(world), "scenario behaviour config");
   const behavior::HumanAwareness* aw = awareness.get();
   core.setAwareness(std::move(awareness));
   core.onSerialState(true, 0.0);

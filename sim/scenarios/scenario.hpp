@@ -1,6 +1,6 @@
 #pragma once
 // The scenario suite (docs/scenarios.md): the robot's own decision core
-// (robot_client/robot_core: people tracking, pattern, Eq 9 speed strategy,
+// (shared/robot/robot_core: people tracking, pattern, Eq 9 speed strategy,
 // trajectory tracking, navigation automaton) driven over the real serial
 // codec by the simulator (world, pedestrians moved by the social force model,
 // ultrasonic model, hub-motor plant, MCU emulator) in sim time, far faster
@@ -62,7 +62,6 @@ struct ScenarioContext {
   config::ControlConfig control;
   std::shared_ptr<control::FuzzyGainScheduler> scheduler;  // may be null (fuzzy-PID tracking refused)
   behavior::AwarenessConfig awareness;
-  std::string speed_fis;  // resolved path of the Eq 9 rule base
 };
 
 /// Loads robot, control (with the fuzzy-PID scheduler) and behaviour configs. Throws config::ConfigError.

@@ -15,7 +15,7 @@
 #include "pc_server/route_file.hpp"
 #include "pc_server/server_config.hpp"
 #include "robot_client/client_config.hpp"
-#include "robot_client/robot_map.hpp"
+#include "sim/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/config/control_config.hpp"
@@ -58,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   tryLoad(text, [](const config::ConfigNode& root) {
     const sim::World w = sim::loadWorld(root);
     root.checkKnown();
-    (void)client::mapFromWorld(w);
+    (void)sim::mapFromWorld(w);
     (void)sim::solidBounds(w);
     sim::checkStartPose(w, 0.2);
   });

@@ -31,8 +31,8 @@
 
 #include "inspect/v1/link.pb.h"
 #include "robot_client/client_config.hpp"
-#include "robot_client/robot_core.hpp"
-#include "robot_client/robot_map.hpp"
+#include "shared/robot/robot_core.hpp"
+#include "sim/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/behavior/speed_strategy.hpp"
 #include "shared/config/control_config.hpp"
@@ -61,14 +61,14 @@ struct Setup {
 };
 Setup* g_setup = nullptr;
 
-bool latched(const client::RobotCore& core) { return core.mode() == v1::ESTOP || core.mode() == v1::FAILSAFE; }
+bool latched(const robot::RobotCore& core) { return core.mode() == v1::ESTOP || core.mode() == v1::FAILSAFE; }
 
-void checkWheels(const client::RobotCore& core, const serial::WheelCommand& c) {
+void checkWheels(const robot::RobotCore& core, const serial::WheelCommand& c) {
   if (latched(core)) FUZZ_CHECK(c.left_mrad_s == 0 && c.right_mrad_s == 0);
 }
 
 struct Robot {
-  client::RobotCore core;
+  robot::RobotCore core;
   net::DelimitedDecoder link{net::kDefaultMaxFrame};
   serial::FrameDecoder serial;
   double t = 0.0;
@@ -76,7 +76,7 @@ struct Robot {
   bool link_up = true;
   bool serial_open = true;
 
-  Robot(const Setup& s, const client::SafetyParams& safety) : core(s.robot, safety, s.control, s.scheduler) {
+  Robot(const Setup& s, const robot::SafetyParams& safety) : core(s.robot, safety, s.control, s.scheduler) {
     auto acfg = s.awareness;
     acfg.robot_radius_m = s.robot.geometry.body_radius_m;
     core.setAwareness(std::make_unique<behavior::HumanAwareness>(s.robot.ultrasonic, acfg, *s.strategy, s.map));
@@ -158,15 +158,16 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   s->awareness = behavior::loadAwarenessConfigFile(dir + "behavior.yaml");
   s->strategy = std::make_unique<behavior::SpeedStrategy>(
       behavior::loadSpeedStrategy(s->awareness.speed_fis, s->awareness.speed));
-  s->map = client::mapFromWorld(sim::loadWorldFile(dir + "worlds/gas_lab.yaml"));
+  s->map = sim::mapFromWorld(sim::loadWorldFile(dir + "worlds/gas_lab.yaml"));
   g_setup = s;
   return 0;
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   // The three reactions to a gas HIGH alarm on a route (client.yaml safety.gas_reaction).
-  client::SafetyParams safety = g_setup->client.safety;
-  static const char* const kReactions[] = {"stop", "retreat", "continue"};
+  robot::SafetyParams safety = g_setup->client.safety;
+  static constexpr robot::GasReaction kReactions[] = {robot::GasReaction::kStop, robot::GasReaction::kRetreat,
+                                                      robot::GasReaction::kContinue};
   safety.gas_reaction = kReactions[size % 3];
   Robot r(*g_setup, safety);
   uint32_t mcu_ms = 0;

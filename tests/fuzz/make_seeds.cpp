@@ -22,7 +22,7 @@
 #include "inspect/v1/link.pb.h"
 #include "pc_server/route_file.hpp"
 #include "robot_client/client_config.hpp"
-#include "robot_client/robot_core.hpp"
+#include "shared/robot/robot_core.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/net/delimited_codec.hpp"
@@ -116,7 +116,7 @@ struct RealRobot {
     config::applyRobot(c, robot);
     return c;
   }();
-  client::RobotCore core{robot, client.safety, control, config::loadScheduler(control)};
+  robot::RobotCore core{robot, client.safety, control, config::loadScheduler(control)};
   double t = 0.0;
   uint32_t ms = 1000;
   int32_t disp = 0;

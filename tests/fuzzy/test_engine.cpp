@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "alloc_counter.hpp"
+#include "tests/support/alloc_counter.hpp"
 #include "shared/fuzzy/engine.hpp"
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
@@ -329,7 +329,7 @@ TEST(EngineAllocation, EvaluateNeverAllocates) {
   const LookupSurface surface(readFisFile(inspect::test::srcPath("config/fuzzy/fuzzy_pid.fis")));
   std::array<double, 3> out{};
   double sink = 0;
-  const std::size_t before = testing::allocationCount();
+  const std::size_t before = inspect::test::allocationCount();
   for (auto& e : engines) {
     for (int i = 0; i < 200; ++i) {
       const std::array<double, 2> in{-3.5 + 0.037 * i, 7.0 - 0.071 * i};
@@ -344,14 +344,14 @@ TEST(EngineAllocation, EvaluateNeverAllocates) {
     surface.evaluate(in, out);
     sink += out[0];
   }
-  const std::size_t after = testing::allocationCount();
+  const std::size_t after = inspect::test::allocationCount();
   EXPECT_EQ(after - before, 0u) << "evaluate() allocated";
   EXPECT_TRUE(std::isfinite(sink));
   // The counter does see allocations (a test that cannot fail is a bug).
-  const std::size_t c0 = testing::allocationCount();
+  const std::size_t c0 = inspect::test::allocationCount();
   auto* v = new std::vector<double>(100);
   delete v;
-  EXPECT_GT(testing::allocationCount(), c0);
+  EXPECT_GT(inspect::test::allocationCount(), c0);
 }
 
 }  // namespace

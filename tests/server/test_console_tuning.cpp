@@ -10,7 +10,7 @@
 #include "pc_server/console.hpp"
 #include "pc_server/robot_registry.hpp"
 #include "pc_server/stop_flag.hpp"
-#include "robot_client/robot_core.hpp"
+#include "shared/robot/robot_core.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/net/gains_proto.hpp"
 #include "shared/util/clock.hpp"
@@ -30,7 +30,7 @@ class CoreSink : public CommandSink {
  public:
   explicit CoreSink(RobotRegistry& r) : registry_(r) {
     control_ = config::loadControlConfigFile(src("config/control.yaml"));
-    core_ = std::make_unique<client::RobotCore>(robot_, safety_, control_, config::loadScheduler(control_));
+    core_ = std::make_unique<robot::RobotCore>(robot_, safety_, control_, config::loadScheduler(control_));
     frame_.ultrasonic_mm.fill(serial::kNoEcho);
     core_->onSerialState(true, 0.0);
     core_->onLinkUp(0.0);
@@ -71,14 +71,14 @@ class CoreSink : public CommandSink {
       registry_.onEvent("robot1", kTuningSerial, ev, monoNowNs());
     }
   }
-  client::RobotCore& core() { return *core_; }
+  robot::RobotCore& core() { return *core_; }
 
  private:
   RobotRegistry& registry_;
   config::RobotConfig robot_;
-  client::SafetyParams safety_;
+  robot::SafetyParams safety_;
   config::ControlConfig control_;
-  std::unique_ptr<client::RobotCore> core_;
+  std::unique_ptr<robot::RobotCore> core_;
   serial::SensorFrame frame_;
   double t_ = 0.0;
   uint64_t next_id_ = 0;

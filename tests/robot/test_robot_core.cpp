@@ -3,21 +3,16 @@
 
 #include <cmath>
 
-#include "robot_client/robot_core.hpp"
-#include "tests/unit/core_harness.hpp"
+#include "shared/robot/robot_core.hpp"
+#include "tests/robot/core_commands.hpp"
+#include "tests/robot/core_harness.hpp"
 
 using namespace inspect;
-using client::RobotCore;
+using robot::RobotCore;
 
 namespace {
 
-v1::Command teleop(uint64_t id, double v, double w) {
-  v1::Command c;
-  c.set_id(id);
-  c.mutable_teleop()->set_v_m_s(v);
-  c.mutable_teleop()->set_w_rad_s(w);
-  return c;
-}
+using test::teleop;
 v1::Command simple(uint64_t id, char kind) {
   v1::Command c;
   c.set_id(id);

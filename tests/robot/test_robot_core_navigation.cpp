@@ -11,14 +11,14 @@
 #include <string>
 #include <vector>
 
-#include "robot_client/robot_core.hpp"
-#include "robot_client/robot_map.hpp"
+#include "shared/robot/robot_core.hpp"
+#include "sim/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
 #include "sim/world.hpp"
 #include "tests/support/paths.hpp"
 
 using namespace inspect;
-using client::RobotCore;
+using robot::RobotCore;
 
 namespace {
 
@@ -64,7 +64,7 @@ config::RobotConfig withGas(bool on) {
 
 struct KinematicRobot {
   config::RobotConfig robot;
-  client::SafetyParams safety;
+  robot::SafetyParams safety;
   RobotCore core{robot, safety};
   serial::SensorFrame f;
   double t = 0.0;
@@ -72,12 +72,12 @@ struct KinematicRobot {
   double disp_l = 0.0, disp_r = 0.0;
   serial::WheelCommand last;
   std::vector<v1::Ack> acks;
-  std::vector<client::CoreEvent> events;
+  std::vector<robot::CoreEvent> events;
 
   std::array<double, 4> gas{0.0, 0.0, 0.0, 20.9};  // values in the default channels' units
   int frames = 0;
 
-  explicit KinematicRobot(const client::SafetyParams& s = {}, bool with_gas = false)
+  explicit KinematicRobot(const robot::SafetyParams& s = {}, bool with_gas = false)
       : robot(withGas(with_gas)), safety(s) {
     f.ultrasonic_mm = {serial::kNoEcho, serial::kNoEcho, serial::kNoEcho, serial::kNoEcho};
     core.onSerialState(true, 0.0);
@@ -403,7 +403,7 @@ obstacles:
   - vertices_m: [1.0, 5.0,  1.5, 5.0,  1.5, 5.5]
 )",
                                           "map_test.yaml");
-  const auto map = client::mapFromWorld(w);
+  const auto map = sim::mapFromWorld(w);
   ASSERT_EQ(map.size(), 4u) << "one wall and three obstacle edges";
   EXPECT_NEAR(map[0].x0, 2.0, 1e-12);
   EXPECT_NEAR(map[0].y0, 0.0, 1e-12);
@@ -417,11 +417,11 @@ obstacles:
   }
   EXPECT_TRUE(corner);
   // The start pose itself is the odometry origin: an empty world gives an empty map.
-  EXPECT_TRUE(client::mapFromWorld(sim::loadWorldText("name: empty\n", "empty.yaml")).empty());
+  EXPECT_TRUE(sim::mapFromWorld(sim::loadWorldText("name: empty\n", "empty.yaml")).empty());
 }
 
 TEST(RobotCoreNavigation, AGoalWithoutProgressIsGivenUpWithFailed) {
-  client::SafetyParams safety;
+  robot::SafetyParams safety;
   safety.nav_stall_s = 3.0;
   KinematicRobot r(safety);
   r.run(0.05);
@@ -443,15 +443,15 @@ TEST(RobotCoreNavigation, AGoalWithoutProgressIsGivenUpWithFailed) {
 
 namespace {
 
-int countKind(const std::vector<client::CoreEvent>& ev, v1::Event::Kind k, v1::GasAlarm::Level level) {
+int countKind(const std::vector<robot::CoreEvent>& ev, v1::Event::Kind k, v1::GasAlarm::Level level) {
   int n = 0;
   for (const auto& e : ev) n += e.kind == k && e.gas_alarm && e.gas_alarm->level() == level;
   return n;
 }
 
-client::SafetyParams reaction(const std::string& r) {
-  client::SafetyParams s;
-  s.gas_reaction = r;
+robot::SafetyParams reaction(const std::string& r) {
+  robot::SafetyParams s;
+  s.gas_reaction = *robot::gasReactionOf(r);
   return s;
 }
 

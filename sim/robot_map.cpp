@@ -1,10 +1,10 @@
-#include "robot_client/robot_map.hpp"
+#include "sim/robot_map.hpp"
 
 #include <cmath>
 
-namespace inspect::client {
+namespace inspect::sim {
 
-std::vector<behavior::MapSegment> mapFromWorld(const sim::World& w) {
+std::vector<behavior::MapSegment> mapFromWorld(const World& w) {
   // Odometry starts at (0, 0, 0) where the robot stands at start-up, so a
   // world point p is R(-theta0) (p - start) in the odometry frame.
   const double c = std::cos(w.start.theta_rad), s = std::sin(w.start.theta_rad);
@@ -13,11 +13,11 @@ std::vector<behavior::MapSegment> mapFromWorld(const sim::World& w) {
     return Eigen::Vector2d(c * dx + s * dy, -s * dx + c * dy);
   };
   std::vector<behavior::MapSegment> map;
-  for (const auto& e : sim::solidEdges(w)) {
+  for (const auto& e : solidEdges(w)) {
     const Eigen::Vector2d a = toOdometry(e.a_m), b = toOdometry(e.b_m);
     map.push_back({a.x(), a.y(), b.x(), b.y()});
   }
   return map;
 }
 
-}  // namespace inspect::client
+}  // namespace inspect::sim

@@ -6,14 +6,14 @@
 #include <fstream>
 #include <sstream>
 
-#include "robot_client/robot_core.hpp"
+#include "shared/robot/robot_core.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/net/gains_proto.hpp"
 #include "tests/support/paths.hpp"
-#include "tests/unit/core_harness.hpp"
+#include "tests/robot/core_harness.hpp"
 
 using namespace inspect;
-using client::RobotCore;
+using robot::RobotCore;
 
 namespace {
 

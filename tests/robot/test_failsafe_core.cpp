@@ -6,28 +6,23 @@
 
 #include <cmath>
 
-#include "robot_client/robot_core.hpp"
+#include "shared/robot/robot_core.hpp"
+#include "tests/robot/core_commands.hpp"
 
 using namespace inspect;
-using client::RobotCore;
+using robot::RobotCore;
 
 namespace {
 
-v1::Command teleop(uint64_t id, double v, double w) {
-  v1::Command c;
-  c.set_id(id);
-  c.mutable_teleop()->set_v_m_s(v);
-  c.mutable_teleop()->set_w_rad_s(w);
-  return c;
-}
+using test::teleop;
 
 struct Robot {
   config::RobotConfig robot;
   // Link and command timeouts both 300 ms (the default link timeout is 250 ms,
   // which makes it fire first; equal timeouts are the race these tests cover),
   // sensor timeout 100 ms.
-  client::SafetyParams safety = [] {
-    client::SafetyParams s;
+  robot::SafetyParams safety = [] {
+    robot::SafetyParams s;
     s.link_timeout_s = 0.3;
     return s;
   }();

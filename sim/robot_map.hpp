@@ -6,11 +6,11 @@
 #include "shared/behavior/human_tracker.hpp"
 #include "sim/world.hpp"
 
-namespace inspect::client {
+namespace inspect::sim {
 
-/// Every wall segment and obstacle edge of `w` (sim::solidEdges), moved from
+/// Every wall segment and obstacle edge of `w` (solidEdges), moved from
 /// the world frame into the odometry frame of a robot started at `w.start`
 /// (origin and x axis = the start pose), ready for behavior::HumanAwareness.
-std::vector<behavior::MapSegment> mapFromWorld(const sim::World& w);
+std::vector<behavior::MapSegment> mapFromWorld(const World& w);
 
-}  // namespace inspect::client
+}  // namespace inspect::sim

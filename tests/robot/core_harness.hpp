@@ -4,16 +4,16 @@
 #include <cmath>
 #include <cstdint>
 
-#include "robot_client/robot_core.hpp"
+#include "shared/robot/robot_core.hpp"
 #include "shared/config/control_config.hpp"
 
 namespace inspect::test {
 
 struct CoreHarness {
   config::RobotConfig robot;
-  client::SafetyParams safety;
+  robot::SafetyParams safety;
   config::ControlConfig control;
-  client::RobotCore core;
+  robot::RobotCore core;
   serial::SensorFrame f;
   double t = 0.0;
   double disp_l = 0, disp_r = 0;

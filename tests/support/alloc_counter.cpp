@@ -1,4 +1,4 @@
-#include "alloc_counter.hpp"
+#include "tests/support/alloc_counter.hpp"
 
 #include <atomic>
 #include <cstdlib>
@@ -23,9 +23,9 @@ void* countedAlignedAlloc(std::size_t size, std::align_val_t align) {
 }
 }  // namespace
 
-namespace inspect::fuzzy::testing {
+namespace inspect::test {
 std::size_t allocationCount() { return g_allocations.load(std::memory_order_relaxed); }
-}  // namespace inspect::fuzzy::testing
+}  // namespace inspect::test
 
 void* operator new(std::size_t size) { return countedAlloc(size); }
 void* operator new[](std::size_t size) { return countedAlloc(size); }
