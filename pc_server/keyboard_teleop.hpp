@@ -1,6 +1,6 @@
 #pragma once
 // Keyboard teleop as a pure state machine: keys and time in, velocity set-point
-// out (see "Teleop from a terminal" in DESIGN.md and docs/console.md).
+// out (docs/console.md, "Keyboard teleop").
 // step: keys step the set-point, which stays until changed.
 // hold: a key drives at a fixed speed while its auto-repeats keep arriving (deadman).
 #include <string>

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "sim/scenarios/scenario.hpp"
+#include "experiments/scenarios/scenario.hpp"
 #include "tests/support/stack.hpp"
 
 using namespace inspect;

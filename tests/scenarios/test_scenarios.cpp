@@ -1,5 +1,5 @@
 // The scenario suite in-process: the robot's decision core against the
-// simulated world (sim/scenarios). The strategy must pass every scenario; the
+// simulated world (experiments/scenarios). The strategy must pass every scenario; the
 // baselines must behave as their definitions say; the figures must be
 // reproducible; a bad suite file must be refused with a clear message.
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <map>
 
-#include "sim/scenarios/scenario.hpp"
+#include "experiments/scenarios/scenario.hpp"
 #include "tests/support/paths.hpp"
 
 using namespace inspect;

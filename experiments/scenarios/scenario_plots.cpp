@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "shared/util/gnuplot.hpp"
-#include "sim/scenarios/scenario.hpp"
+#include "experiments/scenarios/scenario.hpp"
 
 namespace inspect::sim {
 namespace {

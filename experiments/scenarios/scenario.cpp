@@ -1,4 +1,4 @@
-#include "sim/scenarios/scenario.hpp"
+#include "experiments/scenarios/scenario.hpp"
 
 #include <algorithm>
 #include <array>

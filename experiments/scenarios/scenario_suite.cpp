@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "shared/config/config_node.hpp"
-#include "sim/scenarios/scenario.hpp"
+#include "experiments/scenarios/scenario.hpp"
 
 using namespace inspect;
 
