@@ -10,7 +10,7 @@
 # second clone of the tree would miss every compiler-cache entry; these
 # files include them by their path relative to the source tree (found
 # through the project's -I), and are the same in every clone. __FILE__ then
-# reads e.g. pc_server/console.cpp.
+# reads e.g. pc_server/console/console.cpp.
 #
 # A source that cannot share a translation unit (its own macros, a name
 # that would clash) is kept out with the source property INSPECT_NO_UNITY.

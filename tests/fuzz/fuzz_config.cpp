@@ -12,8 +12,8 @@
 #include <cstdint>
 #include <string>
 
-#include "pc_server/route_file.hpp"
-#include "pc_server/server_config.hpp"
+#include "pc_server/console/route_file.hpp"
+#include "pc_server/app/server_config.hpp"
 #include "robot_client/client_config.hpp"
 #include "sim/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"

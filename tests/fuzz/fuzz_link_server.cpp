@@ -18,9 +18,9 @@
 #include <google/protobuf/stubs/logging.h>
 
 #include "inspect/v1/link.pb.h"
-#include "pc_server/hello_check.hpp"
-#include "pc_server/robot_registry.hpp"
-#include "pc_server/status_line.hpp"
+#include "pc_server/link/hello_check.hpp"
+#include "pc_server/link/robot_registry.hpp"
+#include "pc_server/console/status_line.hpp"
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/robot_id.hpp"
 #include "tests/fuzz/fuzz_records.hpp"

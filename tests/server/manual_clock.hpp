@@ -10,8 +10,8 @@
 #include <functional>
 #include <map>
 
-#include "pc_server/console_clock.hpp"
-#include "pc_server/stop_flag.hpp"
+#include "pc_server/console/console_clock.hpp"
+#include "pc_server/app/stop_flag.hpp"
 #include "shared/util/clock.hpp"
 
 namespace inspect::test {

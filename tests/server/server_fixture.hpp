@@ -10,8 +10,8 @@
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
 
-#include "pc_server/link_server.hpp"
-#include "pc_server/robot_registry.hpp"
+#include "pc_server/link/link_server.hpp"
+#include "pc_server/link/robot_registry.hpp"
 #include "shared/util/clock.hpp"
 #include "test_robot.hpp"
 

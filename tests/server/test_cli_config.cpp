@@ -1,8 +1,8 @@
 // Command line and config/server.yaml: defaults, overrides, errors that name the flag or key.
 #include <gtest/gtest.h>
 
-#include "pc_server/cli_options.hpp"
-#include "pc_server/server_config.hpp"
+#include "pc_server/app/cli_options.hpp"
+#include "pc_server/app/server_config.hpp"
 #include "tests/support/paths.hpp"
 
 using namespace inspect;

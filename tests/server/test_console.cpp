@@ -16,10 +16,10 @@
 #include <cmath>
 #include <limits>
 
-#include "pc_server/console.hpp"
-#include "pc_server/line_reader.hpp"
-#include "pc_server/route_file.hpp"
-#include "pc_server/status_line.hpp"
+#include "pc_server/console/console.hpp"
+#include "pc_server/operator/line_reader.hpp"
+#include "pc_server/console/route_file.hpp"
+#include "pc_server/console/status_line.hpp"
 #include "shared/util/clock.hpp"
 #include "tests/server/manual_clock.hpp"
 #include "tests/support/paths.hpp"

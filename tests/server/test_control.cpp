@@ -4,7 +4,7 @@
 
 #include <sstream>
 
-#include "pc_server/console.hpp"
+#include "pc_server/console/console.hpp"
 #include "server_fixture.hpp"
 
 namespace inspect::test {

@@ -1,8 +1,8 @@
 // expect syntax and comparison, table-driven.
 #include <gtest/gtest.h>
 
-#include "pc_server/expect_check.hpp"
-#include "pc_server/text_util.hpp"
+#include "pc_server/console/expect_check.hpp"
+#include "pc_server/console/text_util.hpp"
 
 using namespace inspect::server;
 

@@ -7,8 +7,8 @@
 
 #include <boost/asio/io_context.hpp>
 
-#include "pc_server/cli_options.hpp"
-#include "pc_server/server_config.hpp"
+#include "pc_server/app/cli_options.hpp"
+#include "pc_server/app/server_config.hpp"
 #include "robot_client/client_config.hpp"
 #include "robot_client/server_link.hpp"
 #include "server_fixture.hpp"

@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <sstream>
 
-#include "pc_server/console.hpp"
-#include "pc_server/recorder.hpp"
-#include "pc_server/run_stats.hpp"
+#include "pc_server/console/console.hpp"
+#include "pc_server/recording/recorder.hpp"
+#include "pc_server/recording/run_stats.hpp"
 #include "shared/record/mcap_writer.hpp"
 #include "shared/util/clock.hpp"
 

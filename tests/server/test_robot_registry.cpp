@@ -1,7 +1,7 @@
 // The robot registry: replaced sessions cannot write, bounded histories, selection order.
 #include <gtest/gtest.h>
 
-#include "pc_server/robot_registry.hpp"
+#include "pc_server/link/robot_registry.hpp"
 
 using namespace inspect;
 using namespace inspect::server;

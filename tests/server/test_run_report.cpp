@@ -14,7 +14,7 @@
 #include <random>
 #include <sstream>
 
-#include "pc_server/run_report.hpp"
+#include "pc_server/recording/run_report.hpp"
 #include "shared/util/clock.hpp"
 
 using namespace inspect;

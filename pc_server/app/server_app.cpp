@@ -1,0 +1,271 @@
+#include "pc_server/app/server_app.hpp"
+
+#include <pwd.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <functional>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <thread>
+#include <vector>
+
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+
+#include "pc_server/console/console.hpp"
+#include "pc_server/console/console_runner.hpp"
+#include "pc_server/link/link_server.hpp"
+#include "pc_server/operator/operator_socket.hpp"
+#include "pc_server/link/robot_registry.hpp"
+#include "pc_server/app/startup_error.hpp"
+#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/recording/recorder.hpp"
+#include "pc_server/video/video_hub.hpp"
+#include "shared/util/clock.hpp"
+#include "shared/util/file_util.hpp"
+#include "shared/util/log.hpp"
+
+namespace inspect::server {
+
+namespace asio = boost::asio;
+
+namespace {
+constexpr const char* kDefaultConfig = "config/server.yaml";
+constexpr int kIoThreads = 2;
+// The console thread checks in every 20-50 ms; a stall this long means it hangs.
+constexpr std::chrono::milliseconds kConsoleWatchdog{500};
+
+enum class ConsoleMode { kNone, kScript, kInteractive, kStream };
+
+/// The io_context's threads; stopped and joined on every way out of runServer().
+struct IoThreads {
+  asio::io_context& ioc;
+  std::vector<std::thread> threads;
+  ~IoThreads() {
+    ioc.stop();
+    for (auto& t : threads)
+      if (t.joinable()) t.join();
+  }
+};
+}  // namespace
+
+static std::string localUserName() {
+  if (const char* u = std::getenv("USER"); u && *u) return u;
+  if (const passwd* pw = ::getpwuid(::getuid())) return pw->pw_name;
+  return "operator";
+}
+
+ServerConfig resolveConfig(const CliOptions& options) {
+  ServerConfig c;
+  if (options.config_path) {
+    c = loadServerConfigFile(*options.config_path);
+  } else if (std::filesystem::exists(kDefaultConfig)) {
+    c = loadServerConfigFile(kDefaultConfig);
+  }
+  if (options.bind_address) c.bind_address = *options.bind_address;
+  if (options.port) c.port = *options.port;
+  if (options.video_port) c.video.port = *options.video_port;
+  if (options.video_dir) c.video.dir = *options.video_dir;
+  if (options.no_video) c.video.enabled = false;
+  if (options.runs_dir) c.recording.dir = *options.runs_dir;
+  if (options.no_record) c.recording.enabled = false;
+  if (options.certs_dir) {
+    c.tls.ca = *options.certs_dir + "/ca.pem";
+    c.tls.cert = *options.certs_dir + "/server.pem";
+    c.tls.key = *options.certs_dir + "/server.key";
+  }
+  c.tls.plaintext = options.plaintext;
+  if (options.operator_socket) c.operator_socket = *options.operator_socket;
+  return c;
+}
+
+void writePortFile(const std::string& path, uint16_t port, const std::string& flag) {
+  if (const auto why = writeFileAtomically(path, std::to_string(port) + "\n"); !why.empty())
+    throw StartupError(flag + ": " + why);
+}
+
+int runServer(const CliOptions& options) {
+  const ServerConfig config = resolveConfig(options);
+
+  ConsoleMode mode = ConsoleMode::kNone;
+  if (options.no_console) mode = ConsoleMode::kNone;
+  else if (options.script_path) mode = ConsoleMode::kScript;
+  else if (options.interactive || ::isatty(0)) mode = ConsoleMode::kInteractive;
+  else mode = ConsoleMode::kStream;
+  std::vector<std::string> script;
+  if (options.script_path) script = readScriptFile(*options.script_path);
+
+  // A console writing to a closed pipe must not kill the server.
+  std::signal(SIGPIPE, SIG_IGN);
+
+  asio::io_context ioc;
+  RobotRegistry registry;
+  LinkServer link(ioc, config, registry);
+  link.setLogEvents(mode == ConsoleMode::kNone);
+  if (mode != ConsoleMode::kNone) link.setConsoleWatchdog(kConsoleWatchdog);
+  const auto endpoint = link.listen();
+  if (config.tls.plaintext) {
+    log::warn(log::tag::kServer, net::kPlaintextWarning);
+    std::cerr << "pc_server: " << net::kPlaintextWarning << std::endl;
+  }
+  std::cout << "pc_server: listening on " << endpoint.address().to_string() << ":" << endpoint.port()
+            << (config.tls.plaintext ? " (PLAINTEXT)" : " (mutual TLS, server certificate " + link.certificateInfo() + ")")
+            << std::endl;
+  if (options.port_file) writePortFile(*options.port_file, endpoint.port(), "--port-file");
+
+  std::unique_ptr<Recorder> recorder;
+  if (config.recording.enabled) {
+    try {
+      recorder = std::make_unique<Recorder>(config.recording, INSPECT_VERSION);
+    } catch (const std::exception& e) {
+      throw StartupError(std::string("recording: ") + e.what());
+    }
+    link.addEnvelopeObserver([rec = recorder.get()](const std::string& id, const std::string& address,
+                                                    const v1::Envelope& env, bool inbound, uint64_t time_us) {
+      rec->onEnvelope(id, address, env, inbound, time_us);
+    });
+    // The gain set the robot announced (Hello, GAINS_APPLIED events) with its
+    // version; else what its latest telemetry shows while tracking (the
+    // recorder adds the controller at the run's first tracking telemetry).
+    recorder->setGainsSource([&registry](const std::string& robot) {
+      const auto snap = registry.snapshot(robot, monoNowNs());
+      if (snap && snap->gains_known) return runGainsJson(snap->gains, snap->gains_version);
+      return snap && snap->has_telemetry ? gainsJson(snap->telemetry) : std::string("{}");
+    });
+    recorder->setHelloSource([&registry](const std::string& robot) -> std::optional<v1::Hello> {
+      const auto snap = registry.snapshot(robot, monoNowNs());
+      if (!snap) return std::nullopt;
+      return snap->hello;
+    });
+    std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog.sqlite)";
+    if (!recorder->startupReport().empty()) std::cout << "; " << recorder->startupReport();
+    std::cout << std::endl;
+  }
+
+  std::unique_ptr<VideoHub> video;
+  if (config.video.enabled) {
+    video = std::make_unique<VideoHub>(config.video, config.bind_address, link);
+    link.addEnvelopeObserver([hub = video.get()](const std::string& id, const std::string& address,
+                                                 const v1::Envelope& env, bool inbound, uint64_t time_us) {
+      if (inbound && env.has_telemetry()) hub->onTelemetry(id, address, env, time_us);
+    });
+    if (recorder) {
+      video->setAccessUnitHook([rec = recorder.get()](const std::string& robot, const video::Frame& f,
+                                                      uint64_t capture_us) { rec->onAccessUnit(robot, f, capture_us); });
+      recorder->setVideoFigures([hub = video.get()](const std::string& robot) -> std::optional<VideoFigures> {
+        const auto st = hub->stats(robot);
+        if (!st) return std::nullopt;
+        return VideoFigures{static_cast<int64_t>(st->frames), static_cast<int64_t>(st->decoded),
+                            static_cast<int64_t>(st->lost_packets)};
+      });
+    }
+    video->start();
+    std::cout << "pc_server: video on UDP port " << video->port() << ", SDP files in " << config.video.dir << "/"
+              << std::endl;
+    if (options.video_port_file) writePortFile(*options.video_port_file, video->port(), "--video-port-file");
+  }
+
+  StopFlag stop;
+  asio::signal_set signals(ioc, SIGINT, SIGTERM);
+  std::function<void()> wait_signal = [&] {
+    signals.async_wait([&](const boost::system::error_code& ec, int sig) {
+      if (ec) return;
+      if (sig == SIGINT && stop.interrupt()) {
+        // A console job (tune) takes Ctrl-C as "cancel, keep the best so far".
+        log::info(log::tag::kServer, "SIGINT: cancelling the running console job (Ctrl-C again to shut down)");
+        stop.setInterruptTarget(nullptr);
+        wait_signal();
+        return;
+      }
+      log::info(log::tag::kServer, "signal ", sig == SIGINT ? "SIGINT" : "SIGTERM", ": shutting down");
+      stop.request();
+    });
+  };
+  wait_signal();
+
+  // MCAP chunks of quiet recordings reach the disk within a second.
+  asio::steady_timer record_timer(ioc);
+  std::function<void()> record_tick = [&] {
+    if (recorder) recorder->tick();
+    record_timer.expires_after(std::chrono::milliseconds(200));
+    record_timer.async_wait([&](const boost::system::error_code& ec) {
+      if (!ec) record_tick();
+    });
+  };
+  if (recorder) record_tick();
+
+  auto work = asio::make_work_guard(ioc);
+  IoThreads io{ioc, {}};
+  for (int i = 0; i < kIoThreads; ++i) io.threads.emplace_back([&ioc] { ioc.run(); });
+
+  int status = 0;
+  {
+    Console::Options copt;
+    // Every console (this one and those attached to the operator socket) is one
+    // session; one session at a time controls a robot (docs/console.md).
+    ControlArbiter control;
+    const auto configure = [&](Console& c) {
+      c.setVideo(video.get());
+      c.setRecorder(recorder.get());
+      // The tuning host reads the robot and control configs beside the server's
+      // (config/robot.yaml, config/control.yaml) and writes sessions under the runs.
+      const std::filesystem::path cfg_dir =
+          options.config_path ? std::filesystem::path(*options.config_path).parent_path() : std::filesystem::path("config");
+      const auto beside = [&](const char* name) { return (cfg_dir.empty() ? std::filesystem::path(".") : cfg_dir) / name; };
+      c.setTuningPaths(beside("robot.yaml").string(), beside("control.yaml").string(),
+                       (recorder ? recorder->config().dir : config.recording.dir) + "/tuning");
+    };
+    Console console(registry, link, std::cout, stop, copt);
+    configure(console);
+    console.setSession(&control, control.openSession(localUserName() + "@console"));
+    std::unique_ptr<OperatorSocket> operators;
+    if (!config.operator_socket.empty()) {
+      operators = std::make_unique<OperatorSocket>(config.operator_socket, registry, link, control, copt, configure);
+      operators->start();
+      std::cout << "pc_server: operator consoles: pc_server --attach " << config.operator_socket << std::endl;
+    }
+    console.setAlarmStyle(::isatty(STDOUT_FILENO) == 1);  // red + bell on a terminal, plain text into pipes
+    ConsoleRunner runner(console, stop, config.status_refresh_hz);
+    switch (mode) {
+      case ConsoleMode::kNone:
+        stop.wait();
+        break;
+      case ConsoleMode::kScript:
+        status = runner.runScript(script, *options.script_path) ? 0 : 1;
+        if (options.interactive && !stop.requested() && !console.quitRequested()) runner.runInteractive();
+        break;
+      case ConsoleMode::kInteractive:
+        runner.runInteractive();
+        break;
+      case ConsoleMode::kStream:
+        status = runner.runStream(0) ? 0 : 1;
+        break;
+    }
+    if (operators) operators->stop();
+  }
+  std::cout.flush();
+
+  log::info(log::tag::kServer, "stopping: closing robot sessions");
+  link.stop();
+  if (!link.waitAllClosed(std::chrono::seconds(1))) log::warn(log::tag::kServer, "some sessions did not close within 1 s");
+  asio::post(ioc, [&signals, &record_timer] {
+    boost::system::error_code ignored;
+    signals.cancel(ignored);
+    record_timer.cancel();
+  });
+  if (video) video->stop();
+  work.reset();
+  // IoThreads' destructor joins the io threads before the recorder (declared
+  // earlier) ends the runs still open.
+  return status;  // io stops and joins the threads
+
+}
+
+}  // namespace inspect::server

@@ -1,0 +1,75 @@
+#include "pc_server/app/server_config.hpp"
+
+#include <boost/asio/ip/address.hpp>
+
+namespace inspect::server {
+
+bool validBindAddress(const std::string& address) {
+  boost::system::error_code ec;
+  (void)boost::asio::ip::make_address(address, ec);
+  return !ec;
+}
+
+ServerConfig loadServerConfig(const config::ConfigNode& root) {
+  ServerConfig c;
+  c.bind_address = root.string("bind", c.bind_address);
+  if (!validBindAddress(c.bind_address))
+    root.fail("bind", "'" + c.bind_address + "' is not a numeric IP address (e.g. 0.0.0.0, 127.0.0.1, ::)");
+  c.port = static_cast<uint16_t>(root.integer("port", c.port, 0, 65535));
+  c.server_id = root.string("server_id", c.server_id);
+  if (c.server_id.empty() || c.server_id.size() > 64) root.fail("server_id", "must be 1 to 64 characters");
+  c.heartbeat_period_s = root.number("heartbeat_period_s", c.heartbeat_period_s, 0.01, 5);
+  // The robot sends heartbeats at 0.1 s by default; a timeout must cover a few of them.
+  c.session_timeout_s = root.number("session_timeout_s", c.session_timeout_s, 0.2, 60);
+  c.telemetry_stale_s = root.number("telemetry_stale_s", c.telemetry_stale_s, 0, 60);
+  if (c.telemetry_stale_s > 0 && c.telemetry_stale_s < 0.1)
+    root.fail("telemetry_stale_s", "must be 0 (off) or at least 0.1 s (robots send telemetry at up to 100 Hz)");
+  c.handshake_timeout_s = root.number("handshake_timeout_s", c.handshake_timeout_s, 0.1, 60);
+  // The robot zeroes a set-point older than 300 ms; below 10 Hz it would stutter.
+  c.teleop_resend_hz = root.number("teleop_resend_hz", c.teleop_resend_hz, 10, 100);
+  c.max_frame_bytes = static_cast<std::size_t>(root.integer("max_frame_bytes", static_cast<long>(c.max_frame_bytes),
+                                                            1024, 64L * 1024 * 1024));
+  c.status_refresh_hz = root.number("status_refresh_hz", c.status_refresh_hz, 0.5, 30);
+  const auto v = root.optChild("video");
+  auto& vc = c.video;
+  vc.enabled = v.boolean("enabled", vc.enabled);
+  vc.bind = v.string("bind", vc.bind);
+  if (!vc.bind.empty() && !validBindAddress(vc.bind)) v.fail("bind", "'" + vc.bind + "' is not a numeric IP address");
+  vc.port = static_cast<uint16_t>(v.integer("port", vc.port, 0, 65535));
+  vc.dir = v.string("dir", vc.dir);
+  if (vc.dir.empty()) v.fail("dir", "must not be empty");
+  vc.forward_base_port = static_cast<uint16_t>(v.integer("forward_base_port", vc.forward_base_port, 0, 65000));
+  vc.window = v.string("window", vc.window);
+  if (vc.window != "auto" && vc.window != "on" && vc.window != "off")
+    v.fail("window", "'" + vc.window + "' is not one of auto, on, off");
+  vc.snapshot_period_s = v.number("snapshot_period_s", vc.snapshot_period_s, 0, 3600);
+  vc.reorder_window = static_cast<std::size_t>(v.integer("reorder_window", static_cast<long>(vc.reorder_window), 1, 1024));
+  vc.keyframe_min_interval_s = v.number("keyframe_min_interval_s", vc.keyframe_min_interval_s, 0.05, 10);
+  const auto r = root.optChild("recording");
+  auto& rc = c.recording;
+  rc.enabled = r.boolean("enabled", rc.enabled);
+  rc.dir = r.string("dir", rc.dir);
+  if (rc.dir.empty()) r.fail("dir", "must not be empty");
+  rc.auto_start = r.boolean("auto_start", rc.auto_start);
+  rc.compression = r.string("compression", rc.compression);
+  if (rc.compression != "zstd" && rc.compression != "none")
+    r.fail("compression", "'" + rc.compression + "' is not one of zstd, none");
+  rc.max_fragment_s = r.number("max_fragment_s", rc.max_fragment_s, 0.1, 60);
+  c.operator_socket = root.string("operator_socket", c.operator_socket);
+  const auto t = root.optChild("tls");
+  for (const char* key : {"ca", "cert", "key"}) {
+    std::string& field = key[0] == 'c' ? (key[1] == 'a' ? c.tls.ca : c.tls.cert) : c.tls.key;
+    field = t.string(key, field);
+    if (field.empty()) t.fail(key, "must not be empty (plaintext is only the --plaintext flag)");
+  }
+  return c;
+}
+
+ServerConfig loadServerConfigFile(const std::string& path) {
+  const auto root = config::ConfigNode::loadFile(path);
+  ServerConfig c = loadServerConfig(root);
+  root.checkKnown();
+  return c;
+}
+
+}  // namespace inspect::server

@@ -1,0 +1,213 @@
+#pragma once
+// The operator console's commands: parsing, dispatch and output. It holds no
+// terminal and no socket: lines in, text out (tested on strings); the robots
+// are reached through the registry (state) and a CommandSink (commands).
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "pc_server/link/command_sink.hpp"
+#include "pc_server/console/console_clock.hpp"
+#include "pc_server/operator/control_arbiter.hpp"
+#include "pc_server/operator/keyboard_teleop.hpp"
+#include "pc_server/link/robot_registry.hpp"
+#include "pc_server/app/stop_flag.hpp"
+#include "shared/catalog/catalog.hpp"
+#include "shared/control/gain_set.hpp"
+
+namespace inspect::server {
+
+class VideoHub;
+class Recorder;
+
+class Console {
+ public:
+  struct Options {
+    double ack_timeout_s = 1.0;    // stop/estop/resume/drive wait this long for the Ack
+    double poll_period_s = 0.02;   // expect ... within, wait
+    double ack_poll_period_s = 0.001;  // waiting for a command's Ack
+    double max_v_m_s = 1.0;        // drive limits (the keyboard gauge uses the same)
+    double max_w_rad_s = 2.0;
+  };
+  /// Runs keyboard teleop on the selected robot until the operator leaves; false on failure.
+  using TeleopHandler = std::function<bool(KeyboardTeleop::Mode mode, const std::string& robot_id)>;
+
+  /// Counts of a session, for the script summary and the exit status.
+  struct Tally {
+    int commands = 0;
+    int errors = 0;
+    int expects_passed = 0;
+    int expects_failed = 0;
+  };
+
+  Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop);
+  Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop, Options options);
+
+  /// Runs one line (blank lines and '#' comments are fine); false if it failed
+  /// (an error, or an expect that did not hold). `line_no` appears in expect results.
+  bool execute(const std::string& line, int line_no);
+
+  /// Background work between commands: selects the first robot to connect when
+  /// none is selected and returns the text of new robot events and of completed
+  /// runs ("robot1: goto completed"). Call it often.
+  std::string background();
+  /// background() printed to the output, then the idle hook; used while waiting.
+  void pump();
+  /// The clock this console reads and waits on (default: the real one; tests
+  /// pass one they advance themselves). Must outlive the console.
+  void setClock(ConsoleClock& clock) { clock_ = &clock; }
+  ConsoleClock& clock() { return *clock_; }
+  /// Called while the console waits (e.g. to refresh the status line).
+  void setIdleHook(std::function<void()> hook) { idle_hook_ = std::move(hook); }
+  /// Interactive terminals: alarm lines in red with the terminal bell.
+  void setAlarmStyle(bool on) { alarm_style_ = on; }
+  /// Enables `teleop` (only an interactive terminal has one).
+  void setTeleopHandler(TeleopHandler handler) { teleop_handler_ = std::move(handler); }
+
+  /// Makes this console a session of `arbiter`: its motion commands need the
+  /// robot's control (taken on first use when free), `control` shows and
+  /// changes it, and notes from other sessions print in background().
+  void setSession(ControlArbiter* arbiter, uint64_t session) {
+    control_ = arbiter;
+    session_ = session;
+  }
+  uint64_t session() const { return session_; }
+  /// Starts this console's event feed at the newest event: a session that
+  /// attaches mid-run does not replay the registry's buffer (up to
+  /// kMaxPendingEvents old events); `alarms` shows what is in force.
+  void eventsFromNow() { event_cursor_ = registry_.eventCursor(); }
+
+  bool quitRequested() const { return quit_; }
+  const std::string& selected() const { return selected_; }
+  const Tally& tally() const { return tally_; }
+  const Options& options() const { return options_; }
+  RobotRegistry& registry() { return registry_; }
+  /// Enables snapshot and the video figures (null: the server has no video).
+  void setVideo(VideoHub* hub) { video_ = hub; }
+  VideoHub* video() const { return video_; }
+  /// Enables record/runs/run (null: the server records nothing).
+  void setRecorder(Recorder* r) { recorder_ = r; }
+  Recorder* recorder() const { return recorder_; }
+  /// The robot's status line with the video figures and the recording mark ("| REC <run-id>").
+  std::string statusText(const std::string& robot) const;
+  CommandSink& sink() { return sink_; }
+  /// Where the tuning host reads the robot and control configs and writes
+  /// its sessions (defaults: config/robot.yaml, config/control.yaml, runs/tuning).
+  void setTuningPaths(std::string robot_config, std::string control_config, std::string dir);
+
+  /// The text of `help` (all commands) or `help <command>`; empty for an unknown command.
+  static std::string helpText(const std::string& command = "");
+
+ private:
+  using Args = std::vector<std::string>;
+  using Handler = bool (Console::*)(const Args& args, const std::string& rest, int line_no);
+  struct CommandDef {
+    const char* name;
+    const char* syntax;
+    const char* summary;
+    const char* details;
+    Handler run;
+  };
+  static const std::vector<CommandDef>& commands();
+  static const CommandDef* findCommand(const std::string& name);
+
+  bool cmdHelp(const Args& args, const std::string& rest, int line_no);
+  bool cmdRobots(const Args& args, const std::string& rest, int line_no);
+  bool cmdSelect(const Args& args, const std::string& rest, int line_no);
+  bool cmdStatus(const Args& args, const std::string& rest, int line_no);
+  bool cmdDrive(const Args& args, const std::string& rest, int line_no);
+  bool cmdTeleop(const Args& args, const std::string& rest, int line_no);
+  bool cmdTrack(const Args& args, const std::string& rest, int line_no);
+  bool cmdGoto(const Args& args, const std::string& rest, int line_no);
+  bool cmdRoute(const Args& args, const std::string& rest, int line_no);
+  bool cmdStop(const Args& args, const std::string& rest, int line_no);
+  bool cmdEstop(const Args& args, const std::string& rest, int line_no);
+  bool cmdResume(const Args& args, const std::string& rest, int line_no);
+  bool cmdVideo(const Args& args, const std::string& rest, int line_no);
+  bool cmdPtz(const Args& args, const std::string& rest, int line_no);
+  bool cmdSnapshot(const Args& args, const std::string& rest, int line_no);
+  bool cmdRecord(const Args& args, const std::string& rest, int line_no);
+  bool cmdRuns(const Args& args, const std::string& rest, int line_no);
+  bool cmdRun(const Args& args, const std::string& rest, int line_no);
+  bool cmdReport(const Args& args, const std::string& rest, int line_no);
+  bool cmdExport(const Args& args, const std::string& rest, int line_no);
+  bool cmdReplay(const Args& args, const std::string& rest, int line_no);
+  bool cmdInspect(const Args& args, const std::string& rest, int line_no);
+  bool cmdAlarms(const Args& args, const std::string& rest, int line_no);
+  bool cmdAck(const Args& args, const std::string& rest, int line_no);
+  bool cmdIdentify(const Args& args, const std::string& rest, int line_no);
+  bool cmdTune(const Args& args, const std::string& rest, int line_no);
+  bool cmdGains(const Args& args, const std::string& rest, int line_no);
+  struct TuningState;
+  /// The tuning host's state, loaded on first use; prints why (as `cmd`) and returns null on failure.
+  TuningState* tuning(const std::string& cmd);
+  /// Sends gains to a robot, reports its Ack and books the push in the catalog.
+  bool pushGains(const std::string& robot, const control::GainSet& g, const std::string& source,
+                 const std::string& session);
+  /// A run of the catalog and its directory; prints why not (as `cmd`) when there is none.
+  std::optional<std::pair<catalog::RunDetail, std::string>> findRun(const std::string& cmd, const std::string& id);
+  bool cmdWait(const Args& args, const std::string& rest, int line_no);
+  bool cmdExpect(const Args& args, const std::string& rest, int line_no);
+  bool cmdEcho(const Args& args, const std::string& rest, int line_no);
+  bool cmdQuit(const Args& args, const std::string& rest, int line_no);
+
+  /// Prints "<cmd>: <message>" and returns false.
+  bool fail(const std::string& cmd, const std::string& message);
+  /// The selected robot when it is connected; otherwise prints why (as `cmd`) and returns nullopt.
+  std::optional<std::string> connectedRobot(const std::string& cmd);
+  /// Whether this session may move `robot` (see setSession); prints why not.
+  bool mayMove(const std::string& robot, const std::string& cmd);
+  bool cmdControl(const Args& args, const std::string& rest, int line_no);
+  /// Sends a Stop/EStop/Resume and reports its Ack.
+  bool simpleCommand(const std::string& name, const Args& args, v1::Command cmd);
+  /// Sends `cmd` to the selected robot, waits for its Ack and prints the answer. With `runs`
+  /// (track, goto, route) the command's COMPLETED Ack is printed when it comes (background()).
+  bool sendAndReport(const std::string& name, v1::Command cmd, bool runs = false);
+  /// Waits up to ack_timeout_s for the Ack of `command_id`; nullopt when none came.
+  std::optional<v1::Ack> waitAck(const std::string& robot_id, uint64_t command_id);
+  /// Sleeps up to `seconds` while pumping; false if the server is stopping.
+  bool sleepPumping(double seconds);
+  /// Now on this console's clock, in seconds (for elapsed times).
+  double nowS() { return static_cast<double>(clock_->nowNs()) * 1e-9; }
+  /// The time `seconds` from now on this console's clock, in its nanoseconds.
+  int64_t deadlineAfter(double seconds) { return clock_->nowNs() + std::llround(seconds * 1e9); }
+
+  RobotRegistry& registry_;
+  CommandSink& sink_;
+  std::ostream& out_;
+  StopFlag& stop_;
+  Options options_;
+  SteadyConsoleClock steady_clock_{stop_};
+  ConsoleClock* clock_ = &steady_clock_;
+  std::function<void()> idle_hook_;
+  TeleopHandler teleop_handler_;
+  VideoHub* video_ = nullptr;
+  Recorder* recorder_ = nullptr;
+  bool alarm_style_ = false;
+  std::string selected_;
+  uint64_t event_cursor_ = 0;
+  ControlArbiter* control_ = nullptr;
+  uint64_t session_ = 0;  // this session's place in the registry's event feed (from the start for the first)
+  bool quit_ = false;
+  Tally tally_;
+  /// An accepted long-running command waiting for its COMPLETED Ack (at most one per robot).
+  struct Run {
+    std::string robot_id;
+    uint64_t command_id = 0;
+    std::string name;
+  };
+  std::vector<Run> runs_;
+  std::shared_ptr<TuningState> tuning_;
+  std::atomic<bool> tune_cancel_{false};  // Ctrl-C during tune (StopFlag's interrupt target)
+  std::string tuning_robot_config_ = "config/robot.yaml";
+  std::string tuning_control_config_ = "config/control.yaml";
+  std::string tuning_dir_ = "runs/tuning";
+};
+
+}  // namespace inspect::server

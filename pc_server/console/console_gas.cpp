@@ -1,0 +1,116 @@
+// The console's gas commands: inspect <route>, alarms, ack (docs/gas.md).
+#include <cmath>
+
+#include "pc_server/console/console.hpp"
+#include "pc_server/recording/recorder.hpp"
+#include "pc_server/console/route_file.hpp"
+#include "pc_server/console/text_util.hpp"
+#include "shared/config/config_node.hpp"
+#include "shared/util/clock.hpp"
+
+namespace inspect::server {
+
+namespace {
+
+std::string value(double v, const std::string& unit) {
+  return (std::isnan(v) ? std::string("--") : fmtShort(v, 2)) + (unit.empty() ? "" : " " + unit);
+}
+
+// "#3 robot1 H2S HIGH 12.3 ppm (A2 10 ppm, worst 15.1 ppm) at (2.10, 2.95): raised 14.2 s ago, active, unacknowledged"
+std::string alarmLine(const AlarmRecord& r, int64_t now_ns) {
+  const auto& a = r.alarm;
+  std::string s = "#" + std::to_string(r.number) + " " + r.robot_id + " " + a.channel_name() + " " +
+                  v1::GasAlarm::Level_Name(a.level());
+  if (a.level() == v1::GasAlarm::SENSOR_FAULT) {
+    s += " " + a.fault() + " (reading " + value(a.value(), a.unit()) + ")";
+  } else {
+    s += " " + value(a.value(), a.unit()) + " (" + (a.level() == v1::GasAlarm::HIGH ? "A2 " : "A1 ") +
+         value(a.threshold(), a.unit()) + ", worst " + value(a.peak(), a.unit()) + ")";
+  }
+  s += " at (" + fmtFixed(a.pose().x_m()) + ", " + fmtFixed(a.pose().y_m()) + "): raised " +
+       fmtFixed(static_cast<double>(now_ns - r.raised_ns) * 1e-9, 1) + " s ago, ";
+  s += r.active() ? std::string("ACTIVE")
+                  : "cleared after " + fmtFixed(static_cast<double>(r.cleared_ns - r.raised_ns) * 1e-9, 1) + " s";
+  s += r.acked ? ", acknowledged" : ", unacknowledged";
+  return s;
+}
+
+}  // namespace
+
+bool Console::cmdInspect(const Args& args, const std::string&, int) {
+  if (args.empty() || args.size() > 2) return fail("inspect", "syntax: inspect <route> [speed_m_s]");
+  Route r;
+  try {
+    r = loadRouteFile(resolveRoute(args[0]));
+  } catch (const config::ConfigError& e) {
+    return fail("inspect", e.what());
+  }
+  if (args.size() == 2) {
+    const auto pv = parseNumber(args[1]);
+    const double v = pv ? *pv : 0.0;
+    if (!pv || !(v > 0.0) || v > kMaxRouteSpeed_m_s)
+      return fail("inspect", "speed_m_s '" + args[1] + "' must be a number in (0, " + fmtShort(kMaxRouteSpeed_m_s) +
+                                 "] m/s");
+    r.speed_m_s = v;
+  }
+  const auto robot = connectedRobot("inspect");
+  if (!robot) return false;
+  if (recorder_) {
+    if (!r.map.empty()) recorder_->setRunMap(*robot, r.map);
+  } else {
+    out_ << "inspect: note: the server records nothing (--no-record): no run, no report\n";
+  }
+  v1::Command c;
+  *c.mutable_go_to() = goToOf(r, true);
+  out_ << "inspection '" << r.name << "': " << r.points.size() << " points, " << r.inspectionPoints()
+       << " inspection points" << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string())
+       << (r.map.empty() ? std::string() : ", map " + r.map) << "\n";
+  const bool ok = sendAndReport("inspect", std::move(c), true);
+  if (!ok && recorder_) recorder_->setRunMap(*robot, "");  // refused: no run to attach the map to
+  return ok;
+}
+
+bool Console::cmdAlarms(const Args& args, const std::string&, int) {
+  if (args.size() > 1 || (args.size() == 1 && args[0] != "all")) return fail("alarms", "syntax: alarms [all]");
+  const bool all = args.size() == 1;
+  const auto list = registry_.alarms(all);
+  if (list.empty()) {
+    out_ << (all ? "no gas alarms so far\n" : "no active or unacknowledged gas alarms\n");
+    return true;
+  }
+  const int64_t now = clock_->nowNs();
+  for (const auto& r : list) out_ << alarmLine(r, now) << "\n";
+  return true;
+}
+
+bool Console::cmdAck(const Args& args, const std::string&, int) {
+  if (args.size() != 1) return fail("ack", "syntax: ack <number>|all (alarms lists the numbers)");
+  const int64_t now = clock_->nowNs();
+  std::vector<AlarmRecord> done;
+  if (args[0] == "all") {
+    done = registry_.ackAllAlarms(now);
+    if (done.empty()) {
+      out_ << "ack: nothing to acknowledge\n";
+      return true;
+    }
+  } else {
+    std::string n = args[0];
+    if (!n.empty() && n[0] == '#') n.erase(0, 1);
+    const auto pv = parseNumber(n);
+    const double v = pv ? *pv : 0.0;
+    if (!pv || v < 1 || v != std::floor(v) || v > 1e9)
+      return fail("ack", "'" + args[0] + "' is not an alarm number (alarms lists them)");
+    const auto r = registry_.ackAlarm(static_cast<int>(v), now);
+    if (!r) return fail("ack", "no alarm #" + n + " (alarms lists them)");
+    done.push_back(*r);
+  }
+  for (const auto& r : done) {
+    const std::string text = "alarm #" + std::to_string(r.number) + " (" + r.alarm.channel_name() + " " +
+                             v1::GasAlarm::Level_Name(r.alarm.level()) + ") acknowledged by the operator";
+    out_ << r.robot_id << ": " << text << "\n";
+    if (recorder_) recorder_->noteAlarmAck(r.robot_id, r.alarm, text);
+  }
+  return true;
+}
+
+}  // namespace inspect::server

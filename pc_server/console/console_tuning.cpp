@@ -1,0 +1,604 @@
+// The console's tuning commands (docs/tuning.md): identify <run>, tune, gains.
+// The tuning host's state (plant, working gains, last session) lives in one
+// TuningState per console; it is created on first use from the robot and
+// control configs (config/robot.yaml, config/control.yaml by default).
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "pc_server/console/console.hpp"
+#include "pc_server/recording/recorder.hpp"
+#include "pc_server/console/text_util.hpp"
+#include "pc_server/tuning/plant_id.hpp"
+#include "pc_server/tuning/tuner.hpp"
+#include "pc_server/tuning/tuning_report.hpp"
+#include "shared/config/config_node.hpp"
+#include "shared/config/control_config.hpp"
+#include "shared/config/gains_file.hpp"
+#include "shared/config/robot_config.hpp"
+#include "shared/fuzzy/fis_reader.hpp"
+#include "shared/fuzzy/fis_writer.hpp"
+#include "shared/net/gains_proto.hpp"
+#include "shared/util/clock.hpp"
+#include "sim/robot_plant.hpp"
+
+namespace inspect::server {
+
+namespace fs = std::filesystem;
+
+struct Console::TuningState {
+  config::RobotConfig robot;
+  config::ControlConfig control;
+  fuzzy::Fis fis;                  // the fuzzy system of control.fis_path (or imported)
+  bool fis_imported = false;       // push it along with the gains
+  control::GainSet paper;          // config/control.yaml's (the paper's) gains
+  control::GainSet working;        // what `gains set` edits and `gains push` sends
+  std::optional<control::GainSet> tuned;
+  std::string tuned_session;       // session id of `tuned`
+  control::PlantModel plant;       // what `tune` tunes for
+  std::string plant_source = "nominal (config/robot.yaml)";
+  std::string last_session_dir;
+};
+
+namespace {
+
+std::string gainsLine(const control::GainSet& g) {
+  std::ostringstream os;
+  bool first = true;
+  for (const char* n : control::kGainNames) {
+    os << (first ? "" : " ") << n << "=" << fmtShort(control::gainValue(g, n), 4);
+    first = false;
+  }
+  return os.str();
+}
+
+std::string wheelLine(const char* name, const control::WheelMotorModel& m) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%-5s gain %.3f  time constant %.3f s  dead time %.3f s  saturation %.2f rad/s", name,
+                m.gain, m.time_constant_s, m.dead_time_s, m.saturation_rad_s);
+  return buf;
+}
+
+constexpr double kMaxTuneReference_s = 300.0;
+
+std::string sessionStamp() {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", &tm);
+  return buf;
+}
+
+// "key=value" arguments of `tune`.
+bool splitKeyValue(const std::string& a, std::string& k, std::string& v) {
+  const auto eq = a.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == a.size()) return false;
+  k = a.substr(0, eq);
+  v = a.substr(eq + 1);
+  return true;
+}
+
+}  // namespace
+
+void Console::setTuningPaths(std::string robot_config, std::string control_config, std::string dir) {
+  tuning_robot_config_ = std::move(robot_config);
+  tuning_control_config_ = std::move(control_config);
+  tuning_dir_ = std::move(dir);
+  tuning_.reset();
+}
+
+Console::TuningState* Console::tuning(const std::string& cmd) {
+  if (tuning_) return tuning_.get();
+  try {
+    auto t = std::make_shared<TuningState>();
+    t->robot = config::loadRobotConfigFile(tuning_robot_config_);
+    t->control = config::loadControlConfigFile(tuning_control_config_);
+    config::applyRobot(t->control, t->robot);
+    t->fis = fuzzy::readFisFile(t->control.fis_path);
+    t->paper.fuzzy = t->control.tracker.fuzzy;
+    t->paper.aux = t->control.tracker.aux;
+    t->working = t->paper;
+    t->plant = sim::nominalPlant(t->robot);
+    tuning_ = std::move(t);
+  } catch (const std::exception& e) {
+    fail(cmd, std::string("cannot load the tuning configs: ") + e.what());
+    return nullptr;
+  }
+  return tuning_.get();
+}
+
+// ------------------------------------------------------------------ identify
+
+bool Console::cmdIdentify(const Args& args, const std::string&, int) {
+  if (args.size() != 1) return fail("identify", "syntax: identify <run-id>|last");
+  TuningState* ts = tuning("identify");
+  if (!ts) return false;
+  if (!recorder_) return fail("identify", "the server records nothing (--no-record): there are no runs");
+  std::string id = args[0];
+  if (id == "last") {
+    // The newest run that played a wheel test (an identification route).
+    catalog::RunFilter f;
+    f.limit = 50;
+    for (const auto& r : recorder_->catalog().listRuns(f))
+      if (r.name.rfind("identification", 0) == 0) {
+        id = r.id;
+        break;
+      }
+    if (id == "last") return fail("identify", "no identification run in the catalog (route identification records one)");
+  }
+  const auto run = findRun("identify", id);
+  if (!run) return false;
+  const auto& [d, dir] = *run;
+  tuning::PlantFit fit;
+  tuning::RunWheelData data;
+  try {
+    data = tuning::readRunWheelSeries(dir + "/run.mcap");
+    tuning::IdentifyOptions o;
+    o.nominal_saturation_rad_s = ts->robot.limits.max_wheel_speed_rad_s;
+    fit = tuning::identifyPlant(data.left, data.right, o);
+  } catch (const std::exception& e) {
+    return fail("identify", "run " + d.info.id + ": " + e.what());
+  }
+  out_ << "identify: run " << d.info.id << " (" << d.info.name << "): " << data.samples_used << " of "
+       << data.telemetry_messages << " telemetry samples, " << fmtShort(fit.duration_s, 1) << " s, grid "
+       << fmtShort(fit.sample_period_s * 1000.0, 3) << " ms\n";
+  for (const auto& [name, w] : {std::pair{"left", &fit.left}, std::pair{"right", &fit.right}}) {
+    out_ << "  " << wheelLine(name, w->model) << "  fit " << fmtFixed(w->fit_percent, 1) << " %  rms "
+         << fmtShort(w->rms_error_rad_s, 3) << " rad/s" << (w->saturation_observed ? "" : "  (saturation not reached: nominal)")
+         << "\n";
+  }
+  const auto nominal = sim::nominalPlant(ts->robot);
+  out_ << "  nominal (config/robot.yaml): gain 1, time constant " << fmtShort(nominal.left.time_constant_s, 3)
+       << " s, no dead time\n";
+  for (const auto& w : fit.warnings) out_ << "  warning: " << w << "\n";
+  const std::string path = dir + "/plant.yaml";
+  try {
+    std::ofstream f(path);
+    f << tuning::plantYaml(fit, "run " + d.info.id);
+    if (!f) throw std::runtime_error("cannot write " + path);
+    f.close();
+    std::error_code ec;
+    recorder_->catalog().addFile(d.info.id, "plant", path, static_cast<int64_t>(fs::file_size(path, ec)));
+  } catch (const std::exception& e) {
+    return fail("identify", e.what());
+  }
+  ts->plant = fit.model;
+  ts->plant_source = "identified from run " + d.info.id;
+  out_ << "identify: model saved as " << path << "; tune now uses it\n";
+  return true;
+}
+
+// ---------------------------------------------------------------------- tune
+
+bool Console::cmdTune(const Args& args, const std::string&, int) {
+  if (args.size() == 1 && args[0] == "list") {
+    // The tuning sessions in the catalog, newest first.
+    if (!recorder_) return fail("tune", "the server records nothing (--no-record): no catalog of sessions");
+    const auto list = recorder_->catalog().listTuningSessions(20);
+    if (list.empty()) {
+      out_ << "no tuning sessions in the catalog\n";
+      return true;
+    }
+    for (const auto& t : list) {
+      char line[512];
+      std::snprintf(line, sizeof line, "%-34s %-8s %-36s %5lld evals %7.1f s  cost %.4g -> %.4g%s  %s\n", t.id.c_str(),
+                    t.robot.empty() ? "-" : t.robot.c_str(), t.reference.c_str(), static_cast<long long>(t.evals),
+                    t.wall_s, t.initial_cost, t.best_cost, t.cancelled ? " (cancelled)" : "", t.dir.c_str());
+      out_ << line;
+    }
+    return true;
+  }
+  TuningState* ts = tuning("tune");
+  if (!ts) return false;
+  tuning::TuneSetup s;
+  s.robot = ts->robot;
+  s.control = ts->control;
+  s.fis = ts->fis;
+  s.plant = ts->plant;
+  std::string plant_source = ts->plant_source;
+  std::string start = "working";
+  for (const auto& a : args) {
+    std::string k, v;
+    if (!splitKeyValue(a, k, v)) return fail("tune", "'" + a + "' is not key=value (help tune)");
+    const auto num = parseNumber(v);
+    auto number = [&](double lo, double hi) -> std::optional<double> {
+      if (!num || !(*num >= lo && *num <= hi)) {
+        fail("tune", k + "=" + v + ": expected a number in [" + fmtShort(lo) + ", " + fmtShort(hi) + "]");
+        return std::nullopt;
+      }
+      return num;
+    };
+    if (k == "ref") {
+      if (v == "circle") s.reference.kind = tuning::TuneReference::Kind::kCircle;
+      else if (v == "line") s.reference.kind = tuning::TuneReference::Kind::kLine;
+      else if (v == "waypoints") s.reference.kind = tuning::TuneReference::Kind::kWaypoints;
+      else return fail("tune", "ref=" + v + ": expected circle, line or waypoints");
+    } else if (k == "radius") {
+      const auto x = number(0.5, 50.0);
+      if (!x) return false;
+      s.reference.radius_m = *x;
+    } else if (k == "speed") {
+      const auto x = number(0.05, ts->robot.limits.max_v_m_s);
+      if (!x) return false;
+      s.reference.speed_m_s = *x;
+    } else if (k == "laps") {
+      const auto x = number(0.1, 10.0);
+      if (!x) return false;
+      s.reference.laps = *x;
+    } else if (k == "length") {
+      const auto x = number(1.0, 100.0);
+      if (!x) return false;
+      s.reference.length_m = *x;
+    } else if (k == "evals") {
+      const auto x = number(10, 100000);
+      if (!x) return false;
+      s.max_evals = static_cast<int>(*x);
+    } else if (k == "variations") {
+      const auto x = number(1, 64);
+      if (!x) return false;
+      s.plant_variations = static_cast<int>(*x);
+    } else if (k == "seeds") {
+      const auto x = number(1, 64);
+      if (!x) return false;
+      s.seeds = static_cast<int>(*x);
+    } else if (k == "threads") {
+      const auto x = number(0, 64);
+      if (!x) return false;
+      s.threads = static_cast<int>(*x);
+    } else if (k == "seed") {
+      const auto x = number(0, 4294967295.0);
+      if (!x) return false;
+      s.seed = static_cast<uint32_t>(*x);
+    } else if (k == "params") {
+      s.params.clear();
+      if (v == "all") {
+        s.params.assign(control::kGainNames.begin(), control::kGainNames.end());
+      } else {
+        std::stringstream ss(v);
+        std::string p;
+        while (std::getline(ss, p, ',')) {
+          control::GainSet probe;
+          if (!control::gainByName(probe, p))
+            return fail("tune", "params: unknown gain '" + p + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3, or all)");
+          s.params.push_back(p);
+        }
+      }
+    } else if (k == "plant") {
+      if (v == "nominal") {
+        s.plant = sim::nominalPlant(ts->robot);
+        plant_source = "nominal (config/robot.yaml)";
+      } else if (v != "current") {
+        try {
+          std::string path = v;
+          if (!fs::exists(path) && recorder_) {  // a run id: its identified plant
+            path = recorder_->config().dir + "/" + v + "/plant.yaml";
+            if (!fs::exists(path)) return fail("tune", "plant=" + v + ": no such file, and no run '" + v + "' with plant.yaml (identify it first)");
+          }
+          s.plant = tuning::loadPlantFile(path);
+          plant_source = "from " + path;
+        } catch (const std::exception& e) {
+          return fail("tune", std::string("plant=") + v + ": " + e.what());
+        }
+      }
+    } else if (k == "start") {
+      if (v != "working" && v != "paper" && v != "tuned") return fail("tune", "start=" + v + ": expected working, paper or tuned");
+      if (v == "tuned" && !ts->tuned) return fail("tune", "start=tuned: nothing tuned yet");
+      start = v;
+    } else {
+      return fail("tune", "unknown option '" + k + "' (help tune)");
+    }
+  }
+  const control::GainSet start_gains = start == "paper" ? ts->paper : start == "tuned" ? *ts->tuned : ts->working;
+  // Each run's samples are held in memory: a reference longer than 5 minutes
+  // (a slow, many-lap circle) would cost gigabytes and minutes per evaluation.
+  try {
+    const auto path = s.reference.makePath();
+    double t = 0.0;
+    for (double d = 0.0; d < path->length_m(); d += 0.05) t += 0.05 / std::max(1e-3, path->at(d).speed_m_s);
+    if (t > kMaxTuneReference_s)
+      return fail("tune", s.reference.describe() + " lasts " + fmtShort(t, 0) + " s: at most " +
+                              fmtShort(kMaxTuneReference_s, 0) + " s (fewer laps, a smaller radius or a higher speed)");
+  } catch (const std::exception& e) {
+    return fail("tune", e.what());
+  }
+  std::unique_ptr<tuning::Tuner> tuner;
+  try {
+    tuner = std::make_unique<tuning::Tuner>(s);
+  } catch (const std::exception& e) {
+    return fail("tune", e.what());
+  }
+  const auto& setup = tuner->setup();
+  std::string params;
+  for (const auto& p : setup.params) params += (params.empty() ? "" : ",") + p;
+  out_ << "tune: " << setup.reference.describe() << "; plant " << plant_source << "\n"
+       << "  " << wheelLine("left", setup.plant.left) << "\n  " << wheelLine("right", setup.plant.right) << "\n"
+       << "  tuning " << params << " from the " << start << " gains; " << setup.max_evals << " evaluations x "
+       << setup.plant_variations * setup.seeds << " runs (" << setup.plant_variations << " plant variations x "
+       << setup.seeds << " noise seeds); Ctrl-C stops and keeps the best so far\n";
+  out_.flush();
+
+  std::atomic<bool>& cancel = tune_cancel_;  // outlives the command: the signal handler may still hold it
+  cancel.store(false);
+  stop_.setInterruptTarget(&cancel);
+  const bool tty = alarm_style_;  // an interactive terminal: one redrawn progress line
+  int last_decile = -1;
+  const double t0 = nowS();
+  double last_draw_s = -1.0;
+  tuning::TuneResult result;
+  try {
+    result = tuner->run(
+        start_gains,
+        [&](const tuning::TuneProgress& p) {
+          if (stop_.requested()) cancel.store(true);
+          const double el = nowS() - t0;
+          const double frac = p.max_evals > 0 ? static_cast<double>(p.evals) / p.max_evals : 1.0;
+          const int decile = static_cast<int>(frac * 10.0);
+          char line[200];
+          std::string bar(20, '.');
+          for (int i = 0; i < static_cast<int>(frac * 20.0) && i < 20; ++i) bar[static_cast<std::size_t>(i)] = '#';
+          std::snprintf(line, sizeof line, "[%s] %4d/%d evals  best cost %.4g (start %.4g, %+.1f %%)  %s  %.1f s",
+                        bar.c_str(), p.evals, p.max_evals, p.best_cost, p.initial_cost,
+                        p.initial_cost > 0 ? 100.0 * (p.best_cost - p.initial_cost) / p.initial_cost : 0.0,
+                        p.phase.c_str(), el);
+          if (tty) {
+            if (el - last_draw_s >= 0.1 || p.evals == p.max_evals) {
+              out_ << "\r\x1b[K" << line << std::flush;
+              last_draw_s = el;
+            }
+          } else if (decile != last_decile) {
+            out_ << "  " << line << "\n" << std::flush;
+            last_decile = decile;
+          }
+        },
+        &cancel);
+  } catch (const std::exception& e) {
+    stop_.setInterruptTarget(nullptr);
+    if (tty) out_ << "\n";
+    return fail("tune", e.what());
+  }
+  stop_.setInterruptTarget(nullptr);
+  if (tty) out_ << "\n";
+  out_ << "tune: " << (result.cancelled ? "cancelled after " : "done: ") << result.evals << " evaluations in "
+       << fmtShort(result.wall_s, 3) << " s (" << result.algorithm << "); cost " << fmtShort(result.initial_eval.cost, 4)
+       << " -> " << fmtShort(result.best_eval.cost, 4) << "\n";
+  out_ << "  best: " << gainsLine(result.best) << "\n";
+
+  // PID and fuzzy-PID with the paper's gains against the tuned set.
+  tuning::Comparison cmp;
+  try {
+    cmp = tuning::compareControllers(*tuner, {{"PID (paper)", control::WheelControl::kPid, ts->paper},
+                                              {"fuzzy-PID (paper)", control::WheelControl::kFuzzyPid, ts->paper},
+                                              {"fuzzy-PID (tuned)", control::WheelControl::kFuzzyPid, result.best}});
+  } catch (const std::exception& e) {
+    return fail("tune", std::string("comparison: ") + e.what());
+  }
+  out_ << tuning::comparisonTable(cmp);
+  const std::string robot = selected_;
+  std::string session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot);
+  for (int n = 2; fs::exists(tuning_dir_ + "/" + session) && n < 1000; ++n)  // two sessions in one second
+    session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot) + "-" + std::to_string(n);
+  const std::string dir = tuning_dir_ + "/" + session;
+  try {
+    const auto files = tuning::writeTuningSession(dir, setup, result, cmp, ts->fis);
+    for (const auto& n : files.notes) out_ << "  note: " << n << "\n";
+    out_ << "tune: session " << session << ": " << files.files.size() << " files in " << dir << "/\n";
+  } catch (const std::exception& e) {
+    return fail("tune", "cannot write the session: " + std::string(e.what()));
+  }
+  if (recorder_) {
+    catalog::TuningSession cs;
+    cs.id = session;
+    cs.created = std::chrono::system_clock::now();
+    cs.robot = robot;
+    cs.reference = setup.reference.describe();
+    cs.plant_json = tuning::plantJson(setup.plant);
+    cs.params = params;
+    cs.algorithm = result.algorithm;
+    cs.evals = result.evals;
+    cs.wall_s = result.wall_s;
+    cs.cancelled = result.cancelled;
+    cs.initial_cost = result.initial_eval.cost;
+    cs.best_cost = result.best_eval.cost;
+    cs.initial_gains_json = config::gainsJson(result.initial);
+    cs.best_gains_json = config::gainsJson(result.best);
+    cs.dir = dir;
+    try {
+      recorder_->catalog().addTuningSession(cs);
+    } catch (const std::exception& e) {
+      out_ << "tune: warning: session not in the catalog: " << e.what() << "\n";
+    }
+  }
+  ts->tuned = result.best;
+  ts->tuned_session = session;
+  ts->working = result.best;
+  ts->last_session_dir = dir;
+  out_ << "tune: the working gains are now the tuned set; `gains push` sends them to " << (robot.empty() ? "the selected robot" : robot)
+       << "\n";
+  return true;
+}
+
+// --------------------------------------------------------------------- gains
+
+bool Console::pushGains(const std::string& robot, const control::GainSet& g, const std::string& source,
+                        const std::string& session) {
+  TuningState* ts = tuning("gains");
+  if (!ts) return false;
+  if (const std::string why = control::validateGains(g); !why.empty()) return fail("gains", "not pushed: " + why);
+  if (!mayMove(robot, "gains push")) return false;
+  v1::Command c;
+  auto* u = c.mutable_gains();
+  net::toProto(g, *u->mutable_gains());
+  u->set_source(source);
+  if (ts->fis_imported) u->set_fis(fuzzy::formatFis(ts->fis));
+  const uint64_t id = sink_.sendCommand(robot, std::move(c));
+  if (id == 0) return fail("gains", robot + " is not connected");
+  const auto ack = waitAck(robot, id);
+  if (!ack) {
+    ++tally_.errors;
+    out_ << robot << ": gains push: no ack within " << fmtShort(options_.ack_timeout_s) << " s\n";
+    return false;
+  }
+  const bool ok = ack->status() == v1::Ack::ACCEPTED;
+  if (ok) {
+    out_ << robot << ": gains v" << ack->gains_version() << " accepted (" << ack->reason() << ")\n";
+  } else {
+    ++tally_.errors;
+    out_ << robot << ": gains push rejected: " << ack->reason() << " (v" << ack->gains_version() << " stays in force)\n";
+  }
+  if (recorder_) {
+    catalog::GainsPush p;
+    p.robot = robot;
+    p.time = std::chrono::system_clock::now();
+    p.version = ack->gains_version();
+    p.gains_json = config::gainsJson(g);
+    p.status = ok ? "accepted" : "rejected";
+    p.reason = ok ? "" : ack->reason();
+    p.session_id = session;
+    try {
+      recorder_->catalog().addGainsPush(p);
+    } catch (const std::exception& e) {
+      out_ << "gains: warning: push not in the catalog: " << e.what() << "\n";
+    }
+  }
+  return ok;
+}
+
+bool Console::cmdGains(const Args& args, const std::string&, int) {
+  if (args.empty()) return fail("gains", "syntax: gains show|set|push|revert|export|import ... (help gains)");
+  TuningState* ts = tuning("gains");
+  if (!ts) return false;
+  const std::string& sub = args[0];
+  if (sub == "show") {
+    if (args.size() > 2) return fail("gains", "syntax: gains show [robot]");
+    const std::string robot = args.size() == 2 ? args[1] : selected_;
+    std::optional<RobotSnapshot> snap;
+    if (!robot.empty()) snap = registry_.snapshot(robot, clock_->nowNs());
+    const bool have_robot = snap && snap->gains_known;
+    const control::GainSet rg = have_robot ? net::fromProto(snap->gains) : control::GainSet{};
+    char head[200];
+    std::snprintf(head, sizeof head, "%-6s %12s %12s %12s %12s\n", "gain", "working",
+                  have_robot ? (robot + " v" + std::to_string(snap->gains_version)).c_str() : "robot", "paper",
+                  ts->tuned ? "tuned" : "");
+    out_ << head;
+    for (const char* n : control::kGainNames) {
+      char row[200];
+      const std::string rv = have_robot ? fmtShort(control::gainValue(rg, n), 5) : std::string("--");
+      const std::string tv = ts->tuned ? fmtShort(control::gainValue(*ts->tuned, n), 5) : std::string();
+      std::snprintf(row, sizeof row, "%-6s %12s %12s %12s %12s\n", n, fmtShort(control::gainValue(ts->working, n), 5).c_str(),
+                    rv.c_str(), fmtShort(control::gainValue(ts->paper, n), 5).c_str(), tv.c_str());
+      out_ << row;
+    }
+    out_ << "fuzzy system: " << ts->fis.name << (ts->fis_imported ? " (imported; pushed with the gains)" : "")
+         << (have_robot && !snap->hello.fis_name().empty() ? "; robot's: " + snap->hello.fis_name() : std::string())
+         << "\n";
+    if (!have_robot && !robot.empty()) out_ << "(" << robot << " has not announced its gains)\n";
+    return true;
+  }
+  if (sub == "set") {
+    if (args.size() < 2) return fail("gains", "syntax: gains set <name>=<value> ... | gains set paper|tuned|robot");
+    if (args.size() == 2 && (args[1] == "paper" || args[1] == "tuned" || args[1] == "robot")) {
+      if (args[1] == "paper") ts->working = ts->paper;
+      if (args[1] == "tuned") {
+        if (!ts->tuned) return fail("gains", "nothing tuned yet (tune)");
+        ts->working = *ts->tuned;
+      }
+      if (args[1] == "robot") {
+        const auto snap = selected_.empty() ? std::optional<RobotSnapshot>() : registry_.snapshot(selected_, clock_->nowNs());
+        if (!snap || !snap->gains_known) return fail("gains", "the selected robot has not announced its gains");
+        ts->working = net::fromProto(snap->gains);
+      }
+      out_ << "gains: working set = " << args[1] << ": " << gainsLine(ts->working) << "\n";
+      return true;
+    }
+    control::GainSet next = ts->working;
+    for (std::size_t i = 1; i < args.size(); ++i) {
+      std::string k, v;
+      if (!splitKeyValue(args[i], k, v)) {
+        // "gains set kp 12" form
+        if (args.size() == 3 && i == 1) {
+          k = args[1];
+          v = args[2];
+          i = 2;
+        } else {
+          return fail("gains", "'" + args[i] + "' is not name=value");
+        }
+      }
+      double* slot = control::gainByName(next, k);
+      if (!slot) return fail("gains", "unknown gain '" + k + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3)");
+      const auto x = parseNumber(v);
+      if (!x) return fail("gains", k + ": '" + v + "' is not a number");
+      *slot = *x;
+    }
+    if (const std::string why = control::validateGains(next); !why.empty()) return fail("gains", why + " (nothing changed)");
+    ts->working = next;
+    out_ << "gains: working set: " << gainsLine(ts->working) << "\n";
+    return true;
+  }
+  if (sub == "push") {
+    if (args.size() > 2) return fail("gains", "syntax: gains push [robot]");
+    std::string robot;
+    if (args.size() == 2) {
+      robot = args[1];
+      const auto snap = registry_.snapshot(robot, clock_->nowNs());
+      if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
+    } else {
+      const auto r = connectedRobot("gains");
+      if (!r) return false;
+      robot = *r;
+    }
+    const bool tuned = ts->tuned && control::sameGains(*ts->tuned, ts->working);
+    return pushGains(robot, ts->working, tuned ? "tuning session " + ts->tuned_session : "operator console",
+                     tuned ? ts->tuned_session : "");
+  }
+  if (sub == "revert") {
+    if (args.size() > 2) return fail("gains", "syntax: gains revert [robot]");
+    const std::string robot = args.size() == 2 ? args[1] : selected_;
+    if (robot.empty()) return fail("gains", "no robot selected");
+    const auto snap = registry_.snapshot(robot, clock_->nowNs());
+    if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
+    if (snap->gains_history.empty()) return fail("gains", robot + ": no earlier gains to go back to");
+    const auto& [version, prev] = snap->gains_history.back();
+    out_ << "gains: reverting " << robot << " to the set of v" << version << "\n";
+    if (!pushGains(robot, net::fromProto(prev), "revert to v" + std::to_string(version), "")) return false;
+    return true;
+  }
+  if (sub == "export") {
+    if (args.size() != 2) return fail("gains", "syntax: gains export <file.yaml>");
+    try {
+      config::exportGains(ts->working, ts->fis, args[1], "exported from the pc_server console");
+    } catch (const std::exception& e) {
+      return fail("gains", e.what());
+    }
+    out_ << "gains: working set written to " << args[1] << " with its fuzzy system beside it\n";
+    return true;
+  }
+  if (sub == "import") {
+    if (args.size() != 2) return fail("gains", "syntax: gains import <file.yaml>");
+    fuzzy::Fis fis;
+    config::GainsFile f;
+    try {
+      f = config::importGains(args[1], ts->working, &fis);
+    } catch (const std::exception& e) {
+      return fail("gains", e.what());
+    }
+    ts->working = f.gains;
+    if (!f.fis_path.empty()) {
+      ts->fis_imported = fuzzy::formatFis(fis) != fuzzy::formatFis(ts->fis) || ts->fis_imported;
+      ts->fis = fis;
+    }
+    out_ << "gains: working set from " << args[1] << ": " << gainsLine(ts->working) << "\n";
+    if (ts->fis_imported) out_ << "gains: fuzzy system '" << ts->fis.name << "' goes with the next push\n";
+    return true;
+  }
+  return fail("gains", "unknown subcommand '" + sub + "' (show, set, push, revert, export, import)");
+}
+
+}  // namespace inspect::server

@@ -1,0 +1,161 @@
+#include "pc_server/console/status_line.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+
+#include "pc_server/console/expect_check.hpp"
+#include "pc_server/console/text_util.hpp"
+#include "pc_server/video/video_hub.hpp"
+
+namespace inspect::server {
+
+std::string faultNames(uint32_t faults) {
+  if (faults == 0) return "none";
+  std::string s;
+  for (uint32_t bit = 1; bit != 0; bit <<= 1) {
+    if (!(faults & bit)) continue;
+    std::string name = v1::Fault_IsValid(static_cast<int>(bit)) ? v1::Fault_Name(static_cast<v1::Fault>(bit))
+                                                                : "bit" + std::to_string(bit);
+    if (name.rfind("FAULT_", 0) == 0) name.erase(0, 6);
+    s += (s.empty() ? "" : ",") + name;
+  }
+  return s;
+}
+
+namespace {
+std::string videoFigures(const RobotSnapshot& snap, const VideoHub* video) {
+  if (!snap.telemetry.has_video()) return {};
+  const auto& tv = snap.telemetry.video();
+  if (!tv.enabled()) return " | video off";
+  const auto st = video ? video->stats(snap.id) : std::nullopt;
+  if (!st || !st->active) return " | video no packets" + (tv.error().empty() ? std::string() : " (" + tv.error() + ")");
+  return " | video " + fmtFixed(st->fps_received, 0) + "/" + fmtFixed(st->fps_decoded, 0) + " fps " +
+         fmtFixed(st->kbps, 0) + " kbit/s loss " + fmtFixed(st->loss_pct, 1) + "% lat " +
+         (st->latency_ms < 0 ? std::string("--") : fmtFixed(st->latency_ms, 0)) + " ms";
+}
+}  // namespace
+
+std::string videoReport(const std::string& robot_id, const std::optional<RobotSnapshot>& snap, const VideoHub* video) {
+  std::string s;
+  const auto line = [&s](const std::string& k, const std::string& v) { s += "  " + k + ": " + v + "\n"; };
+  s += robot_id + " video\n";
+  if (snap && snap->has_telemetry && snap->telemetry.has_video()) {
+    const auto& v = snap->telemetry.video();
+    line("robot", std::string(v.enabled() ? "on" : "off") + ", " + v.source() + " " + std::to_string(v.width()) + "x" +
+                      std::to_string(v.height()) + " @ " + fmtShort(v.fps()) + " fps, " + v.encoder() + " " +
+                      std::to_string(v.bitrate_kbps()) + " kbit/s, SSRC " + std::to_string(v.ssrc()) + ", to UDP port " +
+                      std::to_string(v.port()));
+    line("robot frames", "captured " + std::to_string(v.frames_captured()) + ", encoded " +
+                             std::to_string(v.frames_encoded()) + ", dropped " + std::to_string(v.frames_dropped()) +
+                             ", keyframes " + std::to_string(v.keyframes()) + " (" +
+                             std::to_string(v.keyframe_requests()) + " requested), encode " +
+                             fmtFixed(v.encode_ms(), 1) + " ms/frame");
+    if (!v.error().empty()) line("robot error", v.error());
+  } else {
+    line("robot", "no video in telemetry");
+  }
+  if (!video) {
+    line("server", "video off (video.enabled: false or --no-video)");
+    return s;
+  }
+  const auto st = video->stats(robot_id);
+  if (!st) {
+    line("server", "no stream yet");
+  } else {
+    line("received", fmtFixed(st->fps_received, 1) + " fps, decoded " + fmtFixed(st->fps_decoded, 1) + " fps, " +
+                         fmtFixed(st->kbps, 0) + " kbit/s, loss " + fmtFixed(st->loss_pct, 2) + "%, " +
+                         std::to_string(st->width) + "x" + std::to_string(st->height));
+    line("latency", "mean " + fmtFixed(st->latency_ms, 1) + " ms (last second), p50 " + fmtFixed(st->latency_p50_ms, 1) +
+                        " ms, p99 " + fmtFixed(st->latency_p99_ms, 1) + " ms (last 300 frames)");
+    line("counters", "packets " + std::to_string(st->packets) + ", lost " + std::to_string(st->lost_packets) +
+                         ", duplicates " + std::to_string(st->duplicates) + ", late " + std::to_string(st->late) +
+                         ", frames " + std::to_string(st->frames) + ", dropped " + std::to_string(st->frames_dropped) +
+                         ", decoded " + std::to_string(st->decoded) + ", skipped awaiting a keyframe " +
+                         std::to_string(st->frames_skipped) + ", decode errors " +
+                         std::to_string(st->decode_errors) + ", keyframe requests " +
+                         std::to_string(st->keyframe_requests));
+  }
+  const auto c = video->counters();
+  line("rejected datagrams", "not RTP " + std::to_string(c.not_rtp) + ", unknown SSRC " + std::to_string(c.unknown_ssrc) +
+                                 ", wrong source " + std::to_string(c.wrong_source) + ", wrong payload type " +
+                                 std::to_string(c.wrong_payload_type) +
+                                 (c.last_reject.empty() ? std::string() : " (last: " + c.last_reject + ")"));
+  const auto sdp = video->sdpPath(robot_id);
+  if (!sdp.empty())
+    line("play", "ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay " + sdp +
+                     "   (RTP forwarded to 127.0.0.1:" + std::to_string(video->forwardPort(robot_id)) + ")");
+  return s;
+}
+
+std::string statusLine(const std::string& robot_id, const std::optional<RobotSnapshot>& snap, const VideoHub* video) {
+  if (!snap) return robot_id + " | not connected yet";
+  std::string s = robot_id;
+  if (!snap->connected)
+    s += " | DISCONNECTED " + fmtFixed(snap->state_age_s, 1) + " s ago (" + snap->close_reason + ")";
+  if (!snap->has_telemetry) return s + (snap->connected ? " | connected, no telemetry yet" : "");
+  const auto& t = snap->telemetry;
+  s += " | " + modeName(t.mode());
+  s += " | v " + fmtSigned(t.v_m_s()) + " w " + fmtSigned(t.w_rad_s());
+  s += " | x " + fmtFixed(t.pose().x_m()) + " y " + fmtFixed(t.pose().y_m()) + " th " + fmtSigned(t.pose().theta_rad());
+  if (t.mode() == v1::TRACKING)
+    s += " | " + t.track_controller() + " " + fmtFixed(100.0 * t.track_progress(), 0) + "% err " +
+         fmtFixed(t.position_error_m(), 3) + " m " + fmtFixed(t.angle_error_rad(), 3) + " rad kp " + fmtFixed(t.kp(), 1);
+  if (t.mode() == v1::NAVIGATING) {
+    char nav[96];
+    std::snprintf(nav, sizeof nav, " goal %u/%u %s m sw %u", t.goal_index() + 1, t.goal_count(),
+                  fmtFixed(t.goal_distance_m()).c_str(), t.nav_switches());
+    s += " | nav " + t.nav_mode() + nav;
+  }
+  if (t.nearest_person_m() >= 0) {
+    std::string pat = v1::HumanPattern_Name(t.pattern());
+    for (auto& ch : pat) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    s += " | person " + fmtFixed(t.nearest_person_m(), 1) + " m " + (t.pattern() == v1::PATTERN_NONE ? "?" : pat) +
+         " speed x" + fmtFixed(t.speed_factor(), 2);
+  }
+  if (t.ultrasonic_m_size() > 0) {
+    s += " | us";
+    for (double r : t.ultrasonic_m()) s += r < 0 ? " --" : " " + fmtFixed(r);
+  }
+  if (t.gas_size() > 0) {
+    s += " | gas";
+    const auto& ch = snap->hello.gas_channels();
+    for (int i = 0; i < t.gas_size(); ++i) {
+      const double g = t.gas(i);
+      s += " " + (i < ch.size() ? ch[i].name() : "gas" + std::to_string(i)) + " " +
+           (std::isnan(g) ? std::string("--") : fmtShort(g, 1));
+    }
+  }
+  if (t.active_alarms_size() > 0) {
+    // The worst first: HIGH, then LOW, then sensor faults.
+    std::string high, low, fault;
+    for (const auto& a : t.active_alarms()) {
+      if (a.level() == v1::GasAlarm::SENSOR_FAULT) {
+        fault += " " + a.channel_name() + " " + a.fault();
+        continue;
+      }
+      std::string& dst = a.level() == v1::GasAlarm::HIGH ? high : low;
+      dst += " " + a.channel_name() + (a.level() == v1::GasAlarm::HIGH ? " HIGH " : " LOW ") +
+             (std::isnan(a.value()) ? std::string("--") : fmtShort(a.value(), 1)) + " " + a.unit();
+    }
+    if (!high.empty() || !low.empty()) s += " | ALARM" + high + low;
+    if (!fault.empty()) s += " | SENSOR FAULT" + fault;
+  }
+  if (t.battery_v() > 0) s += " | bat " + fmtFixed(t.battery_v(), 1) + " V";
+  s += " | faults " + faultNames(t.faults());
+  s += " | tlm " + fmtFixed(snap->telemetry_hz, 0) + " Hz";
+  if (snap->connected && snap->telemetry_age_s > 0.5) s += " (stale " + fmtFixed(snap->telemetry_age_s, 1) + " s)";
+  s += (t.faults() & v1::FAULT_SERIAL_DOWN) ? " | serial DOWN" : " | serial ok";
+  if (snap->connected) s += videoFigures(*snap, video);
+  return s;
+}
+
+bool statusIsAlarm(const std::optional<RobotSnapshot>& snap) {
+  if (!snap || !snap->connected) return true;
+  if (!snap->has_telemetry) return false;
+  const auto m = snap->telemetry.mode();
+  return m == v1::ESTOP || m == v1::FAILSAFE || snap->telemetry.faults() != 0 ||
+         snap->telemetry.active_alarms_size() > 0;
+}
+
+}  // namespace inspect::server

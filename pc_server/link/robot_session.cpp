@@ -1,0 +1,430 @@
+#include "pc_server/link/robot_session.hpp"
+
+#include <boost/asio/post.hpp>
+#include <boost/asio/write.hpp>
+
+#include "pc_server/link/hello_check.hpp"
+#include "pc_server/link/link_server.hpp"
+#include "pc_server/link/robot_registry.hpp"
+#include "pc_server/console/text_util.hpp"
+#include "shared/net/link_version.hpp"
+#include "shared/util/clock.hpp"
+
+namespace inspect::server {
+
+namespace asio = boost::asio;
+using boost::system::error_code;
+
+namespace {
+
+const char* bodyName(v1::Envelope::BodyCase c) {
+  switch (c) {
+    case v1::Envelope::kHello: return "Hello";
+    case v1::Envelope::kHelloReply: return "HelloReply";
+    case v1::Envelope::kHeartbeat: return "Heartbeat";
+    case v1::Envelope::kCommand: return "Command";
+    case v1::Envelope::kAck: return "Ack";
+    case v1::Envelope::kTelemetry: return "Telemetry";
+    case v1::Envelope::kEvent: return "Event";
+    case v1::Envelope::BODY_NOT_SET: break;
+  }
+  return "an Envelope without a body";
+}
+
+std::chrono::nanoseconds seconds(double s) {
+  return std::chrono::nanoseconds(static_cast<int64_t>(s * 1e9));
+}
+}  // namespace
+
+RobotSession::RobotSession(Strand strand, asio::ip::tcp::socket socket,
+                           const std::shared_ptr<asio::ssl::context>& tls, LinkServer& server, RobotRegistry& registry,
+                           const ServerConfig& config, uint64_t serial)
+    : strand_(strand),
+      stream_(std::move(socket), tls),
+      server_(server),
+      registry_(registry),
+      config_(config),
+      serial_(serial),
+      handshake_timer_(strand_),
+      watchdog_timer_(strand_),
+      heartbeat_timer_(strand_),
+      teleop_timer_(strand_),
+      stale_timer_(strand_),
+      decoder_(config.max_frame_bytes) {
+  error_code ec;
+  const auto ep = stream_.socket().remote_endpoint(ec);
+  address_ = ec ? std::string("?") : ep.address().to_string() + ":" + std::to_string(ep.port());
+  stream_.socket().set_option(asio::ip::tcp::no_delay(true), ec);  // small frames, latency matters
+}
+
+std::string RobotSession::who() const { return robot_id_.empty() ? address_ : robot_id_ + " (" + address_ + ")"; }
+
+void RobotSession::start() {
+  asio::post(strand_, [self = shared_from_this()] {
+    self->last_rx_ = Clock::now();
+    self->handshake_timer_.expires_after(seconds(self->config_.handshake_timeout_s));
+    self->handshake_timer_.async_wait([self](const error_code& ec) {
+      if (ec || self->closed_ || self->accepted_ || self->rejecting_) return;
+      self->closeNow(std::string(self->cert_name_.empty() && self->stream_.tls() ? "no TLS handshake" : "no Hello") +
+                         " within " + fmtShort(self->config_.handshake_timeout_s) + " s (handshake timeout)",
+                     log::Level::kWarn);
+    });
+    self->stream_.asyncHandshake(asio::ssl::stream_base::server, [self](const error_code& ec) {
+      if (self->closed_) return;
+      if (ec) {
+        self->closeNow("TLS handshake failed: " + net::describeHandshakeError(ec, self->stream_.ssl()),
+                       log::Level::kWarn);
+        return;
+      }
+      if (self->stream_.tls()) {
+        self->cert_name_ = net::peerCommonName(self->stream_.ssl());
+        log::debug(log::tag::kLink, self->address_, ": TLS up, robot certificate CN=", self->cert_name_);
+      } else {
+        log::warn(log::tag::kLink, self->address_, ": UNAUTHENTICATED plaintext connection (--plaintext)");
+      }
+      self->doRead();
+    });
+  });
+}
+
+void RobotSession::close(std::string reason) {
+  asio::post(strand_, [self = shared_from_this(), reason = std::move(reason)] {
+    self->closeNow(reason, log::Level::kInfo);
+  });
+}
+
+void RobotSession::sendCommand(v1::Command cmd) {
+  asio::post(strand_, [self = shared_from_this(), cmd = std::move(cmd)] {
+    if (self->closed_ || !self->accepted_) return;
+    if (cmd.has_stop() || cmd.has_estop()) {
+      self->teleop_active_ = false;
+      ++self->teleop_generation_;
+      self->teleop_timer_.cancel();
+    }
+    v1::Envelope env;
+    *env.mutable_command() = cmd;
+    self->enqueue(env);
+  });
+}
+
+void RobotSession::setTeleop(double v_m_s, double w_rad_s, uint64_t first_id) {
+  asio::post(strand_, [self = shared_from_this(), v_m_s, w_rad_s, first_id] {
+    if (self->closed_ || !self->accepted_) return;
+    self->teleop_active_ = true;
+    self->teleop_v_m_s_ = v_m_s;
+    self->teleop_w_rad_s_ = w_rad_s;
+    const uint64_t gen = ++self->teleop_generation_;
+    self->teleop_timer_.cancel();
+    self->sendTeleopNow(first_id);
+    self->teleop_timer_.expires_after(seconds(1.0 / self->config_.teleop_resend_hz));
+    self->armTeleop(gen);
+  });
+}
+
+void RobotSession::clearTeleop() {
+  asio::post(strand_, [self = shared_from_this()] {
+    self->teleop_active_ = false;
+    ++self->teleop_generation_;
+    self->teleop_timer_.cancel();
+  });
+}
+
+void RobotSession::doRead() {
+  stream_.asyncReadSome(asio::buffer(rx_buf_),
+                          [self = shared_from_this()](const error_code& ec, std::size_t n) { self->onRead(ec, n); });
+}
+
+void RobotSession::onRead(const error_code& ec, std::size_t n) {
+  if (closed_) return;
+  if (rejecting_) {
+    // Discard whatever the rejected robot still sends; its closing ends the linger.
+    if (ec) closeNow(reject_reason_, log::Level::kDebug);
+    else doRead();
+    return;
+  }
+  if (ec) {
+    if (ec == asio::error::eof || ec == asio::ssl::error::stream_truncated) {  // TCP FIN without TLS close_notify
+      if (decoder_.buffered() > 0)
+        closeNow("connection closed in the middle of a frame (" + std::to_string(decoder_.buffered()) +
+                     " bytes of an incomplete frame)",
+                 log::Level::kWarn);
+      else
+        closeNow("connection closed by the robot", log::Level::kInfo);
+    } else {
+      const std::size_t partial = decoder_.buffered();
+      closeNow("read error: " + ec.message() +
+                   (partial ? " (" + std::to_string(partial) + " bytes of an incomplete frame)" : ""),
+               log::Level::kWarn);
+    }
+    return;
+  }
+  last_rx_ = Clock::now();
+  decoder_.append(rx_buf_.data(), n);
+  for (;;) {
+    std::span<const uint8_t> frame;
+    const auto st = decoder_.next(frame);
+    if (st == net::DelimitedDecoder::Status::kNeedMore) break;
+    if (st == net::DelimitedDecoder::Status::kInvalid) {
+      closeNow("framing error: " + decoder_.error(), log::Level::kWarn);
+      return;
+    }
+    if (!handleFrame(frame)) return;
+    if (rejecting_) break;
+  }
+  doRead();
+}
+
+bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
+  v1::Envelope env;
+  if (!net::DelimitedDecoder::parse(frame, env)) {
+    closeNow("malformed frame: " + std::to_string(frame.size()) + " bytes do not parse as inspect.v1.Envelope",
+             log::Level::kWarn);
+    return false;
+  }
+  const auto body = env.body_case();
+  if (!accepted_) {
+    if (body != v1::Envelope::kHello) {
+      closeNow(std::string("protocol error: first message must be Hello, got ") + bodyName(body), log::Level::kWarn);
+      return false;
+    }
+    handleHello(env.hello());
+    return !closed_;
+  }
+  switch (body) {
+    case v1::Envelope::kHeartbeat:
+      return true;  // last_rx_ already counts it
+    case v1::Envelope::kTelemetry: {
+      const auto& t = env.telemetry();
+      last_telemetry_ = Clock::now();
+      stale_stopped_ = false;
+      robot_moving_ = t.mode() == v1::TELEOP || t.mode() == v1::TRACKING || t.mode() == v1::NAVIGATING ||
+                      t.mode() == v1::WHEEL_TEST || t.cmd_v_m_s() != 0.0 || t.cmd_w_rad_s() != 0.0;
+    }
+      registry_.onTelemetry(robot_id_, serial_, env.telemetry(), monoNowNs());
+      server_.observe(robot_id_, address_, env, true, monoNowUs());
+      return true;
+    case v1::Envelope::kEvent:
+      registry_.onEvent(robot_id_, serial_, env.event(), monoNowNs());
+      server_.observe(robot_id_, address_, env, true, monoNowUs());
+      if (server_.logEvents())
+        log::info(log::tag::kLink, "[", robot_id_, "] ", v1::Event::Kind_Name(env.event().kind()), ": ", env.event().text());
+      return true;
+    case v1::Envelope::kAck:
+      registry_.onAck(robot_id_, serial_, env.ack());
+      server_.observe(robot_id_, address_, env, true, monoNowUs());
+      return true;
+    case v1::Envelope::kHello:
+      closeNow("protocol error: second Hello after the handshake", log::Level::kWarn);
+      return false;
+    case v1::Envelope::kHelloReply:
+    case v1::Envelope::kCommand:
+      closeNow(std::string("protocol error: robot sent a ") + bodyName(body) + ", which only the server sends",
+               log::Level::kWarn);
+      return false;
+    case v1::Envelope::BODY_NOT_SET:
+      break;
+  }
+  closeNow("protocol error: Envelope without a known body (newer protocol?)", log::Level::kWarn);
+  return false;
+}
+
+void RobotSession::handleHello(const v1::Hello& hello) {
+  if (const auto why = helloRejection(hello)) rejectHello(*why);
+  else if (stream_.tls() && hello.robot_id() != cert_name_)
+    rejectHello("robot id '" + hello.robot_id() + "' does not match its certificate (CN '" + cert_name_ +
+                "'): a robot may only connect as the id its certificate was made for");
+  else acceptHello(hello);
+}
+
+void RobotSession::rejectHello(const std::string& reason) {
+  log::warn(log::tag::kLink, address_, ": handshake rejected: ", reason);
+  handshake_timer_.cancel();
+  rejecting_ = true;
+  reject_reason_ = "handshake rejected: " + reason;
+  v1::Envelope env;
+  auto* r = env.mutable_hello_reply();
+  r->set_accepted(false);
+  r->set_reason(reason);
+  r->set_protocol_version(net::kProtocolVersion);
+  r->set_server_id(config_.server_id);
+  enqueue(env);
+  // Bound the linger: a robot that neither reads nor closes is dropped anyway.
+  handshake_timer_.expires_after(kRejectLinger);
+  handshake_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
+    if (!ec) self->closeNow(self->reject_reason_, log::Level::kDebug);
+  });
+}
+
+void RobotSession::acceptHello(const v1::Hello& hello) {
+  handshake_timer_.cancel();
+  accepted_ = true;
+  robot_id_ = hello.robot_id();
+  registry_.onConnected(robot_id_, address_, serial_, hello, monoNowNs());
+  std::string caps;
+  for (const auto& c : hello.capabilities()) caps += (caps.empty() ? "" : ",") + c;
+  log::info(log::tag::kLink, robot_id_, " connected from ", address_, " (software '", hello.software_version(),
+            "', capabilities [", caps, "])");
+  server_.attach(robot_id_, shared_from_this());
+  if (closed_) return;
+  v1::Envelope env;
+  auto* r = env.mutable_hello_reply();
+  r->set_accepted(true);
+  r->set_protocol_version(net::kProtocolVersion);
+  r->set_server_id(config_.server_id);
+  enqueue(env);
+  heartbeat_timer_.expires_after(std::chrono::nanoseconds(0));
+  armHeartbeat();
+  armWatchdog();
+  last_telemetry_ = Clock::now();
+  if (config_.telemetry_stale_s > 0) armStaleCheck();
+}
+
+void RobotSession::armWatchdog() {
+  watchdog_timer_.expires_at(last_rx_ + seconds(config_.session_timeout_s));
+  watchdog_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
+    if (ec || self->closed_) return;
+    if (Clock::now() - self->last_rx_ >= seconds(self->config_.session_timeout_s)) {
+      self->closeNow("nothing received for " + fmtShort(self->config_.session_timeout_s) +
+                         " s (session timeout: robot gone or link half-open)",
+                     log::Level::kWarn);
+      return;
+    }
+    self->armWatchdog();
+  });
+}
+
+// The operator is blind to a robot whose telemetry stopped while it moves
+// (e.g. the robot->server direction stalled while commands still arrive, so
+// the robot's own link timeout does not fire): e-stop it, once per gap. The
+// EStop zeroes the wheels at once (a Stop ramps down) and is latched: the
+// operator resumes once the robot is visible again (no automatic restart).
+void RobotSession::armStaleCheck() {
+  stale_timer_.expires_after(std::chrono::milliseconds(20));
+  stale_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
+    if (ec || self->closed_) return;
+    const auto gap = Clock::now() - self->last_telemetry_;
+    if (!self->stale_stopped_ && (self->robot_moving_ || self->teleop_active_) &&
+        gap >= seconds(self->config_.telemetry_stale_s)) {
+      self->stale_stopped_ = true;
+      self->teleop_active_ = false;
+      ++self->teleop_generation_;
+      self->teleop_timer_.cancel();
+      const std::string why = "no telemetry for " + fmtShort(std::chrono::duration<double>(gap).count(), 2) +
+                              " s while moving: EStop sent (the operator cannot see the robot; resume once it is "
+                              "back)";
+      log::warn(log::tag::kLink, self->who(), ": ", why);
+      v1::Envelope env;
+      env.mutable_command()->set_id(self->server_.nextCommandId());
+      env.mutable_command()->mutable_estop();
+      self->enqueue(env);
+      v1::Event ev;  // shown on every console like the robot's own events
+      ev.set_kind(v1::Event::FAULT_RAISED);
+      ev.set_text("server: " + why);
+      self->registry_.onEvent(self->robot_id_, self->serial_, ev, monoNowNs());
+    }
+    self->armStaleCheck();
+  });
+}
+
+void RobotSession::armHeartbeat() {
+  heartbeat_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
+    if (ec || self->closed_) return;
+    v1::Envelope env;
+    env.mutable_heartbeat()->set_time_us(monoNowUs());
+    self->enqueue(env);
+    if (self->closed_) return;
+    const auto period = seconds(self->config_.heartbeat_period_s);
+    auto next = self->heartbeat_timer_.expiry() + period;
+    if (next < Clock::now()) next = Clock::now() + period;  // fell behind: do not burst
+    self->heartbeat_timer_.expires_at(next);
+    self->armHeartbeat();
+  });
+}
+
+void RobotSession::armTeleop(uint64_t generation) {
+  teleop_timer_.async_wait([self = shared_from_this(), generation](const error_code& ec) {
+    if (ec || self->closed_ || !self->teleop_active_ || generation != self->teleop_generation_) return;
+    if (!self->server_.consoleResponsive()) {
+      // The robot's own 300 ms deadman takes it from here.
+      self->teleop_active_ = false;
+      log::warn(log::tag::kLink, self->who(), ": console unresponsive: teleop set-point cleared, re-send stopped");
+      return;
+    }
+    self->sendTeleopNow(self->server_.nextCommandId());
+    if (self->closed_) return;
+    const auto period = seconds(1.0 / self->config_.teleop_resend_hz);
+    auto next = self->teleop_timer_.expiry() + period;
+    if (next < Clock::now()) next = Clock::now() + period;
+    self->teleop_timer_.expires_at(next);
+    self->armTeleop(generation);
+  });
+}
+
+void RobotSession::sendTeleopNow(uint64_t id) {
+  v1::Envelope env;
+  auto* c = env.mutable_command();
+  c->set_id(id);
+  c->mutable_teleop()->set_v_m_s(teleop_v_m_s_);
+  c->mutable_teleop()->set_w_rad_s(teleop_w_rad_s_);
+  enqueue(env);
+}
+
+void RobotSession::enqueue(v1::Envelope& env) {
+  if (closed_) return;
+  env.set_seq(++tx_seq_);
+  env.set_send_time_us(monoNowUs());
+  std::string frame;
+  if (!net::appendDelimited(env, frame)) {
+    log::error(log::tag::kLink, who(), ": cannot serialise an outgoing ", bodyName(env.body_case()));
+    return;
+  }
+  if (queued_bytes_ + frame.size() > kMaxQueuedBytes) {
+    closeNow("more than " + std::to_string(kMaxQueuedBytes) + " bytes waiting to be sent: the robot is not reading",
+             log::Level::kWarn);
+    return;
+  }
+  queued_bytes_ += frame.size();
+  if (accepted_ && env.has_command()) server_.observe(robot_id_, address_, env, false, env.send_time_us());
+  const bool idle = tx_queue_.empty();
+  tx_queue_.push_back(std::move(frame));
+  if (idle) doWrite();
+}
+
+void RobotSession::doWrite() {
+  stream_.asyncWrite(asio::buffer(tx_queue_.front()),
+                    [self = shared_from_this()](const error_code& ec, std::size_t) { self->onWrite(ec); });
+}
+
+void RobotSession::onWrite(const error_code& ec) {
+  if (closed_) return;
+  if (ec) {
+    closeNow("write error: " + ec.message(), log::Level::kWarn);
+    return;
+  }
+  queued_bytes_ -= tx_queue_.front().size();
+  tx_queue_.pop_front();
+  if (!tx_queue_.empty()) {
+    doWrite();
+  } else if (rejecting_) {
+    // The reply is out: half-close so the robot reads it and sees EOF; its close ends the linger.
+    error_code ignored;
+    stream_.socket().shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
+  }
+}
+
+void RobotSession::closeNow(const std::string& reason, log::Level level) {
+  if (closed_) return;
+  closed_ = true;
+  teleop_active_ = false;
+  log::logf(level, log::tag::kLink, who(), ": closed: ", reason);
+  handshake_timer_.cancel();
+  watchdog_timer_.cancel();
+  heartbeat_timer_.cancel();
+  teleop_timer_.cancel();
+  stale_timer_.cancel();
+  stream_.close();
+  if (accepted_) registry_.onDisconnected(robot_id_, serial_, reason, monoNowNs());
+  server_.detach(shared_from_this(), robot_id_);
+}
+
+}  // namespace inspect::server

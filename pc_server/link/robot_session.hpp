@@ -1,0 +1,117 @@
+#pragma once
+// One robot's TCP connection: handshake, delimited framing, heartbeats, the
+// session timeout and the teleop set-point re-send. Every member is touched
+// only on the session's strand; the public functions post to it.
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <span>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
+
+#include "inspect/v1/link.pb.h"
+#include "pc_server/app/server_config.hpp"
+#include "shared/net/delimited_codec.hpp"
+#include "shared/net/tls.hpp"
+#include "shared/util/log.hpp"
+
+namespace inspect::server {
+
+class LinkServer;
+class RobotRegistry;
+
+class RobotSession : public std::enable_shared_from_this<RobotSession> {
+ public:
+  using Strand = boost::asio::strand<boost::asio::io_context::executor_type>;
+  using Clock = std::chrono::steady_clock;
+  /// Unsent bytes allowed to pile up before the robot counts as not reading.
+  static constexpr std::size_t kMaxQueuedBytes = 4u << 20;
+  /// How long a rejected robot gets to read the HelloReply before the socket closes.
+  static constexpr auto kRejectLinger = std::chrono::milliseconds(500);
+
+  /// `socket` must use `strand` as its executor (accepted onto it); `tls`
+  /// null = plaintext (--plaintext), else the TLS handshake comes first.
+  RobotSession(Strand strand, boost::asio::ip::tcp::socket socket,
+               const std::shared_ptr<boost::asio::ssl::context>& tls, LinkServer& server, RobotRegistry& registry,
+               const ServerConfig& config, uint64_t serial);
+
+  /// Starts the TLS handshake, then reading; arms the handshake timeout (TLS + Hello).
+  void start();
+  /// Closes the connection, logging `reason`; thread-safe.
+  void close(std::string reason);
+  /// Sends a command (id already set); Stop/EStop also clear the set-point. Thread-safe.
+  void sendCommand(v1::Command cmd);
+  /// Sends the set-point now with `first_id`, then re-sends it at teleop_resend_hz. Thread-safe.
+  void setTeleop(double v_m_s, double w_rad_s, uint64_t first_id);
+  /// Stops re-sending the set-point. Thread-safe.
+  void clearTeleop();
+
+  uint64_t serial() const { return serial_; }
+  /// Peer "ip:port" (fixed at construction).
+  const std::string& address() const { return address_; }
+  /// The common name of the robot's verified certificate ("" before the TLS handshake or in plaintext).
+  const std::string& certificateName() const { return cert_name_; }
+
+ private:
+  void doRead();
+  void onRead(const boost::system::error_code& ec, std::size_t n);
+  /// Returns false when the session was closed.
+  bool handleFrame(std::span<const uint8_t> frame);
+  void handleHello(const v1::Hello& hello);
+  void acceptHello(const v1::Hello& hello);
+  void rejectHello(const std::string& reason);
+  void enqueue(v1::Envelope& env);
+  void doWrite();
+  void onWrite(const boost::system::error_code& ec);
+  void armWatchdog();
+  void armStaleCheck();
+  void armHeartbeat();
+  void armTeleop(uint64_t generation);
+  void sendTeleopNow(uint64_t id);
+  void closeNow(const std::string& reason, log::Level level);
+  std::string who() const;
+
+  Strand strand_;
+  net::LinkStream stream_;
+  LinkServer& server_;
+  RobotRegistry& registry_;
+  const ServerConfig config_;
+  const uint64_t serial_;
+  std::string address_;
+
+  boost::asio::steady_timer handshake_timer_;
+  boost::asio::steady_timer watchdog_timer_;
+  boost::asio::steady_timer heartbeat_timer_;
+  boost::asio::steady_timer teleop_timer_;
+  boost::asio::steady_timer stale_timer_;
+
+  net::DelimitedDecoder decoder_;
+  std::array<char, 16 * 1024> rx_buf_{};
+  std::deque<std::string> tx_queue_;
+  std::size_t queued_bytes_ = 0;
+  uint64_t tx_seq_ = 0;
+
+  std::string cert_name_;        // CN of the robot's certificate, after the TLS handshake
+  std::string robot_id_;         // set by an accepted Hello
+  bool accepted_ = false;
+  bool rejecting_ = false;       // HelloReply{accepted=false} queued; close once sent
+  std::string reject_reason_;
+  bool closed_ = false;
+  Clock::time_point last_rx_;
+  Clock::time_point last_telemetry_;
+  bool robot_moving_ = false;    // its last telemetry: a moving mode or a non-zero command
+  bool stale_stopped_ = false;   // an EStop went out for the current telemetry gap
+
+  bool teleop_active_ = false;
+  double teleop_v_m_s_ = 0;
+  double teleop_w_rad_s_ = 0;
+  uint64_t teleop_generation_ = 0;  // bumps on every change, so stale timer chains end
+};
+
+}  // namespace inspect::server

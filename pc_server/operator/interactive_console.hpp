@@ -1,0 +1,37 @@
+#pragma once
+// The console on a terminal: a prompt, a live status line of the selected robot
+// on the bottom row, robot events as they arrive, and keyboard teleop.
+#include <chrono>
+#include <string>
+
+#include "pc_server/console/console.hpp"
+#include "pc_server/operator/line_reader.hpp"
+#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/operator/terminal.hpp"
+
+namespace inspect::server {
+
+class InteractiveConsole {
+ public:
+  InteractiveConsole(Console& console, StopFlag& stop, double status_refresh_hz);
+  /// Runs until quit, end of input (Ctrl-D) or the stop request; restores the terminal.
+  void run();
+
+ private:
+  /// Keyboard teleop of `robot_id` until q/Esc, disconnect or stop (the Console's TeleopHandler).
+  bool teleop(KeyboardTeleop::Mode mode, const std::string& robot_id);
+  /// Redraws the status line when its period is due (or `force`).
+  void refreshStatus(bool force);
+  std::string statusText() const;
+  /// Prints background text (events) above the current input line, then `redraw`.
+  void printAbove(const std::string& text, const std::string& redraw);
+
+  Console& console_;
+  StopFlag& stop_;
+  Terminal term_;
+  LineReader reader_;
+  std::chrono::steady_clock::duration status_period_;
+  std::chrono::steady_clock::time_point next_status_{};
+};
+
+}  // namespace inspect::server

@@ -1,0 +1,424 @@
+#include "pc_server/recording/recorder.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "foxglove/CompressedVideo.pb.h"
+#include "shared/record/mcap_writer.hpp"
+#include "shared/util/clock.hpp"
+#include "shared/util/log.hpp"
+#include "shared/video/frame_source.hpp"
+#include "shared/video/mp4_writer.hpp"
+
+namespace inspect::server {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+uint64_t wallNowNs() {
+  return static_cast<uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count());
+}
+
+/// A time on this process's monotonic clock (µs) as wall-clock ns.
+uint64_t monoUsToWallNs(uint64_t mono_us) {
+  const int64_t age_ns = (static_cast<int64_t>(monoNowUs()) - static_cast<int64_t>(mono_us)) * 1000;
+  return wallNowNs() - static_cast<uint64_t>(std::max<int64_t>(age_ns, 0));
+}
+
+int64_t fileBytes(const std::string& path) {
+  std::error_code ec;
+  const auto n = fs::file_size(path, ec);
+  return ec ? 0 : static_cast<int64_t>(n);
+}
+}  // namespace
+
+std::string gainsJson(const v1::Telemetry& t) {
+  if (t.track_controller().empty()) return "{}";
+  char json[256];
+  std::snprintf(json, sizeof json, R"({"controller":"%s","kp":%.6g,"ki":%.6g,"kd":%.6g})",
+                t.track_controller().c_str(), t.kp(), t.ki(), t.kd());
+  return json;
+}
+
+std::string runGainsJson(const v1::Gains& g, uint32_t version) {
+  nlohmann::json j;
+  j["version"] = version;
+  j["kp"] = g.kp();
+  j["ki"] = g.ki();
+  j["kd"] = g.kd();
+  j["ke"] = g.ke();
+  j["kec"] = g.kec();
+  j["k1"] = g.k1();
+  j["k2"] = g.k2();
+  j["k3"] = g.k3();
+  j["a1"] = g.a1();
+  j["a2"] = g.a2();
+  j["a3"] = g.a3();
+  return j.dump();
+}
+
+struct Recorder::Run {
+  catalog::RunInfo info;
+  record::McapWriter mcap;
+  uint16_t ch_telemetry = 0, ch_command = 0, ch_ack = 0, ch_event = 0, ch_server = 0, ch_camera = 0, ch_info = 0;
+  std::unique_ptr<video::Mp4Writer> mp4;
+  std::string mp4_error;
+  RunStats stats;
+  uint64_t command_id = 0;   // the track/goto command that started it (ends it on COMPLETED/FAILED)
+  std::string address;       // robot's link address, to notice reconnects
+  uint64_t video_frames = 0;
+  bool gains_known = false;  // gains_json names the tracking controller
+  nlohmann::json gains = nlohmann::json::object();  // the run's gains_json
+
+  explicit Run(record::McapWriterOptions o) : mcap(std::move(o)) {}
+};
+
+Recorder::Recorder(const RecordingConfig& config, std::string software_version)
+    : config_(config), software_version_(std::move(software_version)) {
+  std::error_code ec;
+  fs::create_directories(config_.dir, ec);
+  if (ec) throw std::runtime_error("recording.dir: cannot create '" + config_.dir + "': " + ec.message());
+  catalog_ = std::make_unique<catalog::Catalog>(catalog::Catalog::open(config_.dir + "/catalog.sqlite"));
+  const auto incomplete = catalog_->markIncompleteRuns();
+  for (const auto& id : incomplete) {
+    const auto detail = catalog_->run(id);
+    std::string what = id + ": marked incomplete";
+    if (detail) {
+      const std::string dir = config_.dir + "/" + id;
+      const std::string mcap = dir + "/run.mcap";
+      try {
+        if (fs::exists(mcap)) {
+          const auto r = record::repairMcap(mcap);
+          what += r.was_complete ? ", MCAP complete"
+                                 : ", MCAP repaired (" + std::to_string(r.messages_kept) + " messages kept, " +
+                                       std::to_string(r.bytes_dropped) + " bytes of an unfinished chunk dropped)";
+          catalog_->addFile(id, "mcap", mcap, fileBytes(mcap));
+        }
+      } catch (const std::exception& e) {
+        what += std::string(", MCAP not repaired: ") + e.what();
+      }
+      const std::string mp4 = dir + "/video.mp4";
+      if (fs::exists(mp4)) catalog_->addFile(id, "video", mp4, fileBytes(mp4));
+    }
+    log::warn(log::tag::kRecord, what);
+    startup_report_ += (startup_report_.empty() ? "" : "; ") + what;
+  }
+}
+
+Recorder::~Recorder() {
+  std::lock_guard lk(mu_);
+  std::vector<std::string> robots;
+  for (const auto& [robot, r] : runs_) robots.push_back(robot);
+  for (const auto& robot : robots) {
+    try {
+      stopLocked(robot, "stopped");
+    } catch (const std::exception& e) {
+      log::error(log::tag::kRecord, robot, ": ending the run at shutdown: ", e.what());
+    }
+  }
+}
+
+void Recorder::setGainsSource(std::function<std::string(const std::string&)> f) {
+  std::lock_guard lk(mu_);
+  gains_source_ = std::move(f);
+}
+
+void Recorder::setHelloSource(std::function<std::optional<v1::Hello>(const std::string&)> f) {
+  std::lock_guard lk(mu_);
+  hello_source_ = std::move(f);
+}
+
+void Recorder::setRunMap(const std::string& robot, const std::string& map_path) {
+  std::lock_guard lk(mu_);
+  if (map_path.empty()) {  // the command that would have started the run was refused
+    pending_map_.erase(robot);
+    return;
+  }
+  if (auto it = runs_.find(robot); it != runs_.end()) {
+    try {
+      catalog_->addFile(it->second->info.id, "map", map_path, fileBytes(map_path));
+    } catch (const std::exception& e) {
+      log::error(log::tag::kRecord, robot, ": run map not in the catalog: ", e.what());
+    }
+    return;
+  }
+  pending_map_[robot] = map_path;
+}
+
+
+void Recorder::noteAlarmAck(const std::string& robot, const v1::GasAlarm& a, const std::string& text) {
+  std::lock_guard lk(mu_);
+  auto it = runs_.find(robot);
+  const std::string run_id = it == runs_.end() ? "" : it->second->info.id;
+  try {
+    if (it != runs_.end()) noteLocked(*it->second, robot, text);
+    catalog_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), v1::GasAlarm::Level_Name(a.level()),
+                       "acked", a.value(), a.pose().x_m(), a.pose().y_m());
+  } catch (const std::exception& e) {
+    log::error(log::tag::kRecord, robot, ": alarm acknowledgement not recorded: ", e.what());
+  }
+}
+
+void Recorder::setVideoFigures(std::function<std::optional<VideoFigures>(const std::string&)> f) {
+  std::lock_guard lk(mu_);
+  video_figures_ = std::move(f);
+}
+
+std::optional<std::string> Recorder::activeRun(const std::string& robot) const {
+  std::lock_guard lk(mu_);
+  auto it = runs_.find(robot);
+  if (it == runs_.end()) return std::nullopt;
+  return it->second->info.id;
+}
+
+std::string Recorder::start(const std::string& robot, const std::string& name, const std::string& route) {
+  std::lock_guard lk(mu_);
+  return startLocked(robot, name, route, 0);
+}
+
+std::string Recorder::startLocked(const std::string& robot, const std::string& name, const std::string& route,
+                                  uint64_t command_id) {
+  if (auto it = runs_.find(robot); it != runs_.end())
+    throw std::runtime_error(robot + " is already recording run " + it->second->info.id);
+  catalog::RunStart rs;
+  rs.robot = robot;
+  rs.name = name;
+  rs.route = route;
+  rs.software_version = software_version_;
+  if (gains_source_) rs.gains_json = gains_source_(robot);
+  const bool gains_known = rs.gains_json != "{}";
+  rs.dir = config_.dir;  // the runs directory: the run's files are in <dir>/<run id>/
+  record::McapWriterOptions mo;
+  mo.compression = config_.compression == "none" ? "" : config_.compression;
+  // Chunks closed by 0.8 s of log time (ticks every 0.2 s): a kill loses at most 1 s.
+  mo.chunk_max_age_ns = 800'000'000;
+  auto run = std::make_unique<Run>(mo);
+  run->info = catalog_->startRun(rs);
+  run->info.dir = config_.dir + "/" + run->info.id;
+  try {
+    fs::create_directories(run->info.dir);
+    run->mcap.open(run->info.dir + "/run.mcap");
+    run->ch_telemetry = run->mcap.addProtobufChannel(v1::Telemetry::descriptor(), "/telemetry");
+    run->ch_command = run->mcap.addProtobufChannel(v1::Command::descriptor(), "/command");
+    run->ch_ack = run->mcap.addProtobufChannel(v1::Ack::descriptor(), "/ack");
+    run->ch_event = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/event");
+    run->ch_server = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/server_event");
+    run->ch_camera = run->mcap.addProtobufChannel(foxglove::CompressedVideo::descriptor(), "/camera");
+    run->ch_info = run->mcap.addProtobufChannel(v1::Hello::descriptor(), "/robot_info");
+    video::Mp4Settings ms;
+    ms.max_fragment_s = config_.max_fragment_s;
+    run->mp4 = std::make_unique<video::Mp4Writer>(run->info.dir + "/video.mp4", ms);
+  } catch (const std::exception& e) {
+    catalog_->endRun(run->info.id, "failed", std::chrono::system_clock::now());
+    throw std::runtime_error("run " + run->info.id + ": " + e.what());
+  }
+  run->command_id = command_id;
+  run->gains_known = gains_known && rs.gains_json.find("\"controller\"") != std::string::npos;
+  run->gains = nlohmann::json::parse(rs.gains_json, nullptr, false);
+  if (!run->gains.is_object()) run->gains = nlohmann::json::object();
+  const std::string id = run->info.id;
+  noteLocked(*run, robot, "run " + id + " started" + (name.empty() ? "" : " (" + name + ")"));
+  catalog_->addFile(id, "mcap", run->info.dir + "/run.mcap", 0);
+  if (auto pm = pending_map_.find(robot); pm != pending_map_.end()) {
+    catalog_->addFile(id, "map", pm->second, fileBytes(pm->second));
+    pending_map_.erase(pm);
+  }
+  // The robot as it announced itself (gas channels and units), for reports and tools.
+  if (hello_source_) {
+    if (const auto h = hello_source_(robot)) {
+      const uint64_t now = wallNowNs();
+      run->mcap.write(run->ch_info, now, now, *h);
+      hello_[robot] = *h;
+    }
+  }
+  runs_[robot] = std::move(run);
+  log::info(log::tag::kRecord, robot, ": recording run ", id);
+  return id;
+}
+
+std::optional<std::string> Recorder::stop(const std::string& robot, const std::string& outcome) {
+  std::lock_guard lk(mu_);
+  if (!runs_.count(robot)) return std::nullopt;
+  return stopLocked(robot, outcome);
+}
+
+std::string Recorder::stopLocked(const std::string& robot, const std::string& outcome) {
+  auto node = runs_.extract(robot);
+  Run& r = *node.mapped();
+  noteLocked(r, robot, "run " + r.info.id + " ended: " + outcome);
+  r.mcap.close();
+  if (r.mp4) r.mp4->close();
+  const auto fig = r.stats.figures();
+  catalog::Summary s;
+  s.duration_s = fig.duration_s;
+  s.distance_m = fig.distance_m;
+  if (fig.min_person_m >= 0) s.min_person_m = fig.min_person_m;
+  if (fig.tracking_samples) {
+    s.track_max_pos_err_m = fig.max_position_error_m;
+    s.track_rms_pos_err_m = fig.rms_position_error_m;
+    s.track_max_angle_err_rad = fig.max_angle_error_rad;
+  }
+  if (video_figures_) {
+    if (const auto v = video_figures_(robot)) {
+      s.video_frames_received = v->frames_received;
+      s.video_frames_decoded = v->frames_decoded;
+      s.video_packets_lost = v->packets_lost;
+    }
+  }
+  const auto hello = hello_.find(robot);
+  for (const auto& g : fig.gas) {
+    const bool named = hello != hello_.end() && g.channel < hello->second.gas_channels_size();
+    s.gas.push_back({named ? hello->second.gas_channels(static_cast<int>(g.channel)).name() : "gas" + std::to_string(g.channel),
+                     named ? hello->second.gas_channels(static_cast<int>(g.channel)).unit() : "", g.max, g.mean});
+  }
+  catalog_->setSummary(r.info.id, s);
+  catalog_->addFile(r.info.id, "mcap", r.info.dir + "/run.mcap", fileBytes(r.info.dir + "/run.mcap"));
+  if (r.mp4)
+    for (const auto& f : r.mp4->files()) catalog_->addFile(r.info.id, "video", f, fileBytes(f));
+  catalog_->endRun(r.info.id, outcome, std::chrono::system_clock::now());
+  log::info(log::tag::kRecord, robot, ": run ", r.info.id, " ended (", outcome, "): ", r.mcap.stats().messages, " messages, ",
+            r.video_frames, " video frames");
+  return r.info.id;
+}
+
+void Recorder::noteLocked(Run& r, const std::string& robot, const std::string& text) {
+  v1::Event e;
+  e.set_kind(v1::Event::INFO);
+  e.set_text(text);
+  e.set_robot_time_us(monoNowUs());
+  const uint64_t now = wallNowNs();
+  r.mcap.write(r.ch_server, now, now, e);
+  catalog_->addEvent(r.info.id, robot, std::chrono::system_clock::now(), "server", text);
+}
+
+void Recorder::onEnvelope(const std::string& robot, const std::string& address, const v1::Envelope& env,
+                          bool inbound, uint64_t time_us) {
+  std::lock_guard lk(mu_);
+  auto it = runs_.find(robot);
+  if (!inbound && env.has_command() && it == runs_.end() && config_.auto_start) {
+    const auto& c = env.command();
+    std::string name;
+    if (c.has_track()) name = "track";
+    if (c.has_wheel_test()) name = "identification " + c.wheel_test().name();
+    if (c.has_go_to())
+      name = c.go_to().name().empty() ? "goto"
+                                      : (c.go_to().inspection() ? "inspection " : "route ") + c.go_to().name();
+    if (!name.empty()) {
+      try {
+        startLocked(robot, name,
+                    c.has_go_to() ? c.go_to().name() : c.has_wheel_test() ? c.wheel_test().name() : "", c.id());
+        it = runs_.find(robot);
+      } catch (const std::exception& e) {
+        log::error(log::tag::kRecord, robot, ": cannot start a run: ", e.what());
+      }
+    }
+  }
+  // Gas alarms go into the catalog during runs and outside them.
+  if (inbound && env.has_event() && env.event().has_gas_alarm()) {
+    const auto& a = env.event().gas_alarm();
+    try {
+      catalog_->addAlarm(it == runs_.end() ? "" : it->second->info.id, robot, std::chrono::system_clock::now(),
+                         a.channel_name(), v1::GasAlarm::Level_Name(a.level()), a.active() ? "raised" : "cleared", a.value(),
+                         a.pose().x_m(), a.pose().y_m());
+    } catch (const std::exception& e) {
+      log::error(log::tag::kRecord, robot, ": alarm not in the catalog: ", e.what());
+    }
+  }
+  if (it == runs_.end()) return;
+  Run& r = *it->second;
+  if (r.address.empty()) r.address = address;
+  if (address != r.address) {
+    noteLocked(r, robot, "robot reconnected from " + address + " (was " + r.address + "); run continues");
+    r.address = address;
+  }
+  const uint64_t log_ns = monoUsToWallNs(time_us);
+  const uint64_t publish_ns = env.send_time_us() * 1000;  // the sender's clock
+  try {
+    switch (env.body_case()) {
+      case v1::Envelope::kTelemetry:
+        r.stats.add(env.telemetry());
+        // The gains in force, as soon as the robot tracks with them.
+        if (!r.gains_known && env.telemetry().mode() == v1::TRACKING && !env.telemetry().track_controller().empty()) {
+          const auto& t = env.telemetry();
+          // The full set (from Hello / GAINS_APPLIED) keeps its values; the
+          // controller, and kp/ki/kd for robots that announce no set, come from telemetry.
+          const auto from_t = nlohmann::json::parse(gainsJson(t), nullptr, false);
+          if (from_t.is_object())
+            for (const auto& [k, v] : from_t.items())
+              if (!r.gains.contains(k)) r.gains[k] = v;
+          catalog_->setGains(r.info.id, r.gains.dump());
+          r.gains_known = true;
+        }
+        r.mcap.write(r.ch_telemetry, log_ns, publish_ns, env.telemetry());
+        break;
+      case v1::Envelope::kCommand: r.mcap.write(r.ch_command, log_ns, publish_ns, env.command()); break;
+      case v1::Envelope::kAck: r.mcap.write(r.ch_ack, log_ns, publish_ns, env.ack()); break;
+      case v1::Envelope::kEvent:
+        r.mcap.write(r.ch_event, log_ns, publish_ns, env.event());
+        if (env.event().kind() == v1::Event::GAINS_APPLIED && env.event().has_gains()) {
+          // New gains during the run: the catalog keeps the latest set and counts the changes.
+          const std::string controller = r.gains.value("controller", "");
+          const int changes = r.gains.value("changes_in_run", 0) + 1;
+          r.gains = nlohmann::json::parse(runGainsJson(env.event().gains(), env.event().gains_version()));
+          if (!controller.empty()) r.gains["controller"] = controller;
+          r.gains["changes_in_run"] = changes;
+          catalog_->setGains(r.info.id, r.gains.dump());
+        }
+        catalog_->addEvent(r.info.id, robot, std::chrono::system_clock::now(),
+                           v1::Event::Kind_Name(env.event().kind()), env.event().text());
+        break;
+      default: break;
+    }
+  } catch (const std::exception& e) {
+    log::error(log::tag::kRecord, robot, ": run ", r.info.id, ": ", e.what());
+  }
+  // The command that started the run ends it.
+  if (inbound && env.has_ack() && r.command_id && env.ack().command_id() == r.command_id) {
+    const auto st = env.ack().status();
+    if (st == v1::Ack::COMPLETED || st == v1::Ack::FAILED || st == v1::Ack::REJECTED)
+      stopLocked(robot, st == v1::Ack::COMPLETED ? "completed" : "failed");
+  }
+}
+
+void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us) {
+  std::lock_guard lk(mu_);
+  auto it = runs_.find(robot);
+  if (it == runs_.end()) return;
+  Run& r = *it->second;
+  ++r.video_frames;
+  const uint64_t capture_wall_ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
+  foxglove::CompressedVideo v;
+  v.mutable_timestamp()->set_seconds(static_cast<int64_t>(capture_wall_ns / 1'000'000'000));
+  v.mutable_timestamp()->set_nanos(static_cast<int32_t>(capture_wall_ns % 1'000'000'000));
+  v.set_frame_id("camera");
+  v.set_data(frame.annexb.data(), frame.annexb.size());
+  v.set_format("h264");
+  try {
+    r.mcap.write(r.ch_camera, wallNowNs(), capture_wall_ns, v);
+    if (r.mp4) r.mp4->write(frame.annexb.data(), frame.annexb.size(), frame.keyframe, capture_us ? capture_us : monoNowUs());
+  } catch (const std::exception& e) {
+    if (r.mp4_error.empty()) log::error(log::tag::kRecord, robot, ": run ", r.info.id, " video: ", e.what());
+    r.mp4_error = e.what();
+    r.mp4.reset();
+  }
+}
+
+void Recorder::tick() {
+  std::lock_guard lk(mu_);
+  const uint64_t now = wallNowNs();
+  for (auto& [robot, r] : runs_) {
+    try {
+      r->mcap.tick(now);
+    } catch (const std::exception& e) {
+      log::error(log::tag::kRecord, robot, ": ", e.what());
+    }
+  }
+}
+
+}  // namespace inspect::server

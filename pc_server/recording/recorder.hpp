@@ -1,0 +1,101 @@
+#pragma once
+// Recording of inspection runs on the server (docs/recording.md): per robot
+// at most one run, written to <dir>/<run-id>/ as run.mcap (every telemetry
+// message, command, ack and event on its own channel, and the camera's H.264
+// frames as foxglove.CompressedVideo) and video.mp4 (fragmented, no
+// re-encode), listed in <dir>/catalog.sqlite with its summary figures.
+// A run survives robot reconnects (marked in the log). At start-up, runs a
+// killed server left open are marked incomplete and their MCAP files repaired.
+// Thread-safe.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "inspect/v1/link.pb.h"
+#include "pc_server/recording/run_stats.hpp"
+#include "pc_server/app/server_config.hpp"
+#include "shared/catalog/catalog.hpp"
+#include "shared/video/rtp_h264.hpp"
+
+namespace inspect::server {
+
+using RecordingConfig = RecordingServerConfig;
+
+/// Video figures of a robot's stream, for the run summary.
+struct VideoFigures {
+  int64_t frames_received = 0, frames_decoded = 0, packets_lost = 0;
+};
+
+/// The wheel PID gains a telemetry message reports while tracking, as JSON
+/// ({"controller":"fuzzy_pid","kp":..,"ki":..,"kd":..}); "{}" when not tracking.
+std::string gainsJson(const v1::Telemetry& t);
+/// The full gain set a robot announced (Hello, GAINS_APPLIED) with its version, as JSON.
+std::string runGainsJson(const v1::Gains& g, uint32_t version);
+
+class Recorder {
+ public:
+  /// Opens (creates) <dir>/catalog.sqlite, marks runs left open as
+  /// incomplete and repairs their MCAP files. Throws std::runtime_error.
+  Recorder(const RecordingConfig& config, std::string software_version);
+  ~Recorder();  // ends open runs as "stopped"
+
+  /// Starts a run for `robot`; returns its id. Throws std::runtime_error
+  /// (already recording, cannot create files).
+  std::string start(const std::string& robot, const std::string& name, const std::string& route = "");
+  /// Ends the robot's run; its id, or nullopt when none was recording.
+  std::optional<std::string> stop(const std::string& robot, const std::string& outcome = "stopped");
+  std::optional<std::string> activeRun(const std::string& robot) const;
+
+  /// Every envelope to or from a robot (LinkServer's observer).
+  void onEnvelope(const std::string& robot, const std::string& address, const v1::Envelope& env, bool inbound,
+                  uint64_t time_us);
+  /// Every intact access unit of a robot's camera (VideoReceiver's hook).
+  void onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us);
+  /// Closes MCAP chunks of quiet recordings; call every 100-200 ms.
+  void tick();
+  /// Where a new run gets the robot's controller gains in force (JSON; "{}" when unknown).
+  void setGainsSource(std::function<std::string(const std::string& robot)> f);
+  /// Where run summaries get the robot's video figures.
+  void setVideoFigures(std::function<std::optional<VideoFigures>(const std::string& robot)> f);
+  /// Where a run gets the robot's Hello (gas channel names and units), written
+  /// to the run's /robot_info channel at its start.
+  void setHelloSource(std::function<std::optional<v1::Hello>(const std::string& robot)> f);
+  /// The site map (world file) of the robot's current run, or of its next one
+  /// when none is running (`inspect` with a route that names a map); listed
+  /// as the run's "map" file, which reports draw. "" forgets a pending one.
+  void setRunMap(const std::string& robot, const std::string& map_path);
+  /// The operator acknowledged a gas alarm: /server_event and the catalog's alarms.
+  void noteAlarmAck(const std::string& robot, const v1::GasAlarm& alarm, const std::string& text);
+
+  catalog::Catalog& catalog() { return *catalog_; }
+  const RecordingConfig& config() const { return config_; }
+  /// What start-up found: "2 runs marked incomplete (…), MCAP repaired: …".
+  const std::string& startupReport() const { return startup_report_; }
+
+ private:
+  struct Run;
+  std::string startLocked(const std::string& robot, const std::string& name, const std::string& route,
+                          uint64_t command_id);
+  std::string stopLocked(const std::string& robot, const std::string& outcome);
+  void noteLocked(Run& r, const std::string& robot, const std::string& text);
+
+  RecordingConfig config_;
+  std::string software_version_;
+  std::unique_ptr<catalog::Catalog> catalog_;
+  std::string startup_report_;
+  std::function<std::optional<VideoFigures>(const std::string&)> video_figures_;
+  std::function<std::string(const std::string&)> gains_source_;
+  std::function<std::optional<v1::Hello>(const std::string&)> hello_source_;
+  std::map<std::string, std::string> pending_map_;  // robot -> map for its next run
+  std::map<std::string, v1::Hello> hello_;          // robot -> Hello at its run's start
+  mutable std::mutex mu_;
+  std::map<std::string, std::unique_ptr<Run>> runs_;  // robot -> its run
+};
+
+}  // namespace inspect::server
