@@ -10,7 +10,6 @@ namespace {
 
 using config::ConfigNode;
 
-constexpr double kMaxCoord_m = 1000.0;
 constexpr double kMaxTime_s = 1e9;
 
 bool validName(const std::string& s, std::size_t max_len, bool allow_dot) {

@@ -8,7 +8,6 @@
 namespace inspect::sim {
 namespace {
 
-constexpr double kMaxCoord_m = 1000.0;
 
 bool validId(const std::string& id) {
   if (id.empty() || id.size() > 64) return false;

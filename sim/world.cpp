@@ -11,8 +11,6 @@ namespace {
 
 using config::ConfigNode;
 
-// World coordinates must stay in a sane box (also keeps float error small).
-constexpr double kMaxCoord_m = 1000.0;
 constexpr double kMaxAngle_rad = 6.2832;
 
 template <class F>

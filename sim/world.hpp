@@ -16,6 +16,10 @@
 
 namespace inspect::sim {
 
+/// World coordinates (walls, obstacles, people, gas sources) stay within
+/// +-kMaxCoord_m, a sane box that also keeps float error small.
+inline constexpr double kMaxCoord_m = 1000.0;
+
 /// A painted line on the floor seen by the grayscale sensor.
 struct FloorLine {
   Segment centre;

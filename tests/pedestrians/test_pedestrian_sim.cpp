@@ -17,7 +17,7 @@
 #include "shared/serial/frame_codec.hpp"
 #include "sim/pedestrian_crowd.hpp"
 #include "sim/simulation.hpp"
-#include "sim/truth_log.hpp"
+#include "sim/mcu_sim/truth_log.hpp"
 #include "tests/support/paths.hpp"
 #include "tests/sim/world_text.hpp"
 

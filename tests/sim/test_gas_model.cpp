@@ -25,7 +25,7 @@
 #include "sim/gas_model.hpp"
 #include "sim/gas_sensor.hpp"
 #include "sim/simulation.hpp"
-#include "sim/truth_log.hpp"
+#include "sim/mcu_sim/truth_log.hpp"
 #include "sim/world.hpp"
 #include "tests/sim/world_text.hpp"
 #include "tests/support/paths.hpp"

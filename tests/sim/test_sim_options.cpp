@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/sim_options.hpp"
+#include "sim/mcu_sim/sim_options.hpp"
 
 using namespace inspect::sim;
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "shared/util/clock.hpp"
-#include "sim/pty_port.hpp"
+#include "sim/mcu_sim/pty_port.hpp"
 
 namespace {
 

@@ -9,7 +9,7 @@
 
 #include "shared/control/diff_drive.hpp"
 #include "shared/serial/frame_codec.hpp"
-#include "sim/pty_port.hpp"
+#include "sim/mcu_sim/pty_port.hpp"
 #include "sim/sim_observer.hpp"
 #include "sim/simulation.hpp"
 

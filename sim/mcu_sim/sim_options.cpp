@@ -1,4 +1,4 @@
-#include "sim/sim_options.hpp"
+#include "sim/mcu_sim/sim_options.hpp"
 
 #include <cerrno>
 #include <cmath>

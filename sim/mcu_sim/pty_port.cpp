@@ -1,4 +1,4 @@
-#include "sim/pty_port.hpp"
+#include "sim/mcu_sim/pty_port.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

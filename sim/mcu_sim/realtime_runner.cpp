@@ -1,4 +1,4 @@
-#include "sim/realtime_runner.hpp"
+#include "sim/mcu_sim/realtime_runner.hpp"
 
 #include <poll.h>
 #include <signal.h>

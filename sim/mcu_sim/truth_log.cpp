@@ -1,4 +1,4 @@
-#include "sim/truth_log.hpp"
+#include "sim/mcu_sim/truth_log.hpp"
 
 #include <algorithm>
 #include <array>

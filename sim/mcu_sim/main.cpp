@@ -6,11 +6,11 @@
 #include <vector>
 
 #include "shared/config/robot_config.hpp"
-#include "sim/pty_port.hpp"
-#include "sim/realtime_runner.hpp"
-#include "sim/sim_options.hpp"
+#include "sim/mcu_sim/pty_port.hpp"
+#include "sim/mcu_sim/realtime_runner.hpp"
+#include "sim/mcu_sim/sim_options.hpp"
 #include "sim/simulation.hpp"
-#include "sim/truth_log.hpp"
+#include "sim/mcu_sim/truth_log.hpp"
 #include "sim/world.hpp"
 
 using namespace inspect;

@@ -1,0 +1,62 @@
+# The allowed dependency arrows between the project's folders
+# (docs/architecture.md), checked on every build: an #include that breaks
+# one fails the build with the file, the line and the rule.
+#
+#   cmake -DROOT=<source tree> [-DSTAMP=<file>] -P cmake/CheckIncludes.cmake
+#
+# Programs are on top: robot_client/, pc_server/, sim/ (mcu_sim), experiments/.
+# Below them shared/robot (the decision core), below it the other shared/
+# libraries; proto/ (inspect/...) at the bottom.
+#   shared/*      includes inspect/ and shared/ only, and not shared/robot/
+#                 (except shared/robot itself): no library includes a program
+#   sim/          no robot_client/, pc_server/, experiments/, tests/, and not
+#                 shared/robot/: the world does not know the robot's mind
+#   robot_client/ no pc_server/, experiments/, tests/; of sim/ only the world
+#                 file and the map made from it (robot_client --map)
+#   pc_server/    no robot_client/, experiments/, tests/
+#   experiments/  no robot_client/; of tests/ only tests/support/paths.hpp
+if(NOT ROOT)
+  message(FATAL_ERROR "CheckIncludes.cmake: -DROOT=<source tree> is required")
+endif()
+
+set(problems "")
+set(checked 0)
+
+# rule(<folder> <what may not be included: a regex on the include path> <why>)
+function(check_folder folder deny why)
+  file(GLOB_RECURSE files RELATIVE ${ROOT} ${ROOT}/${folder}/*.cpp ${ROOT}/${folder}/*.hpp)
+  foreach(f IN LISTS files)
+    if(DEFINED skip_regex AND f MATCHES "${skip_regex}")
+      continue()
+    endif()
+    file(STRINGS ${ROOT}/${f} lines REGEX "^[ \t]*#[ \t]*include[ \t]*\"")
+    foreach(l IN LISTS lines)
+      string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]*\"([^\"]+)\".*$" "\\1" inc "${l}")
+      if(inc MATCHES "${deny}")
+        set(problems "${problems}\n  ${f}: #include \"${inc}\": ${why}")
+      endif()
+    endforeach()
+  endforeach()
+  set(problems "${problems}" PARENT_SCOPE)
+endfunction()
+
+set(programs "^(robot_client|pc_server|sim|experiments|tests)/")
+set(skip_regex "^shared/robot/")
+check_folder(shared "${programs}|^shared/robot/" "a shared library includes neither a program nor the decision core above it")
+unset(skip_regex)
+check_folder(shared/robot "${programs}" "the decision core includes no program")
+check_folder(sim "^(robot_client|pc_server|experiments|tests)/|^shared/robot/" "the simulator includes no other program and not the robot's decision core")
+check_folder(robot_client "^(pc_server|experiments|tests)/|^sim/(.*/)?[a-z_]+\\.hpp$" "robot_client includes no other program (of sim/ only world.hpp and robot_map.hpp)")
+check_folder(pc_server "^(robot_client|experiments|tests)/" "pc_server includes no other program")
+check_folder(experiments "^robot_client/|^tests/(.*/)?[a-z_]+\\.hpp$" "an experiment includes no program's code (of tests/ only tests/support/paths.hpp)")
+
+# The allowed exceptions of the two rules above with exceptions.
+string(REGEX REPLACE "\n  robot_client/[^:]+: #include \"sim/(world|robot_map)\\.hpp\": [^\n]*" "" problems "${problems}")
+string(REGEX REPLACE "\n  experiments/[^:]+: #include \"tests/support/paths\\.hpp\": [^\n]*" "" problems "${problems}")
+
+if(problems)
+  message(FATAL_ERROR "includes that break the dependency arrows of docs/architecture.md:${problems}")
+endif()
+if(STAMP)
+  file(TOUCH ${STAMP})
+endif()
