@@ -6,16 +6,31 @@
 #include <sstream>
 
 namespace inspect::plot {
-namespace {
 std::string quote(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     if (c == '"' || c == '\\') out += '\\';
-    out += c;
+    if (c == '\n') out += "\\n";
+    else out += c;
   }
   return out + "\"";
 }
-}  // namespace
+
+std::string runScript(const std::string& png_path, const std::string& script) {
+  const std::string script_path = png_path + ".gp";
+  {
+    std::ofstream f(script_path);
+    if (!(f << script)) return "cannot write " + script_path;
+  }
+  FILE* pipe = ::popen(("gnuplot " + quote(script_path) + " 2>&1").c_str(), "r");
+  if (!pipe) return "cannot run gnuplot";
+  std::string out;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, pipe)) out += buf;
+  if (::pclose(pipe) != 0) return "gnuplot failed (is gnuplot-nox installed?): " + out.substr(0, 400);
+  std::remove(script_path.c_str());
+  return "";
+}
 
 std::string renderPng(const std::string& png_path, const std::vector<Panel>& panels, int width_px,
                       int panel_height_px) {
@@ -76,22 +91,7 @@ std::string renderPng(const std::string& png_path, const std::vector<Panel>& pan
     g << "\n";
   }
   if (panels.size() > 1) g << "unset multiplot\n";
-  const std::string script_path = png_path + ".gp";
-  {
-    std::ofstream f(script_path);
-    if (!f) return "cannot write " + script_path;
-    f << g.str();
-  }
-  const std::string cmd = "gnuplot " + quote(script_path) + " 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return "cannot run gnuplot";
-  std::string out;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, pipe)) out += buf;
-  const int rc = ::pclose(pipe);
-  if (rc != 0) return "gnuplot failed (is gnuplot-nox installed?): " + out.substr(0, 400);
-  std::remove(script_path.c_str());
-  return "";
+  return runScript(png_path, g.str());
 }
 
 }  // namespace inspect::plot

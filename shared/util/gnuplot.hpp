@@ -64,6 +64,14 @@ inline Panel panel(const std::string& title, const std::string& xlabel, const st
   return p;
 }
 
+/// A gnuplot string literal ("\n" in `s` becomes a line break in the figure).
+std::string quote(const std::string& s);
+
+/// Runs a gnuplot `script` that writes `png_path` itself, keeping the script
+/// next to it (<png>.gp) until it worked. "" or what went wrong (gnuplot
+/// missing, its error). renderPng draws through it; so do the gas maps.
+std::string runScript(const std::string& png_path, const std::string& script);
+
 /// Writes `png_path` with the panels stacked vertically. Returns an empty
 /// string on success, else what went wrong (gnuplot missing, its error).
 std::string renderPng(const std::string& png_path, const std::vector<Panel>& panels, int width_px = 900,
