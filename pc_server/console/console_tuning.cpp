@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "pc_server/console/console.hpp"
+#include "pc_server/console/tuning_state.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "pc_server/tuning/plant_id.hpp"
@@ -32,31 +33,8 @@ namespace inspect::server {
 
 namespace fs = std::filesystem;
 
-struct Console::TuningState {
-  config::RobotConfig robot;
-  config::ControlConfig control;
-  fuzzy::Fis fis;                  // the fuzzy system of control.fis_path (or imported)
-  bool fis_imported = false;       // push it along with the gains
-  control::GainSet paper;          // config/control.yaml's (the paper's) gains
-  control::GainSet working;        // what `gains set` edits and `gains push` sends
-  std::optional<control::GainSet> tuned;
-  std::string tuned_session;       // session id of `tuned`
-  control::PlantModel plant;       // what `tune` tunes for
-  std::string plant_source = "nominal (config/robot.yaml)";
-  std::string last_session_dir;
-};
 
 namespace {
-
-std::string gainsLine(const control::GainSet& g) {
-  std::ostringstream os;
-  bool first = true;
-  for (const char* n : control::kGainNames) {
-    os << (first ? "" : " ") << n << "=" << fmtShort(control::gainValue(g, n), 4);
-    first = false;
-  }
-  return os.str();
-}
 
 std::string wheelLine(const char* name, const control::WheelMotorModel& m) {
   char buf[160];
@@ -75,15 +53,6 @@ std::string sessionStamp() {
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", &tm);
   return buf;
-}
-
-// "key=value" arguments of `tune`.
-bool splitKeyValue(const std::string& a, std::string& k, std::string& v) {
-  const auto eq = a.find('=');
-  if (eq == std::string::npos || eq == 0 || eq + 1 == a.size()) return false;
-  k = a.substr(0, eq);
-  v = a.substr(eq + 1);
-  return true;
 }
 
 }  // namespace
@@ -369,7 +338,7 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
   out_ << "tune: " << (result.cancelled ? "cancelled after " : "done: ") << result.evals << " evaluations in "
        << fmtShort(result.wall_s, 3) << " s (" << result.algorithm << "); cost " << fmtShort(result.initial_eval.cost, 4)
        << " -> " << fmtShort(result.best_eval.cost, 4) << "\n";
-  out_ << "  best: " << gainsLine(result.best) << "\n";
+  out_ << "  best: " << gainsText(result.best) << "\n";
 
   // PID and fuzzy-PID with the paper's gains against the tuned set.
   tuning::Comparison cmp;
@@ -469,136 +438,6 @@ bool Console::pushGains(const std::string& robot, const control::GainSet& g, con
     }
   }
   return ok;
-}
-
-bool Console::cmdGains(const Args& args, const std::string&, int) {
-  if (args.empty()) return fail("gains", "syntax: gains show|set|push|revert|export|import ... (help gains)");
-  TuningState* ts = tuning("gains");
-  if (!ts) return false;
-  const std::string& sub = args[0];
-  if (sub == "show") {
-    if (args.size() > 2) return fail("gains", "syntax: gains show [robot]");
-    const std::string robot = args.size() == 2 ? args[1] : selected_;
-    std::optional<RobotSnapshot> snap;
-    if (!robot.empty()) snap = registry_.snapshot(robot, clock_->nowNs());
-    const bool have_robot = snap && snap->gains_known;
-    const control::GainSet rg = have_robot ? net::fromProto(snap->gains) : control::GainSet{};
-    char head[200];
-    std::snprintf(head, sizeof head, "%-6s %12s %12s %12s %12s\n", "gain", "working",
-                  have_robot ? (robot + " v" + std::to_string(snap->gains_version)).c_str() : "robot", "paper",
-                  ts->tuned ? "tuned" : "");
-    out_ << head;
-    for (const char* n : control::kGainNames) {
-      char row[200];
-      const std::string rv = have_robot ? fmtShort(control::gainValue(rg, n), 5) : std::string("--");
-      const std::string tv = ts->tuned ? fmtShort(control::gainValue(*ts->tuned, n), 5) : std::string();
-      std::snprintf(row, sizeof row, "%-6s %12s %12s %12s %12s\n", n, fmtShort(control::gainValue(ts->working, n), 5).c_str(),
-                    rv.c_str(), fmtShort(control::gainValue(ts->paper, n), 5).c_str(), tv.c_str());
-      out_ << row;
-    }
-    out_ << "fuzzy system: " << ts->fis.name << (ts->fis_imported ? " (imported; pushed with the gains)" : "")
-         << (have_robot && !snap->hello.fis_name().empty() ? "; robot's: " + snap->hello.fis_name() : std::string())
-         << "\n";
-    if (!have_robot && !robot.empty()) out_ << "(" << robot << " has not announced its gains)\n";
-    return true;
-  }
-  if (sub == "set") {
-    if (args.size() < 2) return fail("gains", "syntax: gains set <name>=<value> ... | gains set paper|tuned|robot");
-    if (args.size() == 2 && (args[1] == "paper" || args[1] == "tuned" || args[1] == "robot")) {
-      if (args[1] == "paper") ts->working = ts->paper;
-      if (args[1] == "tuned") {
-        if (!ts->tuned) return fail("gains", "nothing tuned yet (tune)");
-        ts->working = *ts->tuned;
-      }
-      if (args[1] == "robot") {
-        const auto snap = selected_.empty() ? std::optional<RobotSnapshot>() : registry_.snapshot(selected_, clock_->nowNs());
-        if (!snap || !snap->gains_known) return fail("gains", "the selected robot has not announced its gains");
-        ts->working = net::fromProto(snap->gains);
-      }
-      out_ << "gains: working set = " << args[1] << ": " << gainsLine(ts->working) << "\n";
-      return true;
-    }
-    control::GainSet next = ts->working;
-    for (std::size_t i = 1; i < args.size(); ++i) {
-      std::string k, v;
-      if (!splitKeyValue(args[i], k, v)) {
-        // "gains set kp 12" form
-        if (args.size() == 3 && i == 1) {
-          k = args[1];
-          v = args[2];
-          i = 2;
-        } else {
-          return fail("gains", "'" + args[i] + "' is not name=value");
-        }
-      }
-      double* slot = control::gainByName(next, k);
-      if (!slot) return fail("gains", "unknown gain '" + k + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3)");
-      const auto x = parseNumber(v);
-      if (!x) return fail("gains", k + ": '" + v + "' is not a number");
-      *slot = *x;
-    }
-    if (const std::string why = control::validateGains(next); !why.empty()) return fail("gains", why + " (nothing changed)");
-    ts->working = next;
-    out_ << "gains: working set: " << gainsLine(ts->working) << "\n";
-    return true;
-  }
-  if (sub == "push") {
-    if (args.size() > 2) return fail("gains", "syntax: gains push [robot]");
-    std::string robot;
-    if (args.size() == 2) {
-      robot = args[1];
-      const auto snap = registry_.snapshot(robot, clock_->nowNs());
-      if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
-    } else {
-      const auto r = connectedRobot("gains");
-      if (!r) return false;
-      robot = *r;
-    }
-    const bool tuned = ts->tuned && control::sameGains(*ts->tuned, ts->working);
-    return pushGains(robot, ts->working, tuned ? "tuning session " + ts->tuned_session : "operator console",
-                     tuned ? ts->tuned_session : "");
-  }
-  if (sub == "revert") {
-    if (args.size() > 2) return fail("gains", "syntax: gains revert [robot]");
-    const std::string robot = args.size() == 2 ? args[1] : selected_;
-    if (robot.empty()) return fail("gains", "no robot selected");
-    const auto snap = registry_.snapshot(robot, clock_->nowNs());
-    if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
-    if (snap->gains_history.empty()) return fail("gains", robot + ": no earlier gains to go back to");
-    const auto& [version, prev] = snap->gains_history.back();
-    out_ << "gains: reverting " << robot << " to the set of v" << version << "\n";
-    if (!pushGains(robot, net::fromProto(prev), "revert to v" + std::to_string(version), "")) return false;
-    return true;
-  }
-  if (sub == "export") {
-    if (args.size() != 2) return fail("gains", "syntax: gains export <file.yaml>");
-    try {
-      config::exportGains(ts->working, ts->fis, args[1], "exported from the pc_server console");
-    } catch (const std::exception& e) {
-      return fail("gains", e.what());
-    }
-    out_ << "gains: working set written to " << args[1] << " with its fuzzy system beside it\n";
-    return true;
-  }
-  if (sub == "import") {
-    if (args.size() != 2) return fail("gains", "syntax: gains import <file.yaml>");
-    fuzzy::Fis fis;
-    config::GainsFile f;
-    try {
-      f = config::importGains(args[1], ts->working, &fis);
-    } catch (const std::exception& e) {
-      return fail("gains", e.what());
-    }
-    ts->working = f.gains;
-    if (!f.fis_path.empty()) {
-      ts->fis_imported = fuzzy::formatFis(fis) != fuzzy::formatFis(ts->fis) || ts->fis_imported;
-      ts->fis = fis;
-    }
-    out_ << "gains: working set from " << args[1] << ": " << gainsLine(ts->working) << "\n";
-    if (ts->fis_imported) out_ << "gains: fuzzy system '" << ts->fis.name << "' goes with the next push\n";
-    return true;
-  }
-  return fail("gains", "unknown subcommand '" + sub + "' (show, set, push, revert, export, import)");
 }
 
 }  // namespace inspect::server

@@ -58,4 +58,18 @@ std::string trim(std::string_view text) {
   return std::string(text.substr(a, b - a));
 }
 
+bool splitKeyValue(const std::string& a, std::string& k, std::string& v) {
+  const auto eq = a.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == a.size()) return false;
+  k = a.substr(0, eq);
+  v = a.substr(eq + 1);
+  return true;
+}
+
+std::string gainsText(const control::GainSet& g) {
+  std::string out;
+  for (const char* n : control::kGainNames) out += (out.empty() ? "" : " ") + std::string(n) + "=" + fmtShort(control::gainValue(g, n), 4);
+  return out;
+}
+
 }  // namespace inspect::server

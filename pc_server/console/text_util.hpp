@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "shared/control/gain_set.hpp"
 #include "shared/util/number_text.hpp"
 
 namespace inspect::server {
@@ -18,6 +19,11 @@ std::optional<long long> parseInteger(std::string_view text);
 std::vector<std::string> splitWords(std::string_view text);
 /// Removes leading and trailing blanks (and a trailing '\r').
 std::string trim(std::string_view text);
+/// "key=value" into its two halves (neither empty); false otherwise.
+bool splitKeyValue(const std::string& a, std::string& k, std::string& v);
+/// Every tracking gain as "kp=11.94 ki=11.5 ...".
+std::string gainsText(const control::GainSet& g);
+
 using util::fmtFixed;
 using util::fmtShort;
 using util::fmtSigned;
