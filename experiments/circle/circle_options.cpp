@@ -1,0 +1,179 @@
+// track_experiment's command line and the parts of a run every file shares.
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+
+#include "experiments/circle/circle_experiment.hpp"
+
+namespace inspect::circle {
+
+const char* const kUsage = R"(usage: track_experiment [options]
+The paper's circle-tracking experiment (Figs 18, 20): the same tracker
+(Eqs 10-13) with a PID (Eq 14) or fuzzy-PID (Eqs 14-15) wheel loop against
+the simulated robot, compared metric by metric with the paper.
+  --trajectory circle|line|waypoints   reference (default circle)
+  --radius M        circle radius, m; < 0 turns clockwise (default 3.5)
+  --speed M_S       reference speed, m/s (default 0.5; the paper does not say)
+  --laps N          circle laps (default 1)
+  --length M        line length; waypoints: a length x length/2 rectangle (default 10)
+  --controllers L   comma list of pid, fuzzy_pid, direct (default pid,fuzzy_pid)
+  --robot FILE      robot config (default config/robot.yaml)
+  --control FILE    control config (default config/control.yaml)
+  --seed N          noise seed (default 1)
+  --seeds K         repeat over seeds N..N+K-1, report mean / max (default 1)
+  --no-noise        exact wheel-speed and heading measurements
+  --band-m M        position convergence band, m (default 0.01)
+  --band-rad R      angle convergence band, rad (default 0.01)
+  --plots DIR       write Fig 18 / Fig 20 / wheel-and-gain PNGs into DIR
+  --json FILE       write the figures as JSON
+  --help            this text
+Exit status: 0 done, 1 a plot or the JSON could not be written, 2 bad arguments or config.
+)";
+
+const char* toString(Trajectory t) {
+  switch (t) {
+    case Trajectory::kCircle: return "circle";
+    case Trajectory::kLine: return "line";
+    case Trajectory::kWaypoints: return "waypoints";
+  }
+  return "?";
+}
+
+double parseNumber(const std::string& flag, const std::string& text) {
+  double v = 0;
+  const char* end = text.data() + text.size();
+  const auto [p, ec] = std::from_chars(text.data(), end, v);
+  if (ec != std::errc() || p != end || !std::isfinite(v))
+    throw UsageError(flag + ": expected a number, got '" + text + "'");
+  return v;
+}
+
+long parseInteger(const std::string& flag, const std::string& text, long min, long max) {
+  long v = 0;
+  const char* end = text.data() + text.size();
+  const auto [p, ec] = std::from_chars(text.data(), end, v);
+  if (ec != std::errc() || p != end || v < min || v > max)
+    throw UsageError(flag + ": expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) +
+                     "], got '" + text + "'");
+  return v;
+}
+
+double positive(const std::string& flag, double v) {
+  if (!(v > 0)) throw UsageError(flag + ": must be positive");
+  return v;
+}
+
+WheelControl parseController(const std::string& name) {
+  if (name == "pid") return WheelControl::kPid;
+  if (name == "fuzzy_pid") return WheelControl::kFuzzyPid;
+  if (name == "direct") return WheelControl::kDirect;
+  throw UsageError("--controllers: unknown controller '" + name + "' (pid, fuzzy_pid, direct)");
+}
+
+std::vector<WheelControl> parseControllers(const std::string& list) {
+  std::vector<WheelControl> out;
+  std::size_t begin = 0;
+  while (begin <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', begin), list.size());
+    const WheelControl c = parseController(list.substr(begin, comma - begin));
+    if (std::find(out.begin(), out.end(), c) != out.end())
+      throw UsageError("--controllers: '" + std::string(control::toString(c)) + "' given twice");
+    out.push_back(c);
+    begin = comma + 1;
+  }
+  return out;
+}
+
+Options parseArgs(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw UsageError(flag + ": missing value");
+      return argv[++i];
+    };
+    if (flag == "--help" || flag == "-h") {
+      o.help = true;
+    } else if (flag == "--trajectory") {
+      const std::string t = value();
+      if (t == "circle") o.trajectory = Trajectory::kCircle;
+      else if (t == "line") o.trajectory = Trajectory::kLine;
+      else if (t == "waypoints") o.trajectory = Trajectory::kWaypoints;
+      else throw UsageError("--trajectory: expected circle, line or waypoints, got '" + t + "'");
+    } else if (flag == "--radius") {
+      o.radius_m = parseNumber(flag, value());
+      if (!(std::abs(o.radius_m) >= 0.05)) throw UsageError("--radius: |radius| must be at least 0.05 m");
+    } else if (flag == "--speed") {
+      o.speed_m_s = positive(flag, parseNumber(flag, value()));
+    } else if (flag == "--laps") {
+      o.laps = positive(flag, parseNumber(flag, value()));
+    } else if (flag == "--length") {
+      o.length_m = positive(flag, parseNumber(flag, value()));
+    } else if (flag == "--controllers") {
+      o.controllers = parseControllers(value());
+    } else if (flag == "--robot") {
+      o.robot_path = value();
+    } else if (flag == "--control") {
+      o.control_path = value();
+    } else if (flag == "--seed") {
+      o.seed = static_cast<uint32_t>(parseInteger(flag, value(), 0, 4294967295L));
+    } else if (flag == "--seeds") {
+      o.seeds = static_cast<int>(parseInteger(flag, value(), 1, 10000));
+    } else if (flag == "--no-noise") {
+      o.noise = false;
+    } else if (flag == "--band-m") {
+      o.band_m = positive(flag, parseNumber(flag, value()));
+    } else if (flag == "--band-rad") {
+      o.band_rad = positive(flag, parseNumber(flag, value()));
+    } else if (flag == "--plots") {
+      o.plots_dir = value();
+    } else if (flag == "--json") {
+      o.json_path = value();
+    } else {
+      throw UsageError(flag + ": unknown argument (see --help)");
+    }
+  }
+  return o;
+}
+
+std::unique_ptr<control::ReferencePath> makePath(const Options& o) {
+  const control::Pose2 start{0.0, 0.0, 0.0};  // the paper's start (0, 0, 0)
+  switch (o.trajectory) {
+    case Trajectory::kCircle: return control::makeCircle(start, o.radius_m, o.speed_m_s, o.laps);
+    case Trajectory::kLine: return control::makeLine(start, o.length_m, o.speed_m_s);
+    case Trajectory::kWaypoints: return control::makeRectangleWaypoints(o.length_m, o.speed_m_s);
+  }
+  throw std::logic_error("unknown trajectory");
+}
+
+std::string label(WheelControl c) {
+  switch (c) {
+    case WheelControl::kPid: return "PID";
+    case WheelControl::kFuzzyPid: return "fuzzy-PID";
+    case WheelControl::kDirect: return "direct";
+  }
+  return "?";
+}
+
+std::string fmt(double v, int decimals) {
+  if (std::isnan(v)) return "not conv.";
+  char b[48];
+  std::snprintf(b, sizeof b, "%.*f", decimals, v);
+  return b;
+}
+
+/// The errors at a critical point; nothing if the run does not reach it.
+/// Point 1 is the start, where the robot is placed: both errors are 0.
+std::optional<PointErrors> errorsAtLapFraction(const Run& r, const Options& o, double fraction) {
+  const auto& s = r.result.samples;
+  if (s.empty() || fraction > o.laps + 1e-9) return std::nullopt;
+  if (fraction <= 0) return PointErrors{0.0, 0.0, 0.0};
+  const double t = fraction * 2.0 * std::numbers::pi * std::abs(o.radius_m) / o.speed_m_s;
+  auto it = std::lower_bound(s.begin(), s.end(), t - 1e-9,
+                             [](const sim::ClosedLoopSample& a, double tt) { return a.t_s < tt; });
+  if (it == s.end()) --it;
+  if (it != s.begin() && std::abs((it - 1)->t_s - t) < std::abs(it->t_s - t)) --it;
+  return PointErrors{it->t_s, it->pos_err_m, it->ang_err_rad};
+}
+
+}  // namespace inspect::circle
