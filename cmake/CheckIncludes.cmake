@@ -11,8 +11,8 @@
 #                 (except shared/robot itself): no library includes a program
 #   sim/          no robot_client/, pc_server/, experiments/, tests/, and not
 #                 shared/robot/: the world does not know the robot's mind
-#   robot_client/ no pc_server/, experiments/, tests/; of sim/ only the world
-#                 file and the map made from it (robot_client --map)
+#   robot_client/ no sim/, pc_server/, experiments/, tests/ (the world file
+#                 of --map is shared/world)
 #   pc_server/    no robot_client/, experiments/, tests/
 #   experiments/  no robot_client/; of tests/ only tests/support/paths.hpp
 if(NOT ROOT)
@@ -46,12 +46,11 @@ check_folder(shared "${programs}|^shared/robot/" "a shared library includes neit
 unset(skip_regex)
 check_folder(shared/robot "${programs}" "the decision core includes no program")
 check_folder(sim "^(robot_client|pc_server|experiments|tests)/|^shared/robot/" "the simulator includes no other program and not the robot's decision core")
-check_folder(robot_client "^(pc_server|experiments|tests)/|^sim/(.*/)?[a-z_]+\\.hpp$" "robot_client includes no other program (of sim/ only world.hpp and robot_map.hpp)")
+check_folder(robot_client "^(sim|pc_server|experiments|tests)/" "robot_client includes no other program (nor the simulator)")
 check_folder(pc_server "^(robot_client|experiments|tests)/" "pc_server includes no other program")
 check_folder(experiments "^robot_client/|^tests/(.*/)?[a-z_]+\\.hpp$" "an experiment includes no program's code (of tests/ only tests/support/paths.hpp)")
 
-# The allowed exceptions of the two rules above with exceptions.
-string(REGEX REPLACE "\n  robot_client/[^:]+: #include \"sim/(world|robot_map)\\.hpp\": [^\n]*" "" problems "${problems}")
+# The allowed exception of the rule above.
 string(REGEX REPLACE "\n  experiments/[^:]+: #include \"tests/support/paths\\.hpp\": [^\n]*" "" problems "${problems}")
 
 if(problems)

@@ -13,7 +13,7 @@
 
 #include "robot_client/client_config.hpp"
 #include "robot_client/robot_app.hpp"
-#include "sim/robot_map.hpp"
+#include "shared/world/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/robot/awareness.hpp"
 #include "shared/config/control_config.hpp"
@@ -21,7 +21,7 @@
 #include "shared/config/config_node.hpp"
 #include "shared/net/tls.hpp"
 #include "shared/util/log.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 
 namespace {
 
@@ -185,7 +185,7 @@ int main(int argc, char** argv) {
 
     std::vector<behavior::MapSegment> map;
     if (!cfg.map_file.empty()) {
-      map = sim::mapFromWorld(sim::loadWorldFile(cfg.map_file));
+      map = world::mapFromWorld(world::loadWorldFile(cfg.map_file));
       log::info("main", "map ", cfg.map_file, ": ", map.size(), " wall segments");
     }
     std::unique_ptr<behavior::HumanAwareness> awareness;

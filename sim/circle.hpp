@@ -2,7 +2,7 @@
 // Circles (people seen by the ultrasonic sensors) and ray/circle intersection.
 #include <optional>
 
-#include "sim/geometry.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

@@ -6,7 +6,7 @@
 #include <random>
 
 #include "sim/robot_plant.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

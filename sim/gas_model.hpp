@@ -17,8 +17,7 @@
 #include <string_view>
 #include <vector>
 
-#include "sim/geometry.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

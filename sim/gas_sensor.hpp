@@ -11,7 +11,7 @@
 
 #include "shared/config/gas_config.hpp"
 #include "shared/serial/messages.hpp"
-#include "sim/gas_spec.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "shared/control/diff_drive.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

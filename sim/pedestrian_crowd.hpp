@@ -10,7 +10,7 @@
 #include "shared/behavior/social_force.hpp"
 #include "sim/circle.hpp"
 #include "sim/sim_observer.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

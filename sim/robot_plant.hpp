@@ -6,7 +6,7 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/control/diff_drive.hpp"
 #include "shared/control/plant_model.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

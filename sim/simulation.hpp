@@ -16,7 +16,7 @@
 #include "sim/robot_plant.hpp"
 #include "sim/sim_observer.hpp"
 #include "sim/ultrasonic_model.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

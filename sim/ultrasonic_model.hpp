@@ -11,7 +11,7 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/control/diff_drive.hpp"
 #include "sim/circle.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

@@ -8,7 +8,7 @@
 #include "inspect/v1/link.pb.h"
 #include "shared/robot/awareness.hpp"
 #include "shared/robot/robot_core.hpp"
-#include "sim/robot_map.hpp"
+#include "shared/world/robot_map.hpp"
 #include "shared/behavior/pattern_classifier.hpp"
 #include "shared/behavior/speed_strategy.hpp"
 #include "shared/serial/frame_codec.hpp"
@@ -155,7 +155,7 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
   behavior::AwarenessConfig acfg = ctx.awareness;
   acfg.enabled = true;
   acfg.policy = opt.policy;
-  auto awareness = robot::makeAwareness(ctx.robot, acfg, sim::mapFromWorld(world), "scenario behaviour config");
+  auto awareness = robot::makeAwareness(ctx.robot, acfg, world::mapFromWorld(world), "scenario behaviour config");
   const behavior::HumanAwareness* aw = awareness.get();
   core.setAwareness(std::move(awareness));
   core.onSerialState(true, 0.0);

@@ -17,7 +17,7 @@
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 namespace inspect::sim {
 

@@ -10,7 +10,7 @@
 #include "pc_server/console/text_util.hpp"
 #include "shared/record/csv_export.hpp"
 #include "shared/record/mcap_reader.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 
 namespace inspect::server {
 
@@ -105,7 +105,7 @@ bool Console::cmdReport(const Args& args, const std::string&, int) {
       if (f.kind != "map" || in.have_map) continue;
       // The site map of an inspection route: walls and obstacle edges in the world frame.
       try {
-        const auto w = sim::loadWorldFile(f.path);
+        const auto w = world::loadWorldFile(f.path);
         for (const auto& s : w.walls) in.walls.push_back({s.a.x_m, s.a.y_m, s.b.x_m, s.b.y_m});
         for (const auto& o : w.obstacles)
           for (std::size_t i = 0; i < o.polygon.vertices.size(); ++i) {

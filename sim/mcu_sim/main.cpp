@@ -11,7 +11,7 @@
 #include "sim/mcu_sim/sim_options.hpp"
 #include "sim/simulation.hpp"
 #include "sim/mcu_sim/truth_log.hpp"
-#include "sim/world.hpp"
+#include "sim/world_names.hpp"
 
 using namespace inspect;
 

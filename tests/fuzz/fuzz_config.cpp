@@ -15,12 +15,12 @@
 #include "pc_server/console/route_file.hpp"
 #include "pc_server/app/server_config.hpp"
 #include "robot_client/client_config.hpp"
-#include "sim/robot_map.hpp"
+#include "shared/world/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 #include "tests/fuzz/fuzz_records.hpp"
 #include "tests/support/paths.hpp"
 
@@ -56,11 +56,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   tryLoad(text, [](const config::ConfigNode& root) { (void)behavior::loadAwarenessConfig(root, kConfigDir); });
   tryLoad(text, [](const config::ConfigNode& root) { (void)server::loadServerConfig(root); });
   tryLoad(text, [](const config::ConfigNode& root) {
-    const sim::World w = sim::loadWorld(root);
+    const world::World w = world::loadWorld(root);
     root.checkKnown();
-    (void)sim::mapFromWorld(w);
-    (void)sim::solidBounds(w);
-    sim::checkStartPose(w, 0.2);
+    (void)world::mapFromWorld(w);
+    (void)world::solidBounds(w);
+    world::checkStartPose(w, 0.2);
   });
   try {
     const server::Route r = server::loadRouteText(text, "fuzz.yaml");

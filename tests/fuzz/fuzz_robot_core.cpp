@@ -32,7 +32,7 @@
 #include "inspect/v1/link.pb.h"
 #include "robot_client/client_config.hpp"
 #include "shared/robot/robot_core.hpp"
-#include "sim/robot_map.hpp"
+#include "shared/world/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/behavior/speed_strategy.hpp"
 #include "shared/config/control_config.hpp"
@@ -42,7 +42,7 @@
 #include "shared/serial/crc16.hpp"
 #include "shared/serial/frame_codec.hpp"
 #include "shared/util/log.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 #include "tests/fuzz/fuzz_records.hpp"
 #include "tests/support/paths.hpp"
 
@@ -158,7 +158,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   s->awareness = behavior::loadAwarenessConfigFile(dir + "behavior.yaml");
   s->strategy = std::make_unique<behavior::SpeedStrategy>(
       behavior::loadSpeedStrategy(s->awareness.speed_fis, s->awareness.speed));
-  s->map = sim::mapFromWorld(sim::loadWorldFile(dir + "worlds/gas_lab.yaml"));
+  s->map = world::mapFromWorld(world::loadWorldFile(dir + "worlds/gas_lab.yaml"));
   g_setup = s;
   return 0;
 }

@@ -20,7 +20,7 @@
 #include "shared/navigation/navigator.hpp"
 #include "sim/robot_plant.hpp"
 #include "sim/ultrasonic_model.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 #include "tests/support/paths.hpp"
 
 using namespace inspect;
@@ -34,8 +34,8 @@ namespace {
 constexpr double kDt = 0.01;          // 100 Hz, the robot's control rate
 constexpr double kNoCollisionGap = 0.1;  // body edge to the nearest wall, m: "never closer than body + margin"
 
-sim::World worldOf(const std::string& yaml) {
-  return sim::loadWorldText(yaml, "nav_test_world.yaml");
+world::World worldOf(const std::string& yaml) {
+  return world::loadWorldText(yaml, "nav_test_world.yaml");
 }
 
 bool following(Mode m) { return m == Mode::kFollowCw || m == Mode::kFollowCcw; }
@@ -70,7 +70,7 @@ struct RunSpec {
 };
 
 NavRun runNav(const RunSpec& spec) {
-  const sim::World world = worldOf(spec.world_yaml);
+  const world::World world = worldOf(spec.world_yaml);
   const config::RobotConfig robot;
   const sim::RobotPlant plant(robot, world);
   sim::UltrasonicModel sonar(robot.ultrasonic, spec.seed);
@@ -122,7 +122,7 @@ NavRun runNav(const RunSpec& spec) {
     r.poses.push_back(st.pose);
     r.blocked = r.blocked || ps.blocked;
     r.path_m += std::hypot(st.pose.x_m - before.x_m, st.pose.y_m - before.y_m);
-    const double gap = sim::clearance(world, {st.pose.x_m, st.pose.y_m}) - body;
+    const double gap = world::clearance(world, {st.pose.x_m, st.pose.y_m}) - body;
     r.min_gap_m = std::min(r.min_gap_m, gap);
     r.last = out;
     if (trace.is_open())

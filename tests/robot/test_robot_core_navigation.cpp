@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "shared/robot/robot_core.hpp"
-#include "sim/robot_map.hpp"
+#include "shared/world/robot_map.hpp"
 #include "shared/behavior/human_awareness.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 #include "tests/support/paths.hpp"
 
 using namespace inspect;
@@ -395,7 +395,7 @@ TEST(RobotCoreNavigation, PeopleSlowAndStopTheRobotOnItsWayEq9) {
 
 TEST(RobotMap, WallsAndObstacleEdgesMoveIntoTheOdometryFrame) {
   // Start at (2, 4) facing +y: odometry x = world +y, odometry y = world -x.
-  const sim::World w = sim::loadWorldText(R"(name: map_test
+  const world::World w = world::loadWorldText(R"(name: map_test
 start: {x_m: 2.0, y_m: 4.0, theta_rad: 1.5707963267948966}
 walls:
   - {from_m: [2.0, 6.0], to_m: [4.0, 6.0]}
@@ -403,7 +403,7 @@ obstacles:
   - vertices_m: [1.0, 5.0,  1.5, 5.0,  1.5, 5.5]
 )",
                                           "map_test.yaml");
-  const auto map = sim::mapFromWorld(w);
+  const auto map = world::mapFromWorld(w);
   ASSERT_EQ(map.size(), 4u) << "one wall and three obstacle edges";
   EXPECT_NEAR(map[0].x0, 2.0, 1e-12);
   EXPECT_NEAR(map[0].y0, 0.0, 1e-12);
@@ -417,7 +417,7 @@ obstacles:
   }
   EXPECT_TRUE(corner);
   // The start pose itself is the odometry origin: an empty world gives an empty map.
-  EXPECT_TRUE(sim::mapFromWorld(sim::loadWorldText("name: empty\n", "empty.yaml")).empty());
+  EXPECT_TRUE(world::mapFromWorld(world::loadWorldText("name: empty\n", "empty.yaml")).empty());
 }
 
 TEST(RobotCoreNavigation, AGoalWithoutProgressIsGivenUpWithFailed) {

@@ -173,7 +173,7 @@ TEST(ScenarioSuite, TrackingStopsBeforeABoxOnItsPath) {
   // Not a person: the Eq 9 factor does nothing, the front-sonar obstacle stop must.
   sim::ScenarioSpec spec;
   spec.name = "box_on_path";
-  spec.world = sim::loadWorldText(R"(name: box_on_path
+  spec.world = world::loadWorldText(R"(name: box_on_path
 start: {x_m: 0, y_m: 0, theta_rad: 0}
 obstacles:
   - {name: box, vertices_m: [3.0, -0.5,  3.6, -0.5,  3.6, 0.5,  3.0, 0.5]}

@@ -26,13 +26,14 @@
 #include "sim/gas_sensor.hpp"
 #include "sim/simulation.hpp"
 #include "sim/mcu_sim/truth_log.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 #include "tests/sim/world_text.hpp"
 #include "tests/support/paths.hpp"
 #include "tests/sim/sensor_frames.hpp"
 
 using namespace inspect;
 using namespace inspect::sim;
+using namespace inspect::world;
 
 namespace {
 

@@ -8,11 +8,11 @@
 #include <optional>
 #include <string>
 
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 #include "tests/sim/world_text.hpp"
 #include "tests/support/paths.hpp"
 
-using namespace inspect::sim;
+using namespace inspect::world;
 using inspect::config::ConfigError;
 using inspect::config::ConfigNode;
 

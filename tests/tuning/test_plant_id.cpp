@@ -24,7 +24,7 @@
 #include "shared/control/wheel_profile.hpp"
 #include "shared/record/mcap_writer.hpp"
 #include "sim/robot_plant.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 
 namespace fs = std::filesystem;
 using namespace inspect;
@@ -44,7 +44,7 @@ struct Recording {
 // 50 Hz with +-2 ms jitter and +-0.01 rad/s uniform speed noise.
 Recording recordRun(const control::PlantModel& plant, uint32_t seed, double noise_rad_s = 0.01) {
   const config::RobotConfig robot;
-  const sim::World world{};
+  const world::World world{};
   const sim::RobotPlant motors(robot, world, plant);
   control::SetpointDelay delay(plant.left.dead_time_s, plant.right.dead_time_s);
   const auto profile = control::WheelProfile::standardIdentification(2.0, 5.0);

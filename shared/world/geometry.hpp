@@ -2,9 +2,10 @@
 // Planar geometry for the world simulation: points, segments, simple polygons,
 // ray casting and distances. Pure functions, table-tested.
 #include <optional>
+#include <string>
 #include <vector>
 
-namespace inspect::sim {
+namespace inspect::world {
 
 /// A point or vector in the world frame, metres.
 struct Vec2 {
@@ -18,6 +19,9 @@ inline Vec2 operator*(double k, Vec2 a) { return {k * a.x_m, k * a.y_m}; }
 inline double dot(Vec2 a, Vec2 b) { return a.x_m * b.x_m + a.y_m * b.y_m; }
 /// z component of the 3-D cross product (positive when b is CCW of a).
 inline double cross(Vec2 a, Vec2 b) { return a.x_m * b.y_m - a.y_m * b.x_m; }
+
+/// "(x, y)" for messages ("%g").
+std::string pointText(Vec2 p);
 
 /// A straight line segment from a to b.
 struct Segment {
@@ -53,4 +57,4 @@ double signedArea(const Polygon& poly);
 bool segmentsIntersect(const Segment& s, const Segment& t);
 
 }  // namespace geom
-}  // namespace inspect::sim
+}  // namespace inspect::world

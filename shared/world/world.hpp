@@ -10,11 +10,11 @@
 #include "shared/config/config_node.hpp"
 #include "shared/control/diff_drive.hpp"
 #include "shared/control/plant_model.hpp"
-#include "sim/gas_spec.hpp"
-#include "sim/geometry.hpp"
-#include "sim/pedestrian_script.hpp"
+#include "shared/world/gas_spec.hpp"
+#include "shared/world/geometry.hpp"
+#include "shared/world/pedestrian_script.hpp"
 
-namespace inspect::sim {
+namespace inspect::world {
 
 /// World coordinates (walls, obstacles, people, gas sources) stay within
 /// +-kMaxCoord_m, a sane box that also keeps float error small.
@@ -78,4 +78,4 @@ World loadWorldText(const std::string& yaml, const std::string& name);
 /// body_radius_m at the start pose would overlap a wall or obstacle.
 void checkStartPose(const World& world, double body_radius_m);
 
-}  // namespace inspect::sim
+}  // namespace inspect::world

@@ -1,8 +1,8 @@
-#include "sim/robot_map.hpp"
+#include "shared/world/robot_map.hpp"
 
 #include <cmath>
 
-namespace inspect::sim {
+namespace inspect::world {
 
 std::vector<behavior::MapSegment> mapFromWorld(const World& w) {
   // Odometry starts at (0, 0, 0) where the robot stands at start-up, so a
@@ -20,4 +20,4 @@ std::vector<behavior::MapSegment> mapFromWorld(const World& w) {
   return map;
 }
 
-}  // namespace inspect::sim
+}  // namespace inspect::world

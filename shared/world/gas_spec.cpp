@@ -1,11 +1,11 @@
-#include "sim/gas_spec.hpp"
+#include "shared/world/gas_spec.hpp"
 
 #include <cmath>
 #include <cstdio>
 
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 
-namespace inspect::sim {
+namespace inspect::world {
 namespace {
 
 using config::ConfigNode;
@@ -20,12 +20,6 @@ bool validName(const std::string& s, std::size_t max_len, bool allow_dot) {
     if (!ok) return false;
   }
   return true;
-}
-
-std::string fmtPoint(Vec2 p) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "(%g, %g)", p.x_m, p.y_m);
-  return buf;
 }
 
 // end_s: absent = never ends.
@@ -55,12 +49,12 @@ GasSource readSource(const ConfigNode& n, std::size_t index, const World& world,
   if (!box) n.fail("x_m", "a world with leaks needs walls or obstacles (the gas grid covers their bounding box)");
   const Vec2 p = s.position;
   if (p.x_m <= box->lo.x_m || p.x_m >= box->hi.x_m || p.y_m <= box->lo.y_m || p.y_m >= box->hi.y_m)
-    n.fail("x_m", "leak at " + fmtPoint(p) + " lies outside the walls' bounding box " + fmtPoint(box->lo) + " .. " +
-                      fmtPoint(box->hi));
+    n.fail("x_m", "leak at " + pointText(p) + " lies outside the walls' bounding box " + pointText(box->lo) + " .. " +
+                      pointText(box->hi));
   for (const auto& o : world.obstacles)
     if (geom::pointInPolygon(p, o.polygon))
-      n.fail("x_m", "leak at " + fmtPoint(p) + " lies inside obstacle '" + o.name + "'");
-  if (clearance(world, p) < 1e-6) n.fail("x_m", "leak at " + fmtPoint(p) + " lies on a wall or obstacle edge");
+      n.fail("x_m", "leak at " + pointText(p) + " lies inside obstacle '" + o.name + "'");
+  if (clearance(world, p) < 1e-6) n.fail("x_m", "leak at " + pointText(p) + " lies on a wall or obstacle edge");
   return s;
 }
 
@@ -104,4 +98,4 @@ GasSpec readGasSpec(const ConfigNode& root, const World& world) {
   return g;
 }
 
-}  // namespace inspect::sim
+}  // namespace inspect::world

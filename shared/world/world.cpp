@@ -1,4 +1,4 @@
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <limits>
 #include <sstream>
 
-namespace inspect::sim {
+namespace inspect::world {
 namespace {
 
 using config::ConfigNode;
@@ -220,4 +220,4 @@ void checkStartPose(const World& world, double body_radius_m) {
   }
 }
 
-}  // namespace inspect::sim
+}  // namespace inspect::world

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "shared/config/config_node.hpp"
-#include "sim/geometry.hpp"
+#include "shared/world/geometry.hpp"
 
-namespace inspect::sim {
+namespace inspect::world {
 
 struct World;
 
@@ -57,4 +57,4 @@ inline constexpr double kGasMaxPreRunNoVentilation_s = 600.0;
 /// on a wall). Throws config::ConfigError naming file, key and reason.
 GasSpec readGasSpec(const config::ConfigNode& root, const World& world);
 
-}  // namespace inspect::sim
+}  // namespace inspect::world

@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "shared/config/config_node.hpp"
-#include "sim/geometry.hpp"
+#include "shared/world/geometry.hpp"
 
-namespace inspect::sim {
+namespace inspect::world {
 
 struct World;
 
@@ -35,4 +35,4 @@ struct PedestrianScript {
 /// naming file, key and reason.
 std::vector<PedestrianScript> readPedestrianScripts(const config::ConfigNode& root, const World& world);
 
-}  // namespace inspect::sim
+}  // namespace inspect::world

@@ -1,9 +1,21 @@
-#include "sim/geometry.hpp"
+#include "shared/world/geometry.hpp"
+
+#include <cstdio>
 
 #include <algorithm>
 #include <cmath>
 
-namespace inspect::sim::geom {
+namespace inspect::world {
+
+std::string pointText(Vec2 p) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "(%g, %g)", p.x_m, p.y_m);
+  return buf;
+}
+
+}  // namespace inspect::world
+
+namespace inspect::world::geom {
 
 std::optional<double> raySegment(Vec2 origin, Vec2 dir, const Segment& s) {
   const Vec2 e = s.b - s.a;
@@ -73,4 +85,4 @@ bool segmentsIntersect(const Segment& s, const Segment& t) {
   return false;
 }
 
-}  // namespace inspect::sim::geom
+}  // namespace inspect::world::geom

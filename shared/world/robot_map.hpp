@@ -4,13 +4,13 @@
 #include <vector>
 
 #include "shared/behavior/human_tracker.hpp"
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 
-namespace inspect::sim {
+namespace inspect::world {
 
 /// Every wall segment and obstacle edge of `w` (solidEdges), moved from
 /// the world frame into the odometry frame of a robot started at `w.start`
 /// (origin and x axis = the start pose), ready for behavior::HumanAwareness.
 std::vector<behavior::MapSegment> mapFromWorld(const World& w);
 
-}  // namespace inspect::sim
+}  // namespace inspect::world

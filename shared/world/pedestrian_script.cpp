@@ -1,11 +1,11 @@
-#include "sim/pedestrian_script.hpp"
+#include "shared/world/pedestrian_script.hpp"
 
 #include <cmath>
 #include <cstdio>
 
-#include "sim/world.hpp"
+#include "shared/world/world.hpp"
 
-namespace inspect::sim {
+namespace inspect::world {
 namespace {
 
 
@@ -17,12 +17,6 @@ bool validId(const std::string& id) {
     if (!ok) return false;
   }
   return true;
-}
-
-std::string fmtPoint(Vec2 p) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "(%g, %g)", p.x_m, p.y_m);
-  return buf;
 }
 
 PedestrianScript readOne(const config::ConfigNode& n, std::size_t index, const World& world) {
@@ -53,7 +47,7 @@ PedestrianScript readOne(const config::ConfigNode& n, std::size_t index, const W
   for (std::size_t i = 0; i < s.route.size(); ++i) {
     const double c = clearance(world, s.route[i]);
     if (c < s.radius_m)
-      n.fail("route_m", "point " + std::to_string(i) + " " + fmtPoint(s.route[i]) + " is closer than radius_m (" +
+      n.fail("route_m", "point " + std::to_string(i) + " " + pointText(s.route[i]) + " is closer than radius_m (" +
                             std::to_string(s.radius_m) + " m) to a wall or inside an obstacle");
   }
   if (s.loop && s.route.size() < 2) n.fail("loop", "a looping route needs at least 2 points");
@@ -86,4 +80,4 @@ std::vector<PedestrianScript> readPedestrianScripts(const config::ConfigNode& ro
   return out;
 }
 
-}  // namespace inspect::sim
+}  // namespace inspect::world

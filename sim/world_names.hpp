@@ -1,0 +1,49 @@
+#pragma once
+// The world file's types (shared/world) under the simulator's own names:
+// the simulator reads and simulates worlds, the world format is a library
+// below it (docs/architecture.md).
+#include "shared/world/gas_spec.hpp"
+#include "shared/world/geometry.hpp"
+#include "shared/world/pedestrian_script.hpp"
+#include "shared/world/world.hpp"
+
+namespace inspect::sim {
+
+using world::Bounds;
+using world::castRay;
+using world::checkStartPose;
+using world::clearance;
+using world::FloorLine;
+using world::GasFaultKind;
+using world::GasFault;
+using world::GasSource;
+using world::GasSpec;
+using world::kGasMaxPreRunNoVentilation_s;
+using world::kMaxCoord_m;
+using world::loadWorld;
+using world::loadWorldFile;
+using world::loadWorldText;
+using world::Obstacle;
+using world::onFloorLine;
+using world::PedestrianPause;
+using world::PedestrianScript;
+using world::Polygon;
+using world::readGasSpec;
+using world::readPedestrianScripts;
+using world::Segment;
+using world::solidBounds;
+using world::solidEdges;
+using world::Vec2;
+using world::World;
+using world::pointText;
+
+namespace geom {
+using world::geom::edgesOf;
+using world::geom::pointInPolygon;
+using world::geom::pointSegmentDistance;
+using world::geom::raySegment;
+using world::geom::segmentsIntersect;
+using world::geom::signedArea;
+}  // namespace geom
+
+}  // namespace inspect::sim
