@@ -3,7 +3,7 @@
 // files: serial frames from the FrameEncoder, Hello/telemetry/events/acks
 // from RobotCore as robot_client sends them, commands as pc_server sends
 // them (the real route files), RTP packets of the real H.264 encoder, the
-// .fis files of config/fuzzy and tests/fuzzy/data, the YAML of config/.
+// .fis files of config/fuzzy and tests/shared/fuzzy/data, the YAML of config/.
 // Run once from the source root after a change of a wire format:
 //   build-asan/bin/fuzz_make_seeds tests/fuzz
 // Not a test; the seeds are committed.
@@ -496,7 +496,7 @@ int main(int argc, char** argv) {
   linkServerSeeds();
   robotCoreSeeds();
   rtpSeeds();
-  copyFiles("fis", {kSrc + "/config/fuzzy", kSrc + "/tests/fuzzy/data"}, ".fis");
+  copyFiles("fis", {kSrc + "/config/fuzzy", kSrc + "/tests/shared/fuzzy/data"}, ".fis");
   copyFiles("config", {kSrc + "/config", kSrc + "/config/worlds", kSrc + "/config/routes"}, ".yaml");
   dictionaries();
   std::cout << "seeds written under " << g_out << "\n";

@@ -1,0 +1,529 @@
+// link_load: load generator for the robot <-> server link (docs/load.md).
+//
+// For each fleet size N it starts one real pc_server (mutual TLS, recording
+// on into a temporary runs directory, no video), connects N simulated robots
+// (tests/system/link/sim_robot.hpp: Hello, heartbeats every 100 ms, telemetry at
+// --hz with realistic content and sequence numbers, an Ack for every
+// command, each robot with its own certificate), starts a recorded run for
+// every robot from the console, and measures over --seconds:
+//   - server CPU (utime + stime from /proc/<pid>/stat) and RSS (VmRSS sampled,
+//     VmHWM), the generator's own CPU;
+//   - telemetry latency: Envelope.send_time_us (the generator's CLOCK_MONOTONIC)
+//     to the server's receive time, which the MCAP recording keeps as each
+//     message's log_time (the receive time on CLOCK_MONOTONIC as wall-clock ns:
+//     this machine's CLOCK_REALTIME - CLOCK_MONOTONIC is subtracted again);
+//   - drops: every telemetry sequence number sent must be in the recording
+//     exactly once;
+//   - bytes/s (protobuf frames, and bytes written to the TLS sockets).
+// Prints a table and, with --json FILE, writes the figures. Exit status 0 when
+// nothing was lost and every robot stayed connected, 1 otherwise, 2 for a bad
+// command line.
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+
+#include "shared/util/clock.hpp"
+#include "tests/support/process.hpp"
+#include "tests/system/link/server_harness.hpp"
+#include "tests/system/link/sim_robot.hpp"
+#include "tests/support/test_certs.hpp"
+
+namespace {
+
+namespace asio = boost::asio;
+using namespace inspect;
+using namespace inspect::linktest;
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+  std::vector<int> robots = {1, 10, 25, 50};
+  double seconds = 20.0;
+  double warmup_s = 2.0;
+  double idle_s = 2.0;
+  double hz = 100.0;
+  int threads = 1;
+  bool commands = true;  // one `stop` per robot through the console (acked)
+  std::string json;
+  std::string config;  // pc_server --config ("" = config/server.yaml)
+};
+
+void usage(std::ostream& o) {
+  o << "link_load [--robots 1,10,25,50] [--seconds 20] [--warmup 2] [--idle 2] [--hz 100] [--threads 1]\n"
+       "          [--no-commands] [--config FILE] [--json FILE]\n"
+       "  For each fleet size: one real pc_server (TLS, recording on), N simulated robots at --hz telemetry.\n"
+       "  --robots   fleet sizes, comma separated (1-500 each)\n"
+       "  --seconds  measurement window per fleet size (after --warmup seconds of telemetry)\n"
+       "  --idle     server measured idle this long before the robots connect (its baseline)\n"
+       "  --threads  generator io threads (robots spread over them)\n"
+       "  --no-commands  no console `stop` to each robot (by default each robot gets one and acks it)\n"
+       "  --json     write every figure to FILE\n"
+       "  Exit status: 0 = no telemetry lost and every robot stayed connected; 1 = not; 2 = bad arguments.\n"
+       "  KEEP_TEST_DIRS=1 keeps the server's directories (logs, runs) under $TMPDIR.\n";
+}
+
+bool parse(int argc, char** argv, Options& o) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+      return argv[++i];
+    };
+    try {
+      if (a == "--robots") {
+        o.robots.clear();
+        std::stringstream ss(value());
+        std::string item;
+        while (std::getline(ss, item, ',')) {
+          const int n = std::stoi(item);
+          if (n < 1 || n > 500) throw std::invalid_argument("--robots: " + item + " is not in [1, 500]");
+          o.robots.push_back(n);
+        }
+        if (o.robots.empty()) throw std::invalid_argument("--robots: empty list");
+      } else if (a == "--seconds") {
+        o.seconds = std::stod(value());
+        if (!(o.seconds >= 1 && o.seconds <= 3600)) throw std::invalid_argument("--seconds must be in [1, 3600]");
+      } else if (a == "--warmup") {
+        o.warmup_s = std::stod(value());
+        if (!(o.warmup_s >= 0 && o.warmup_s <= 60)) throw std::invalid_argument("--warmup must be in [0, 60]");
+      } else if (a == "--idle") {
+        o.idle_s = std::stod(value());
+        if (!(o.idle_s >= 0.5 && o.idle_s <= 60)) throw std::invalid_argument("--idle must be in [0.5, 60]");
+      } else if (a == "--hz") {
+        o.hz = std::stod(value());
+        if (!(o.hz >= 1 && o.hz <= 1000)) throw std::invalid_argument("--hz must be in [1, 1000]");
+      } else if (a == "--threads") {
+        o.threads = std::stoi(value());
+        if (o.threads < 1 || o.threads > 16) throw std::invalid_argument("--threads must be in [1, 16]");
+      } else if (a == "--no-commands") {
+        o.commands = false;
+      } else if (a == "--json") {
+        o.json = value();
+      } else if (a == "--config") {
+        o.config = value();
+      } else if (a == "-h" || a == "--help") {
+        usage(std::cout);
+        std::exit(0);
+      } else {
+        throw std::invalid_argument("unknown argument '" + a + "'");
+      }
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "link_load: " << e.what() << " (see --help)\n";
+      return false;
+    } catch (const std::out_of_range&) {
+      std::cerr << "link_load: " << a << ": number out of range\n";
+      return false;
+    }
+  }
+  return true;
+}
+
+double cpuSecondsSelf() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+double percentile(std::vector<int64_t>& v, double p) {
+  if (v.empty()) return NAN;
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(p * static_cast<double>(v.size())) - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return static_cast<double>(v[k]);
+}
+
+double loadAverage() {
+  double l[3] = {0, 0, 0};
+  return ::getloadavg(l, 3) > 0 ? l[0] : NAN;
+}
+
+struct Result {
+  int robots = 0;
+  bool ok = false;
+  std::string error;
+  double window_s = 0;
+  double server_cpu_idle_pct = 0, server_cpu_pct = 0, gen_cpu_pct = 0;
+  double rss_idle_mb = 0, rss_end_mb = 0, rss_peak_mb = 0, hwm_mb = 0;
+  uint64_t server_threads = 0;
+  double lat_p50_ms = NAN, lat_p99_ms = NAN, lat_max_ms = NAN, lat_min_ms = NAN;
+  uint64_t lat_samples = 0;
+  uint64_t sent = 0, recorded = 0, missing = 0, duplicates = 0, out_of_order = 0;
+  double tlm_hz_per_robot = 0;
+  double app_bytes_per_s = 0, wire_bytes_per_s = 0, wire_down_bytes_per_s = 0, mcap_bytes = 0, mcap_bytes_per_s = 0;
+  double mcap_bytes_per_msg = 0;
+  double msg_bytes = 0;  // mean telemetry frame
+  double hb_rx_hz_per_robot = 0, max_hb_gap_ms = 0;
+  uint64_t commands = 0, acks = 0, robots_closed = 0;
+  double clock_offset_drift_us = 0;
+  double drain_s = 0;  // from the end of telemetry until the server had processed all of it
+  double load_avg = NAN;
+  std::vector<nlohmann::json> per_robot;
+};
+
+Result runOne(const Options& opt, int n) {
+  Result r;
+  r.robots = n;
+  test::TempDir dir("link_load_" + std::to_string(n));
+  std::vector<std::string> ids;
+  for (int i = 1; i <= n; ++i) ids.push_back(robotId("load", i));
+  std::string certs;
+  try {
+    certs = test::testCertsDir(ids);
+  } catch (const std::exception& e) {
+    r.error = e.what();
+    return r;
+  }
+
+  ServerUnderTest server;
+  if (!server.start({dir.path(), certs, opt.config, {}})) {
+    r.error = "pc_server did not start: " + server.error();
+    return r;
+  }
+  const double tck = clockTicksPerSecond();
+
+  // Idle baseline: the server with no robot.
+  test::sleepS(0.5);
+  const auto idle0 = sampleProc(server.pid());
+  const auto ti0 = Clock::now();
+  test::sleepS(opt.idle_s);
+  const auto idle1 = sampleProc(server.pid());
+  const double idle_wall = std::chrono::duration<double>(Clock::now() - ti0).count();
+  r.server_cpu_idle_pct = 100.0 * static_cast<double>(idle1.cpu_ticks - idle0.cpu_ticks) / tck / idle_wall;
+  r.rss_idle_mb = static_cast<double>(idle1.rss_kb) / 1024.0;
+
+  // The generator: robots spread over io_contexts with a thread each.
+  std::vector<std::unique_ptr<asio::io_context>> iocs;
+  std::vector<asio::executor_work_guard<asio::io_context::executor_type>> guards;
+  std::vector<std::thread> threads;
+  for (int t = 0; t < opt.threads; ++t) {
+    iocs.push_back(std::make_unique<asio::io_context>(1));
+    guards.push_back(asio::make_work_guard(*iocs.back()));
+  }
+  for (auto& ioc : iocs) threads.emplace_back([&ioc] { ioc->run(); });
+  auto stopGenerator = [&] {
+    for (auto& g : guards) g.reset();
+    for (auto& ioc : iocs) ioc->stop();
+    for (auto& t : threads)
+      if (t.joinable()) t.join();
+  };
+
+  std::vector<std::shared_ptr<SimRobot>> robots;
+  auto fail = [&](const std::string& why) {
+    r.error = why;
+    for (auto& rb : robots) rb->close();
+    test::sleepS(0.2);
+    stopGenerator();
+    const auto st = server.quit(10.0);
+    r.error += st ? " (pc_server exit status " + std::to_string(*st) + ")" : " (pc_server killed after 10 s)";
+    return r;
+  };
+  try {
+    for (int i = 0; i < n; ++i) {
+      SimRobotOptions so;
+      so.id = ids[i];
+      so.certs_dir = certs;
+      so.port = server.port();
+      so.telemetry_hz = opt.hz;
+      so.seed = static_cast<uint32_t>(1000 + i);
+      robots.push_back(std::make_shared<SimRobot>(*iocs[static_cast<std::size_t>(i % opt.threads)], so));
+      robots.back()->start();
+    }
+  } catch (const std::exception& e) {
+    return fail(std::string("robot start: ") + e.what());
+  }
+  const bool all_up = test::waitUntil(
+      [&] {
+        return std::all_of(robots.begin(), robots.end(),
+                           [](const auto& rb) { return rb->stats().accepted || rb->stats().closed; });
+      },
+      30.0);
+  for (const auto& rb : robots)
+    if (!rb->stats().accepted)
+      return fail(rb->id() + " not accepted" + (all_up ? ": " + rb->closeReason() : " within 30 s"));
+
+  if (!server.recordStart(ids, "link_load", 30.0)) return fail("record start not confirmed within 30 s");
+  // One command per robot through the console (acked by the robot, recorded in its run).
+  for (const auto& id : ids) {
+    if (!opt.commands) break;
+    server.console("select " + id);
+    server.console("stop");
+  }
+  if (opt.commands) test::waitUntil(
+      [&] {
+        return std::all_of(robots.begin(), robots.end(), [](const auto& rb) { return rb->stats().acks_sent >= 1; });
+      },
+      10.0 + 0.2 * n);
+
+  for (auto& rb : robots) rb->startTelemetry();
+  test::sleepS(opt.warmup_s);
+  for (auto& rb : robots) rb->resetHeartbeatGap();
+
+  // The measurement window.
+  std::vector<uint64_t> sent0, hb0;
+  uint64_t app0 = 0, wire_up0 = 0, wire_down0 = 0;
+  for (const auto& rb : robots) {
+    const auto tb = rb->tcpBytes();
+    wire_up0 += tb.sent_acked;
+    wire_down0 += tb.received;
+    sent0.push_back(rb->stats().telemetry_sent);
+    hb0.push_back(rb->stats().heartbeats_received);
+    app0 += rb->stats().app_bytes_sent;
+  }
+  const int64_t offset0 = wallMinusMonoNs();
+  const uint64_t t0_us = monoNowUs();
+  const auto w0 = Clock::now();
+  const auto s0 = sampleProc(server.pid());
+  const double gcpu0 = cpuSecondsSelf();
+  uint64_t peak_rss_kb = s0.rss_kb;
+  while (Clock::now() - w0 < std::chrono::duration<double>(opt.seconds)) {
+    test::sleepS(0.25);
+    const auto s = sampleProc(server.pid());
+    if (!s.ok) break;  // the server died: reported below
+    peak_rss_kb = std::max(peak_rss_kb, s.rss_kb);
+  }
+  const auto s1 = sampleProc(server.pid());
+  const double gcpu1 = cpuSecondsSelf();
+  const uint64_t t1_us = monoNowUs();
+  r.window_s = std::chrono::duration<double>(Clock::now() - w0).count();
+  const int64_t offset1 = wallMinusMonoNs();
+  r.load_avg = loadAverage();
+  if (!s1.ok) return fail("pc_server is gone during the measurement:\n" + server.log());
+  uint64_t app1 = 0, sent_window = 0, hb_window = 0, wire_up1 = 0, wire_down1 = 0;
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const auto tb = robots[i]->tcpBytes();
+    wire_up1 += tb.sent_acked;
+    wire_down1 += tb.received;
+    app1 += robots[i]->stats().app_bytes_sent;
+    sent_window += robots[i]->stats().telemetry_sent - sent0[i];
+    hb_window += robots[i]->stats().heartbeats_received - hb0[i];
+  }
+  r.server_cpu_pct = 100.0 * static_cast<double>(s1.cpu_ticks - s0.cpu_ticks) / tck / r.window_s;
+  r.gen_cpu_pct = 100.0 * (gcpu1 - gcpu0) / r.window_s;
+  r.rss_end_mb = static_cast<double>(s1.rss_kb) / 1024.0;
+  r.rss_peak_mb = static_cast<double>(std::max(peak_rss_kb, s1.rss_kb)) / 1024.0;
+  r.hwm_mb = static_cast<double>(s1.hwm_kb) / 1024.0;
+  r.server_threads = s1.threads;
+  r.app_bytes_per_s = static_cast<double>(app1 - app0) / r.window_s;
+  r.wire_bytes_per_s = static_cast<double>(wire_up1 - wire_up0) / r.window_s;
+  r.wire_down_bytes_per_s = static_cast<double>(wire_down1 - wire_down0) / r.window_s;
+  r.tlm_hz_per_robot = static_cast<double>(sent_window) / r.window_s / n;
+  r.hb_rx_hz_per_robot = static_cast<double>(hb_window) / r.window_s / n;
+  r.clock_offset_drift_us = static_cast<double>(offset1 - offset0) / 1000.0;
+
+  // Drain (every robot's last message processed by the server), end the runs, disconnect.
+  for (auto& rb : robots) rb->stopTelemetry();
+  const auto td0 = Clock::now();
+  const bool drained = server.drain(robots, "link_load drain", 60.0);
+  r.drain_s = std::chrono::duration<double>(Clock::now() - td0).count();
+  int64_t max_gap_us = 0;
+  for (const auto& rb : robots) {
+    max_gap_us = std::max<int64_t>(max_gap_us, rb->stats().max_heartbeat_gap_us);
+    r.commands += rb->stats().commands_received;
+    r.acks += rb->stats().acks_sent;
+    r.robots_closed += rb->stats().closed ? 1 : 0;
+  }
+  r.max_hb_gap_ms = static_cast<double>(max_gap_us) / 1000.0;
+  const bool stopped = server.recordStop(ids, 30.0);
+  if (!drained) r.error = "the server did not process the robots' drain markers within 60 s; ";
+  for (auto& rb : robots) rb->close();
+  test::sleepS(0.3);
+  stopGenerator();
+  const auto exit_status = server.quit(15.0);
+  if (!stopped) {
+    r.error += "record stop not confirmed within 30 s";
+    return r;
+  }
+
+  // Read the recordings back.
+  std::vector<int64_t> lat_us;
+  const int64_t offset = (offset0 + offset1) / 2;
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const auto& rb = robots[i];
+    const std::string path = server.mcapPath(rb->id());
+    std::vector<RecordedTelemetry> rec;
+    try {
+      rec = readTelemetry(path);
+    } catch (const std::exception& e) {
+      r.error = rb->id() + ": " + e.what();
+      return r;
+    }
+    const auto c = checkSequence(rec, rb->stats().telemetry_sent);
+    r.sent += c.sent;
+    r.recorded += c.recorded;
+    r.missing += c.missing;
+    r.duplicates += c.duplicates;
+    r.out_of_order += c.out_of_order;
+    for (const auto& m : rec) {
+      if (m.send_us < t0_us || m.send_us > t1_us) continue;
+      const int64_t recv_us = (static_cast<int64_t>(m.log_time_ns) - offset) / 1000;
+      lat_us.push_back(recv_us - static_cast<int64_t>(m.send_us));
+    }
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    if (!ec) r.mcap_bytes += static_cast<double>(size);
+    nlohmann::json pr;
+    pr["id"] = rb->id();
+    pr["sent"] = c.sent;
+    pr["recorded"] = c.recorded;
+    pr["missing"] = c.missing;
+    pr["duplicates"] = c.duplicates;
+    pr["out_of_order"] = c.out_of_order;
+    pr["first_missing"] = c.first_missing;
+    pr["heartbeats_received"] = rb->stats().heartbeats_received.load();
+    pr["max_heartbeat_gap_ms"] = static_cast<double>(rb->stats().max_heartbeat_gap_us) / 1000.0;
+    pr["closed"] = rb->stats().closed.load();
+    pr["close_reason"] = rb->closeReason();
+    r.per_robot.push_back(pr);
+  }
+  // Mean frame: the window's protobuf bytes (telemetry, and a few heartbeats) per telemetry message.
+  r.msg_bytes = sent_window ? static_cast<double>(app1 - app0) / static_cast<double>(sent_window) : 0;
+  // The runs also hold a little before and after the telemetry: MCAP bytes per telemetry
+  // message, times the window's telemetry rate.
+  r.mcap_bytes_per_msg = r.sent ? r.mcap_bytes / static_cast<double>(r.sent) : 0;
+  r.mcap_bytes_per_s = r.mcap_bytes_per_msg * static_cast<double>(sent_window) / r.window_s;
+  r.lat_samples = lat_us.size();
+  if (!lat_us.empty()) {
+    r.lat_min_ms = static_cast<double>(*std::min_element(lat_us.begin(), lat_us.end())) / 1000.0;
+    r.lat_max_ms = static_cast<double>(*std::max_element(lat_us.begin(), lat_us.end())) / 1000.0;
+    r.lat_p50_ms = percentile(lat_us, 0.50) / 1000.0;
+    r.lat_p99_ms = percentile(lat_us, 0.99) / 1000.0;
+  }
+  // robots_closed counts links that ended before we closed them ourselves.
+  r.ok = drained && r.missing == 0 && r.duplicates == 0 && r.robots_closed == 0 &&
+         (!opt.commands || r.acks >= static_cast<uint64_t>(n)) && exit_status.has_value();
+  if (!r.ok) {
+    std::ostringstream e;
+    e << r.error << "missing " << r.missing << ", duplicates " << r.duplicates << ", robots closed early " << r.robots_closed
+      << ", acks " << r.acks << "/" << n << (exit_status ? "" : ", pc_server did not quit within 15 s");
+    r.error = e.str();
+  }
+  return r;
+}
+
+void printTable(const std::vector<Result>& rs, const Options& o) {
+  std::printf("\nlink_load: %.0f Hz telemetry per robot, %.0f s window (after %.0f s warm-up), TLS, recording on, "
+              "%d generator thread(s), %ld cores\n",
+              o.hz, o.seconds, o.warmup_s, o.threads, ::sysconf(_SC_NPROCESSORS_ONLN));
+  std::printf("%6s %8s %8s %8s %8s %7s %7s %7s %7s %7s %7s %7s %9s %9s %7s %8s %8s %8s %6s %6s\n", "robots",
+              "srv CPU%", "CPU%/rob", "idle CPU", "gen CPU%", "RSS MB", "peak MB", "MB/rob", "p50 ms", "p99 ms",
+              "max ms", "tlm Hz", "tlm sent", "recorded", "dropped", "pb kB/s", "tcp kB/s", "mcap kB/s", "hb gap",
+              "closed");
+  for (const auto& r : rs) {
+    if (!r.error.empty() && r.sent == 0) {
+      std::printf("%6d  FAILED: %s\n", r.robots, r.error.c_str());
+      continue;
+    }
+    const double cpu_per = (r.server_cpu_pct - r.server_cpu_idle_pct) / r.robots;
+    const double mb_per = (r.rss_end_mb - r.rss_idle_mb) / r.robots;
+    std::printf("%6d %8.1f %8.2f %8.1f %8.1f %7.1f %7.1f %7.2f %7.2f %7.2f %7.2f %7.1f %9llu %9llu %7llu %8.1f %8.1f "
+                "%8.1f %6.0f %6llu\n",
+                r.robots, r.server_cpu_pct, cpu_per, r.server_cpu_idle_pct, r.gen_cpu_pct, r.rss_end_mb, r.hwm_mb,
+                mb_per, r.lat_p50_ms, r.lat_p99_ms, r.lat_max_ms, r.tlm_hz_per_robot,
+                static_cast<unsigned long long>(r.sent), static_cast<unsigned long long>(r.recorded),
+                static_cast<unsigned long long>(r.missing + r.duplicates), r.app_bytes_per_s / 1000.0,
+                r.wire_bytes_per_s / 1000.0, r.mcap_bytes_per_s / 1000.0, r.max_hb_gap_ms,
+                static_cast<unsigned long long>(r.robots_closed));
+    if (!r.error.empty()) std::printf("       ^ %s\n", r.error.c_str());
+  }
+  if (rs.size() >= 2 && rs.front().sent > 0 && rs.back().sent > 0) {
+    const auto& a = rs.front();
+    const auto& b = rs.back();
+    const double dn = b.robots - a.robots;
+    if (dn > 0)
+      std::printf("growth %d -> %d robots: +%.2f %% of a core and +%.2f MB RSS per added robot; p99 latency %.2f -> "
+                  "%.2f ms\n",
+                  a.robots, b.robots, (b.server_cpu_pct - a.server_cpu_pct) / dn, (b.rss_end_mb - a.rss_end_mb) / dn,
+                  a.lat_p99_ms, b.lat_p99_ms);
+  }
+  std::printf("CPU%% = of one core (utime+stime over the window); CPU%%/rob and MB/rob = above the idle server. "
+              "peak MB = VmHWM.\nLatency = Envelope.send_time_us on the generator -> receive time in the server "
+              "(MCAP log_time), all messages of the window.\npb = protobuf frames robot -> server; tcp = TLS bytes "
+              "robot -> server (TCP_INFO); mcap = recording written. hb gap = longest gap between server "
+              "heartbeats at a robot, ms.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  if (!parse(argc, argv, opt)) return 2;
+  std::vector<Result> results;
+  for (const int n : opt.robots) {
+    std::fprintf(stderr, "link_load: %d robot(s): idle %.0f s, warm-up %.0f s, window %.0f s ...\n", n, opt.idle_s,
+                 opt.warmup_s, opt.seconds);
+    results.push_back(runOne(opt, n));
+    const auto& r = results.back();
+    std::fprintf(stderr, "link_load: %d robot(s): %s\n", n, r.ok ? "ok" : ("FAILED: " + r.error).c_str());
+  }
+  printTable(results, opt);
+  if (!opt.json.empty()) {
+    nlohmann::json j;
+    j["hz"] = opt.hz;
+    j["seconds"] = opt.seconds;
+    j["warmup_s"] = opt.warmup_s;
+    j["generator_threads"] = opt.threads;
+    j["cores"] = ::sysconf(_SC_NPROCESSORS_ONLN);
+    for (const auto& r : results) {
+      nlohmann::json e;
+      e["robots"] = r.robots;
+      e["ok"] = r.ok;
+      e["error"] = r.error;
+      e["window_s"] = r.window_s;
+      e["server_cpu_pct"] = r.server_cpu_pct;
+      e["server_cpu_idle_pct"] = r.server_cpu_idle_pct;
+      e["server_cpu_pct_per_robot"] = (r.server_cpu_pct - r.server_cpu_idle_pct) / r.robots;
+      e["generator_cpu_pct"] = r.gen_cpu_pct;
+      e["server_threads"] = r.server_threads;
+      e["rss_idle_mb"] = r.rss_idle_mb;
+      e["rss_end_mb"] = r.rss_end_mb;
+      e["rss_peak_mb"] = r.rss_peak_mb;
+      e["vmhwm_mb"] = r.hwm_mb;
+      e["rss_mb_per_robot"] = (r.rss_end_mb - r.rss_idle_mb) / r.robots;
+      e["latency_ms"] = {{"min", r.lat_min_ms}, {"p50", r.lat_p50_ms}, {"p99", r.lat_p99_ms}, {"max", r.lat_max_ms},
+                         {"samples", r.lat_samples}};
+      e["telemetry"] = {{"sent", r.sent},           {"recorded", r.recorded},
+                        {"missing", r.missing},     {"duplicates", r.duplicates},
+                        {"out_of_order", r.out_of_order}, {"hz_per_robot", r.tlm_hz_per_robot},
+                        {"mean_frame_bytes", r.msg_bytes}};
+      e["bytes_per_s"] = {{"protobuf_up", r.app_bytes_per_s},
+                          {"tcp_up", r.wire_bytes_per_s},
+                          {"tcp_down", r.wire_down_bytes_per_s},
+                          {"mcap", r.mcap_bytes_per_s}};
+      e["mcap_bytes_per_telemetry"] = r.mcap_bytes_per_msg;
+      e["mcap_bytes"] = r.mcap_bytes;
+      e["heartbeats"] = {{"rx_hz_per_robot", r.hb_rx_hz_per_robot}, {"max_gap_ms", r.max_hb_gap_ms}};
+      e["commands"] = r.commands;
+      e["acks"] = r.acks;
+      e["robots_closed_early"] = r.robots_closed;
+      e["clock_offset_drift_us"] = r.clock_offset_drift_us;
+      e["drain_s"] = r.drain_s;
+      e["load_average_1min"] = r.load_avg;
+      e["per_robot"] = r.per_robot;
+      j["runs"].push_back(e);
+    }
+    std::ofstream f(opt.json);
+    f << j.dump(2) << "\n";
+    if (!f) {
+      std::cerr << "link_load: cannot write " << opt.json << "\n";
+      return 1;
+    }
+  }
+  return std::all_of(results.begin(), results.end(), [](const Result& r) { return r.ok; }) ? 0 : 1;
+}
