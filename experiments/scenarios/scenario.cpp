@@ -152,6 +152,7 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
   sim.setPeopleWaitForMotion(true);  // as mcu_sim --people-wait-motion in the full-stack test
 
   robot::RobotCore core(ctx.robot, robot::SafetyParams{}, ctx.control, ctx.scheduler);
+  std::vector<robot::CoreEvent> events;  // the per-tick take's buffer, swapped with the core's
   behavior::AwarenessConfig acfg = ctx.awareness;
   acfg.enabled = true;
   acfg.policy = opt.policy;
@@ -239,7 +240,8 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
         break;
       }
     }
-    for (const auto& e : core.takeEvents())
+    core.takeEvents(events);
+    for (const auto& e : events)
       if (e.kind == v1::Event::MODE_CHANGE && sent) ++m.mode_switches;
     for (const auto& a : core.takeAcks())
       if (a.command_id() == 1 && a.status() == v1::Ack::COMPLETED) {

@@ -70,10 +70,10 @@ void RobotCore::onGasTransitions(double now_s) {
 }
 
 void RobotCore::applyPendingGains() {
-  auto applied = gains_.applyPending(track_.active());
-  if (!applied) return;
-  track_.setGains(gains_.gains(), applied->new_scheduler);
-  events_.push(std::move(applied->event));
+  auto in_force = gains_.applyPending(track_.active());
+  if (!in_force) return;
+  track_.setGains(gains_.gains(), in_force->new_scheduler);
+  events_.push(std::move(in_force->event));
 }
 
 v1::Ack RobotCore::startTrack(const v1::Command& cmd) {

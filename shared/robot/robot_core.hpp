@@ -72,10 +72,11 @@ class RobotCore {
   /// Moves the events raised since the last call into `out` (swapping
   /// buffers: a caller that keeps `out` allocates nothing).
   void takeEvents(std::vector<CoreEvent>& out) { events_.takeInto(out); }
-  /// The same, into a new vector (for tests and tools).
+  /// The same, into a new vector (for tests and tools); none raised: an
+  /// empty vector, and the core keeps its buffer.
   std::vector<CoreEvent> takeEvents() {
     std::vector<CoreEvent> out;
-    events_.takeInto(out);
+    if (!events_.empty()) events_.takeInto(out);
     return out;
   }
   /// Moves out Acks the core produced on its own (COMPLETED of a track run or a route).
