@@ -1,3 +1,4 @@
+#include "shared/util/number_text.hpp"
 #include "shared/behavior/human_awareness.hpp"
 
 #include <sys/stat.h>
@@ -146,6 +147,9 @@ AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::s
   c.predict_horizon_s = a.number("predict_horizon_s", c.predict_horizon_s, 0, 6.4);
   c.speed.max_avoidance_m = a.number("max_avoidance_m", c.speed.max_avoidance_m, 0.5, 10.0);
   c.speed.sensitive_m = a.number("sensitive_m", c.speed.sensitive_m, 0.1, 5.0);
+  if (!(c.speed.sensitive_m < c.speed.max_avoidance_m))
+    a.fail("sensitive_m", "must be below max_avoidance_m (" + util::fmtShort(c.speed.max_avoidance_m) +
+                              " m): the stop zone lies inside the avoidance distance");
   const auto t = root.optChild("tracker");
   c.tracker.gate_m = t.number("gate_m", c.tracker.gate_m, 0.1, 5);
   c.tracker.map_margin_m = t.number("map_margin_m", c.tracker.map_margin_m, 0, 2);

@@ -172,6 +172,20 @@ TEST(HumanAwareness, PolicyFromConfigAndBadPolicyNamed) {
   }
 }
 
+// Found by fuzz_config: a stop zone beyond the avoidance distance was refused
+// by the speed strategy's own check, whose message named neither the file
+// nor the key.
+TEST(HumanAwareness, SensitiveBeyondAvoidanceIsRefusedNamingFileAndKey) {
+  try {
+    behavior::loadAwarenessConfig(
+        config::ConfigNode::loadString("awareness: {max_avoidance_m: 1.0, sensitive_m: 1.2}\n", "b.yaml"), ".");
+    FAIL() << "accepted sensitive_m beyond max_avoidance_m";
+  } catch (const config::ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("b.yaml", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sensitive_m"), std::string::npos) << e.what();
+  }
+}
+
 TEST(HumanTracker, APersonWhoStopsIsStillAPerson) {
   // Walks towards the robot, then stands 8 s 2 m ahead (reading a gauge): the
   // robot must keep them as a person, not learn them as structure.
