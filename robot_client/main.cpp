@@ -20,6 +20,7 @@
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/net/tls.hpp"
+#include "shared/util/cli_args.hpp"
 #include "shared/util/log.hpp"
 #include "shared/world/world.hpp"
 
@@ -67,7 +68,7 @@ bool fileExists(const char* p) {
 }
 
 [[noreturn]] void usageError(const std::string& msg) {
-  std::fprintf(stderr, "robot_client: %s (see --help)\n", msg.c_str());
+  std::fprintf(stderr, "robot_client: %s\n", msg.c_str());
   std::exit(2);
 }
 
@@ -79,57 +80,42 @@ int main(int argc, char** argv) {
   std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
   std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
   std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
-  std::string serial_dev, server, id, cmd_log, map_path, video_source, video_port;
+  std::string serial_dev, server, id, cmd_log, map_path, video_source;
+  std::optional<int> video_port;
   std::optional<robot::GasReaction> gas_reaction;
   bool no_video = false, plaintext = false;
   std::string certs_dir;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usageError(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--version") {
-      std::printf("robot_client %s\n", INSPECT_VERSION);
-      return 0;
-    } else if (a == "--config") {
-      config_path = value();
-    } else if (a == "--robot-config") {
-      robot_path = value();
-    } else if (a == "--control-config") {
-      control_path = value();
-    } else if (a == "--behavior-config") {
-      behavior_path = value();
-    } else if (a == "--serial") {
-      serial_dev = value();
-    } else if (a == "--server") {
-      server = value();
-    } else if (a == "--id") {
-      id = value();
-    } else if (a == "--cmd-log") {
-      cmd_log = value();
-    } else if (a == "--map") {
-      map_path = value();
-    } else if (a == "--video-source") {
-      video_source = value();
-    } else if (a == "--video-port") {
-      video_port = value();
-    } else if (a == "--certs") {
-      certs_dir = value();
-    } else if (a == "--plaintext") {
-      plaintext = true;
-    } else if (a == "--no-video") {
-      no_video = true;
-    } else if (a == "--gas-reaction") {
-      const std::string r = value();
-      gas_reaction = robot::gasReactionOf(r);
-      if (!gas_reaction) usageError("--gas-reaction '" + r + "' must be continue, stop or retreat");
-    } else {
-      usageError("unknown option '" + a + "'");
+  try {
+    cli::ArgReader a(argc, argv);
+    while (a.next()) {
+      if (a.isHelp()) {
+        std::fputs(kUsage, stdout);
+        return 0;
+      } else if (a.is("--version")) {
+        std::printf("robot_client %s\n", INSPECT_VERSION);
+        return 0;
+      } else if (a.is("--config")) config_path = a.path();
+      else if (a.is("--robot-config")) robot_path = a.path();
+      else if (a.is("--control-config")) control_path = a.path();
+      else if (a.is("--behavior-config")) behavior_path = a.path();
+      else if (a.is("--serial")) serial_dev = a.path();
+      else if (a.is("--server")) server = a.path();
+      else if (a.is("--id")) id = a.path();
+      else if (a.is("--cmd-log")) cmd_log = a.path();
+      else if (a.is("--map")) map_path = a.path();
+      else if (a.is("--video-source")) video_source = a.path();
+      else if (a.is("--video-port")) video_port = static_cast<int>(a.integer(1, 65535));
+      else if (a.is("--certs")) certs_dir = a.path();
+      else if (a.is("--plaintext")) plaintext = true;
+      else if (a.is("--no-video")) no_video = true;
+      else if (a.is("--gas-reaction")) gas_reaction = robot::gasReactionOf(a.choice({"continue", "stop", "retreat"}));
+      else a.unknown();
     }
+    if (!id.empty() && !client::validRobotId(id))
+      throw cli::UsageError("--id: '" + id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
+    if (plaintext && !certs_dir.empty()) throw cli::UsageError("--plaintext cannot be combined with --certs");
+  } catch (const cli::UsageError& e) {
+    usageError(e.what());
   }
 
   try {
@@ -140,21 +126,17 @@ int main(int argc, char** argv) {
     if (!serial_dev.empty()) cfg.serial_device = serial_dev;
     if (!map_path.empty()) cfg.map_file = map_path;
     if (gas_reaction) cfg.safety.gas_reaction = *gas_reaction;
-    if (!id.empty()) {
-      if (!client::validRobotId(id)) usageError("--id '" + id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
-      cfg.robot_id = id;
-    }
+    if (!id.empty()) cfg.robot_id = id;
     if (!server.empty()) {
       const auto colon = server.rfind(':');
-      if (colon == std::string::npos || colon == 0) usageError("--server '" + server + "' must be HOST:PORT");
+      if (colon == std::string::npos || colon == 0) usageError("--server: '" + server + "' is not HOST:PORT");
       cfg.server_host = server.substr(0, colon);
       char* end = nullptr;
       const long port = std::strtol(server.c_str() + colon + 1, &end, 10);
-      if (*end != '\0' || port < 1 || port > 65535) usageError("--server '" + server + "': bad port");
+      if (*end != '\0' || port < 1 || port > 65535) usageError("--server: '" + server + "' has no port number (1-65535)");
       cfg.server_port = static_cast<int>(port);
     }
 
-    if (plaintext && !certs_dir.empty()) usageError("--plaintext cannot be combined with --certs");
     if (!certs_dir.empty()) {
       cfg.tls.ca = certs_dir + "/ca.pem";
       cfg.tls.cert = certs_dir + "/" + cfg.robot_id + ".pem";
@@ -171,12 +153,7 @@ int main(int argc, char** argv) {
 
     if (!video_source.empty()) cfg.video.source = video_source;
     if (no_video) cfg.video.enabled = false;
-    if (!video_port.empty()) {
-      char* end = nullptr;
-      const long port = std::strtol(video_port.c_str(), &end, 10);
-      if (*end != '\0' || port < 1 || port > 65535) usageError("--video-port '" + video_port + "': bad port");
-      cfg.video.port = static_cast<int>(port);
-    }
+    if (video_port) cfg.video.port = *video_port;
 
     config::ControlConfig control;
     if (!control_path.empty()) control = config::loadControlConfigFile(control_path);

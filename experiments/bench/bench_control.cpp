@@ -28,6 +28,7 @@
 
 #ifdef INSPECT_HAVE_FUZZYLITE
 #include <fl/Headers.h>
+#include "shared/util/cli_args.hpp"
 #include "tests/support/paths.hpp"
 #endif
 
@@ -81,37 +82,24 @@ int main(int argc, char** argv) {
   std::string json_path;
   int reps = 7;
   bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "bench_control: %s: missing value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  cli::readOrExit("bench_control", argc, argv, [&](cli::ArgReader& a) {
+    if (a.isHelp()) {
       std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--reps") {
-      reps = std::atoi(value());
-      if (reps < 1) {
-        std::fprintf(stderr, "bench_control: --reps: expected a positive integer\n");
-        return 2;
-      }
-    } else if (a == "--json") {
-      json_path = value();
-    } else if (a == "--robot") {
-      robot_path = value();
-    } else if (a == "--control") {
-      control_path = value();
-    } else if (a == "--quick") {
+      std::exit(0);
+    } else if (a.is("--reps")) {
+      reps = static_cast<int>(a.integer(1, 1000000));
+    } else if (a.is("--json")) {
+      json_path = a.path();
+    } else if (a.is("--robot")) {
+      robot_path = a.path();
+    } else if (a.is("--control")) {
+      control_path = a.path();
+    } else if (a.is("--quick")) {
       quick = true;
     } else {
-      std::fprintf(stderr, "bench_control: %s: unknown argument (see --help)\n", a.c_str());
-      return 2;
+      a.unknown();
     }
-  }
+  });
 
   config::RobotConfig robot;
   config::ControlConfig ctl;

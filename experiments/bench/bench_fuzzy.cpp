@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "shared/util/cli_args.hpp"
 #include "shared/fuzzy/engine.hpp"
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
@@ -70,24 +71,22 @@ int main(int argc, char** argv) {
   std::string json_path;
   int reps = 7;
   bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
+  inspect::cli::readOrExit("bench_fuzzy", argc, argv, [&](inspect::cli::ArgReader& a) {
+    if (a.isHelp()) {
       std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--fis" && i + 1 < argc) {
-      fis_path = argv[++i];
-    } else if (a == "--json" && i + 1 < argc) {
-      json_path = argv[++i];
-    } else if (a == "--reps" && i + 1 < argc) {
-      reps = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--quick") {
+      std::exit(0);
+    } else if (a.is("--fis")) {
+      fis_path = a.path();
+    } else if (a.is("--json")) {
+      json_path = a.path();
+    } else if (a.is("--reps")) {
+      reps = static_cast<int>(a.integer(1, 1000000));
+    } else if (a.is("--quick")) {
       quick = true;
     } else {
-      std::fprintf(stderr, "bench_fuzzy: unknown argument '%s'\n%s", argv[i], kUsage);
-      return 2;
+      a.unknown();
     }
-  }
+  });
 
   std::unique_ptr<fz::Engine> engine;
   std::unique_ptr<fz::LookupSurface> surface;

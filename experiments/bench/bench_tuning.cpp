@@ -25,6 +25,7 @@
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
 #include "sim/robot_plant.hpp"
+#include "shared/util/cli_args.hpp"
 #include "tests/support/paths.hpp"
 
 namespace {
@@ -80,16 +81,6 @@ Rate measureRate(tuning::TuneSetup setup, int threads, int evals, const control:
   return r;
 }
 
-int parseCount(const std::string& flag, const char* text, int min) {
-  char* end = nullptr;
-  const long v = std::strtol(text, &end, 10);
-  if (!end || *end || v < min || v > 10000000) {
-    std::fprintf(stderr, "bench_tuning: %s: expected an integer >= %d, got '%s'\n", flag.c_str(), min, text);
-    std::exit(2);
-  }
-  return static_cast<int>(v);
-}
-
 nlohmann::ordered_json gainsJson(const control::GainSet& g) {
   nlohmann::ordered_json j;
   for (const char* name : control::kGainNames) j[name] = control::gainValue(g, name);
@@ -105,51 +96,39 @@ int main(int argc, char** argv) {
   int evals = -1, threads = 2, variations = -1, seeds = -1;
   bool quick = false, compare = false;
   std::string global_alg, local_alg;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "bench_tuning: %s: missing value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  cli::readOrExit("bench_tuning", argc, argv, [&](cli::ArgReader& a) {
+    constexpr int64_t kMany = 10000000;
+    if (a.isHelp()) {
       std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--evals") {
-      evals = parseCount(a, value(), 10);
-    } else if (a == "--threads") {
-      threads = parseCount(a, value(), 1);
-    } else if (a == "--variations") {
-      variations = parseCount(a, value(), 1);
-    } else if (a == "--seeds") {
-      seeds = parseCount(a, value(), 1);
-    } else if (a == "--quick") {
+      std::exit(0);
+    } else if (a.is("--evals")) {
+      evals = static_cast<int>(a.integer(10, kMany));
+    } else if (a.is("--threads")) {
+      threads = static_cast<int>(a.integer(1, kMany));
+    } else if (a.is("--variations")) {
+      variations = static_cast<int>(a.integer(1, kMany));
+    } else if (a.is("--seeds")) {
+      seeds = static_cast<int>(a.integer(1, kMany));
+    } else if (a.is("--quick")) {
       quick = true;
-    } else if (a == "--compare") {
+    } else if (a.is("--compare")) {
       compare = true;
-    } else if (a == "--plant") {
-      plant_name = value();
-      if (plant_name != "nominal" && plant_name != "worn") {
-        std::fprintf(stderr, "bench_tuning: --plant: expected nominal or worn, got '%s'\n", plant_name.c_str());
-        return 2;
-      }
-    } else if (a == "--global") {
-      global_alg = value();
-    } else if (a == "--local") {
-      local_alg = value();
-    } else if (a == "--json") {
-      json_path = value();
-    } else if (a == "--robot") {
-      robot_path = value();
-    } else if (a == "--control") {
-      control_path = value();
+    } else if (a.is("--plant")) {
+      plant_name = a.choice({"nominal", "worn"});
+    } else if (a.is("--global")) {
+      global_alg = a.path();
+    } else if (a.is("--local")) {
+      local_alg = a.path();
+    } else if (a.is("--json")) {
+      json_path = a.path();
+    } else if (a.is("--robot")) {
+      robot_path = a.path();
+    } else if (a.is("--control")) {
+      control_path = a.path();
     } else {
-      std::fprintf(stderr, "bench_tuning: %s: unknown argument (see --help)\n", a.c_str());
-      return 2;
+      a.unknown();
     }
-  }
+  });
   if (evals < 0) evals = quick ? 40 : 1000;
 
   tuning::TuneSetup setup;

@@ -49,6 +49,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "shared/util/cli_args.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/video/frame_source.hpp"
 #include "shared/video/h264_codec.hpp"
@@ -284,73 +285,48 @@ Json report(const Options& o, cv::Size sz, const std::vector<CaseResult>& cases,
 
 // ---------------------------------------------------------------- arguments
 
-bool parseSizes(const std::string& text, std::vector<cv::Size>& out) {
-  out.clear();
-  std::istringstream is(text);
-  for (std::string t; std::getline(is, t, ',');) {
+/// --sizes WxH,...: width a multiple of 8 (GStreamer's I420 rows and half rows are then unpadded).
+std::vector<cv::Size> parseSizes(cli::ArgReader& a) {
+  std::vector<cv::Size> out;
+  for (const auto& t : a.list()) {
     int w = 0, h = 0;
     char x = 0, extra = 0;
-    // Width a multiple of 8: GStreamer's I420 rows (and half rows) are then unpadded.
     if (std::sscanf(t.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 64 || h < 64 || w > 4096 ||
         h > 4096 || w % 8 || h % 2)
-      return false;
+      a.fail("'" + t + "' is not WxH with W a multiple of 8 in [64, 4096] and H even in [64, 4096]");
     out.emplace_back(w, h);
   }
-  return !out.empty();
+  return out;
 }
 
-bool parseThreads(const std::string& text, std::vector<int>& out) {
-  out.clear();
-  std::istringstream is(text);
-  for (std::string t; std::getline(is, t, ',');) {
-    if (t == "default") {
-      out.push_back(-1);
-      continue;
-    }
+/// --gst-threads N,...: each 0-64 or "default" (-1).
+std::vector<int> parseThreads(cli::ArgReader& a) {
+  std::vector<int> out;
+  for (const auto& t : a.list()) {
     char* end = nullptr;
     const long v = std::strtol(t.c_str(), &end, 10);
-    if (t.empty() || *end || v < 0 || v > 64) return false;
-    out.push_back(static_cast<int>(v));
+    if (t == "default") out.push_back(-1);
+    else if (t.empty() || *end || v < 0 || v > 64) a.fail("'" + t + "' is not 0-64 or default");
+    else out.push_back(static_cast<int>(v));
   }
-  return true;
+  return out;
 }
 
-/// Parses argv into `o`; "" or the complaint.
-std::string parseArgs(int argc, char** argv, Options& o, bool& help) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      help = true;
-      return {};
-    }
-    if (i + 1 >= argc) return a + ": missing value (see --help)";
-    const std::string v = argv[++i];
-    char* end = nullptr;
-    const double num = std::strtod(v.c_str(), &end);
-    const bool numeric = !v.empty() && *end == 0 && std::isfinite(num);
-    if (a == "--seconds" && numeric && num > 0 && num <= 3600) {
-      o.seconds = num;
-    } else if (a == "--warmup" && numeric && num >= 0 && num <= 60) {
-      o.warmup = num;
-    } else if (a == "--fps" && numeric && num > 0 && num <= 120) {
-      o.fps = num;
-    } else if (a == "--bitrate-kbps" && numeric && num >= 50 && num <= 50000) {
-      o.bitrate_kbps = static_cast<int>(num);
-    } else if (a == "--max-seconds" && numeric && num > 0) {
-      o.max_seconds = num;
-    } else if (a == "--port" && numeric && num >= 1 && num <= 65535) {
-      o.port = static_cast<uint16_t>(num);
-    } else if (a == "--sizes" && parseSizes(v, o.sizes)) {
-    } else if (a == "--gst-threads" && parseThreads(v, o.gst_threads)) {
-    } else if (a == "--json") {
-      o.json_path = v;
-    } else if (a == "--role" && (v == "sender" || v == "receiver")) {
-      o.role = v;
-    } else {
-      return a + " " + v + ": unknown argument or bad value (see --help)";
-    }
-  }
-  return {};
+void parseArgs(int argc, char** argv, Options& o, bool& help) {
+  cli::readOrExit("bench_video", argc, argv, [&](cli::ArgReader& a) {
+    if (a.isHelp()) help = true;
+    else if (a.is("--seconds")) o.seconds = a.numberAbove(0, 3600);
+    else if (a.is("--warmup")) o.warmup = a.number(0, 60);
+    else if (a.is("--fps")) o.fps = a.numberAbove(0, 120);
+    else if (a.is("--bitrate-kbps")) o.bitrate_kbps = static_cast<int>(a.integer(50, 50000));
+    else if (a.is("--max-seconds")) o.max_seconds = a.numberAbove(0);
+    else if (a.is("--port")) o.port = static_cast<uint16_t>(a.integer(1, 65535));
+    else if (a.is("--sizes")) o.sizes = parseSizes(a);
+    else if (a.is("--gst-threads")) o.gst_threads = parseThreads(a);
+    else if (a.is("--json")) o.json_path = a.path();
+    else if (a.is("--role")) o.role = a.choice({"sender", "receiver"});
+    else a.unknown();
+  });
 }
 
 }  // namespace
@@ -360,10 +336,7 @@ int main(int argc, char** argv) {
   using namespace inspect::bench_video;
   Options o;
   bool help = false;
-  if (const auto why = parseArgs(argc, argv, o, help); !why.empty()) {
-    std::fprintf(stderr, "bench_video: %s\n", why.c_str());
-    return 2;
-  }
+  parseArgs(argc, argv, o, help);
   if (help) {
     std::fputs(kUsage, stdout);
     return 0;

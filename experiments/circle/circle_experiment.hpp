@@ -14,6 +14,7 @@
 #include "shared/control/pid_controller.hpp"
 #include "shared/control/reference_path.hpp"
 #include "shared/control/trajectory_tracker.hpp"
+#include "shared/util/cli_args.hpp"
 #include "sim/closed_loop.hpp"
 
 namespace inspect::circle {
@@ -21,11 +22,7 @@ namespace inspect::circle {
 using control::WheelControl;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// Bad command line; what() names the flag.
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using cli::UsageError;
 
 enum class Trajectory { kCircle, kLine, kWaypoints };
 

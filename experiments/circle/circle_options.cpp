@@ -1,5 +1,5 @@
 // track_experiment's command line and the parts of a run every file shares.
-#include <charconv>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -39,30 +39,6 @@ const char* toString(Trajectory t) {
   return "?";
 }
 
-double parseNumber(const std::string& flag, const std::string& text) {
-  double v = 0;
-  const char* end = text.data() + text.size();
-  const auto [p, ec] = std::from_chars(text.data(), end, v);
-  if (ec != std::errc() || p != end || !std::isfinite(v))
-    throw UsageError(flag + ": expected a number, got '" + text + "'");
-  return v;
-}
-
-long parseInteger(const std::string& flag, const std::string& text, long min, long max) {
-  long v = 0;
-  const char* end = text.data() + text.size();
-  const auto [p, ec] = std::from_chars(text.data(), end, v);
-  if (ec != std::errc() || p != end || v < min || v > max)
-    throw UsageError(flag + ": expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) +
-                     "], got '" + text + "'");
-  return v;
-}
-
-double positive(const std::string& flag, double v) {
-  if (!(v > 0)) throw UsageError(flag + ": must be positive");
-  return v;
-}
-
 WheelControl parseController(const std::string& name) {
   if (name == "pid") return WheelControl::kPid;
   if (name == "fuzzy_pid") return WheelControl::kFuzzyPid;
@@ -70,67 +46,52 @@ WheelControl parseController(const std::string& name) {
   throw UsageError("--controllers: unknown controller '" + name + "' (pid, fuzzy_pid, direct)");
 }
 
-std::vector<WheelControl> parseControllers(const std::string& list) {
-  std::vector<WheelControl> out;
-  std::size_t begin = 0;
-  while (begin <= list.size()) {
-    const std::size_t comma = std::min(list.find(',', begin), list.size());
-    const WheelControl c = parseController(list.substr(begin, comma - begin));
-    if (std::find(out.begin(), out.end(), c) != out.end())
-      throw UsageError("--controllers: '" + std::string(control::toString(c)) + "' given twice");
-    out.push_back(c);
-    begin = comma + 1;
-  }
-  return out;
-}
-
 Options parseArgs(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw UsageError(flag + ": missing value");
-      return argv[++i];
-    };
-    if (flag == "--help" || flag == "-h") {
+  cli::ArgReader a(argc, argv);
+  while (a.next()) {
+    if (a.isHelp()) {
       o.help = true;
-    } else if (flag == "--trajectory") {
-      const std::string t = value();
-      if (t == "circle") o.trajectory = Trajectory::kCircle;
-      else if (t == "line") o.trajectory = Trajectory::kLine;
-      else if (t == "waypoints") o.trajectory = Trajectory::kWaypoints;
-      else throw UsageError("--trajectory: expected circle, line or waypoints, got '" + t + "'");
-    } else if (flag == "--radius") {
-      o.radius_m = parseNumber(flag, value());
-      if (!(std::abs(o.radius_m) >= 0.05)) throw UsageError("--radius: |radius| must be at least 0.05 m");
-    } else if (flag == "--speed") {
-      o.speed_m_s = positive(flag, parseNumber(flag, value()));
-    } else if (flag == "--laps") {
-      o.laps = positive(flag, parseNumber(flag, value()));
-    } else if (flag == "--length") {
-      o.length_m = positive(flag, parseNumber(flag, value()));
-    } else if (flag == "--controllers") {
-      o.controllers = parseControllers(value());
-    } else if (flag == "--robot") {
-      o.robot_path = value();
-    } else if (flag == "--control") {
-      o.control_path = value();
-    } else if (flag == "--seed") {
-      o.seed = static_cast<uint32_t>(parseInteger(flag, value(), 0, 4294967295L));
-    } else if (flag == "--seeds") {
-      o.seeds = static_cast<int>(parseInteger(flag, value(), 1, 10000));
-    } else if (flag == "--no-noise") {
+    } else if (a.is("--trajectory")) {
+      const std::string t = a.choice({"circle", "line", "waypoints"});
+      o.trajectory = t == "circle" ? Trajectory::kCircle : t == "line" ? Trajectory::kLine : Trajectory::kWaypoints;
+    } else if (a.is("--radius")) {
+      o.radius_m = a.number();
+      if (!(std::abs(o.radius_m) >= 0.05)) a.fail("|radius| must be at least 0.05 m");
+    } else if (a.is("--speed")) {
+      o.speed_m_s = a.numberAbove(0);
+    } else if (a.is("--laps")) {
+      o.laps = a.numberAbove(0);
+    } else if (a.is("--length")) {
+      o.length_m = a.numberAbove(0);
+    } else if (a.is("--controllers")) {
+      o.controllers.clear();
+      for (const auto& name : a.list()) {
+        const WheelControl c = parseController(name);
+        if (std::find(o.controllers.begin(), o.controllers.end(), c) != o.controllers.end())
+          a.fail("'" + std::string(control::toString(c)) + "' given twice");
+        o.controllers.push_back(c);
+      }
+    } else if (a.is("--robot")) {
+      o.robot_path = a.path();
+    } else if (a.is("--control")) {
+      o.control_path = a.path();
+    } else if (a.is("--seed")) {
+      o.seed = static_cast<uint32_t>(a.integer(0, 4294967295LL));
+    } else if (a.is("--seeds")) {
+      o.seeds = static_cast<int>(a.integer(1, 10000));
+    } else if (a.is("--no-noise")) {
       o.noise = false;
-    } else if (flag == "--band-m") {
-      o.band_m = positive(flag, parseNumber(flag, value()));
-    } else if (flag == "--band-rad") {
-      o.band_rad = positive(flag, parseNumber(flag, value()));
-    } else if (flag == "--plots") {
-      o.plots_dir = value();
-    } else if (flag == "--json") {
-      o.json_path = value();
+    } else if (a.is("--band-m")) {
+      o.band_m = a.numberAbove(0);
+    } else if (a.is("--band-rad")) {
+      o.band_rad = a.numberAbove(0);
+    } else if (a.is("--plots")) {
+      o.plots_dir = a.path();
+    } else if (a.is("--json")) {
+      o.json_path = a.path();
     } else {
-      throw UsageError(flag + ": unknown argument (see --help)");
+      a.unknown();
     }
   }
   return o;

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "shared/util/cli_args.hpp"
 #include "shared/fuzzy/engine.hpp"
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
@@ -64,33 +65,24 @@ int main(int argc, char** argv) {
   std::string path;
   inspect::fuzzy::EngineOptions options;
   bool header = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "--help" || a == "-h") {
+  inspect::cli::readOrExit("fis_eval", argc, argv, [&](inspect::cli::ArgReader& a) {
+    if (a.isHelp()) {
       std::fputs(kUsage, stdout);
-      return 0;
-    }
-    if (a == "--clip") {
+      std::exit(0);
+    } else if (a.is("--clip")) {
       options.clip_inputs = true;
-    } else if (a == "--header") {
+    } else if (a.is("--header")) {
       header = true;
-    } else if (a == "--samples" && i + 1 < argc) {
-      const std::string_view v = argv[++i];
-      auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), options.num_samples);
-      if (ec != std::errc() || p != v.data() + v.size()) {
-        std::fprintf(stderr, "fis_eval: --samples needs a whole number, got '%s'\n", argv[i]);
-        return 2;
-      }
-    } else if (!a.empty() && a.front() == '-') {
-      std::fprintf(stderr, "fis_eval: unknown option '%s' (see --help)\n", argv[i]);
-      return 2;
-    } else if (path.empty()) {
-      path = a;
+    } else if (a.is("--samples")) {
+      options.num_samples = static_cast<std::size_t>(a.integer(3, 1000000));
+    } else if (a.isPositional() && path.empty()) {
+      path = a.flag();
+    } else if (a.isPositional()) {
+      throw inspect::cli::UsageError("only one FILE.fis is accepted (see --help)");
     } else {
-      std::fprintf(stderr, "fis_eval: only one FILE.fis is accepted (see --help)\n");
-      return 2;
+      a.unknown();
     }
-  }
+  });
   if (path.empty()) {
     std::fputs("fis_eval: no FILE.fis given (see --help)\n", stderr);
     return 2;

@@ -44,7 +44,7 @@ plot::Series wallSeries(const World& w) {
 
 std::string plotScenario(const std::string& dir, const ScenarioSpec& spec, const std::vector<ScenarioRun>& runs) {
   if (runs.empty()) return "no runs to plot";
-  plot::Panel paths{spec.name + ": paths (marks every 2 s)", "x (m)", "y (m)", {}, {}, {}, true, "outside right"};
+  plot::Panel paths{spec.name + ": paths (marks every 2 s)", "x (m)", "y (m)", {}, {}, {}, true, "outside right", ""};
   paths.series.push_back(wallSeries(spec.world));
   constexpr double kMark_s = 2.0;
   for (const auto& r : runs) {
@@ -86,9 +86,9 @@ std::string plotScenario(const std::string& dir, const ScenarioSpec& spec, const
     paths.series.push_back(std::move(marks));
   }
 
-  plot::Panel speed{"robot speed", "t (s)", "v (m/s)", {}, {}, {}, false, "top right"};
+  plot::Panel speed{"robot speed", "t (s)", "v (m/s)", {}, {}, {}, false, "top right", ""};
   plot::Panel dist{"distance to the nearest person (centres); zones: intimate < 0.45 m, personal < 1.2 m",
-                   "t (s)", "distance (m)", {}, {}, {}, false, "top right"};
+                   "t (s)", "distance (m)", {}, {}, {}, false, "top right", ""};
   dist.yrange = "[0:*]";  // the zones start at 0
   dist.bands.push_back({0.0, 0.45, "#f4b6b6", "intimate"});
   dist.bands.push_back({0.45, 1.2, "#fbe3b5", "personal"});

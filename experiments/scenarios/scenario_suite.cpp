@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "shared/util/cli_args.hpp"
 #include "shared/config/config_node.hpp"
 #include "experiments/scenarios/scenario.hpp"
 
@@ -56,67 +57,49 @@ struct Options {
 };
 
 [[noreturn]] void usageError(const std::string& msg) {
-  std::fprintf(stderr, "scenario_suite: %s (see --help)\n", msg.c_str());
+  std::fprintf(stderr, "scenario_suite: %s\n", msg.c_str());
   std::exit(2);
-}
-
-std::vector<std::string> splitComma(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t p = 0;
-  while (p <= s.size()) {
-    const auto q = s.find(',', p);
-    const std::string item = s.substr(p, q == std::string::npos ? std::string::npos : q - p);
-    if (!item.empty()) out.push_back(item);
-    if (q == std::string::npos) break;
-    p = q + 1;
-  }
-  return out;
 }
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usageError(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (a == "--suite") {
-      o.suite = value();
-    } else if (a == "--only") {
-      o.only = splitComma(value());
-    } else if (a == "--policies") {
-      o.policies.clear();
-      for (const auto& p : splitComma(value())) {
-        try {
-          o.policies.push_back(behavior::parseSpeedPolicy(p));
-        } catch (const std::invalid_argument& e) {
-          usageError(std::string("--policies: ") + e.what());
+  try {
+    cli::ArgReader a(argc, argv);
+    while (a.next()) {
+      if (a.isHelp()) {
+        std::fputs(kUsage, stdout);
+        std::exit(0);
+      } else if (a.is("--suite")) {
+        o.suite = a.path();
+      } else if (a.is("--only")) {
+        o.only = a.list();
+      } else if (a.is("--policies")) {
+        o.policies.clear();
+        for (const auto& p : a.list()) {
+          try {
+            o.policies.push_back(behavior::parseSpeedPolicy(p));
+          } catch (const std::invalid_argument& e) {
+            a.fail(e.what());
+          }
         }
+      } else if (a.is("--robot-config")) {
+        o.robot = a.path();
+      } else if (a.is("--control-config")) {
+        o.control = a.path();
+      } else if (a.is("--behavior-config")) {
+        o.behavior = a.path();
+      } else if (a.is("--seed")) {
+        o.seed = static_cast<uint32_t>(a.integer(0, 4294967295LL));
+      } else if (a.is("--plots")) {
+        o.plots = a.path();
+      } else if (a.is("--json")) {
+        o.json = a.path();
+      } else {
+        a.unknown();
       }
-      if (o.policies.empty()) usageError("--policies: give at least one policy");
-    } else if (a == "--robot-config") {
-      o.robot = value();
-    } else if (a == "--control-config") {
-      o.control = value();
-    } else if (a == "--behavior-config") {
-      o.behavior = value();
-    } else if (a == "--seed") {
-      const std::string v = value();
-      char* end = nullptr;
-      const unsigned long s = std::strtoul(v.c_str(), &end, 10);
-      if (v.empty() || *end != '\0' || s > 0xffffffffUL) usageError("--seed '" + v + "' must be a whole number");
-      o.seed = static_cast<uint32_t>(s);
-    } else if (a == "--plots") {
-      o.plots = value();
-    } else if (a == "--json") {
-      o.json = value();
-    } else {
-      usageError("unknown option '" + a + "'");
     }
+  } catch (const cli::UsageError& e) {
+    usageError(e.what());
   }
   return o;
 }

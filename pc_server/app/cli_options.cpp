@@ -1,94 +1,40 @@
 #include "pc_server/app/cli_options.hpp"
 
-#include <functional>
-#include <map>
-
 #include "pc_server/app/server_config.hpp"
-#include "pc_server/console/text_util.hpp"
 
 namespace inspect::server {
 
-namespace {
-
-struct FlagSpec {
-  bool takes_value;
-  std::function<void(CliOptions&, const std::string&)> apply;
-};
-
-const std::map<std::string, FlagSpec>& flags() {
-  static const std::map<std::string, FlagSpec> kFlags = {
-      {"--config", {true, [](CliOptions& o, const std::string& v) { o.config_path = v; }}},
-      {"--bind",
-       {true,
-        [](CliOptions& o, const std::string& v) {
-          if (!validBindAddress(v)) throw UsageError("--bind: '" + v + "' is not a numeric IP address");
-          o.bind_address = v;
-        }}},
-      {"--port",
-       {true,
-        [](CliOptions& o, const std::string& v) {
-          const auto n = parseInteger(v);
-          if (!n || *n < 0 || *n > 65535) throw UsageError("--port: '" + v + "' is not a port number (0-65535)");
-          o.port = static_cast<uint16_t>(*n);
-        }}},
-      {"--video-port",
-       {true,
-        [](CliOptions& o, const std::string& v) {
-          const auto n = parseInteger(v);
-          if (!n || *n < 0 || *n > 65535) throw UsageError("--video-port: '" + v + "' is not a port number (0-65535)");
-          o.video_port = static_cast<uint16_t>(*n);
-        }}},
-      {"--video-port-file", {true, [](CliOptions& o, const std::string& v) { o.video_port_file = v; }}},
-      {"--video-dir", {true, [](CliOptions& o, const std::string& v) { o.video_dir = v; }}},
-      {"--no-video", {false, [](CliOptions& o, const std::string&) { o.no_video = true; }}},
-      {"--runs-dir", {true, [](CliOptions& o, const std::string& v) { o.runs_dir = v; }}},
-      {"--no-record", {false, [](CliOptions& o, const std::string&) { o.no_record = true; }}},
-      {"--certs", {true, [](CliOptions& o, const std::string& v) { o.certs_dir = v; }}},
-      {"--operator-socket", {true, [](CliOptions& o, const std::string& v) { o.operator_socket = v; }}},
-      {"--attach", {true, [](CliOptions& o, const std::string& v) { o.attach = v; }}},
-      {"--plaintext", {false, [](CliOptions& o, const std::string&) { o.plaintext = true; }}},
-      {"--port-file", {true, [](CliOptions& o, const std::string& v) { o.port_file = v; }}},
-      {"--script", {true, [](CliOptions& o, const std::string& v) { o.script_path = v; }}},
-      {"--interactive", {false, [](CliOptions& o, const std::string&) { o.interactive = true; }}},
-      {"--no-console", {false, [](CliOptions& o, const std::string&) { o.no_console = true; }}},
-      {"--help", {false, [](CliOptions& o, const std::string&) { o.help = true; }}},
-      {"-h", {false, [](CliOptions& o, const std::string&) { o.help = true; }}},
-  };
-  return kFlags;
-}
-
-}  // namespace
-
 CliOptions parseCli(const std::vector<std::string>& args) {
   CliOptions o;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    std::string name = args[i];
-    std::optional<std::string> value;
-    if (const auto eq = name.find('='); name.rfind("--", 0) == 0 && eq != std::string::npos) {
-      value = name.substr(eq + 1);
-      name = name.substr(0, eq);
-    }
-    const auto it = flags().find(name);
-    if (it == flags().end()) {
-      if (name.empty() || name[0] != '-') throw UsageError("unexpected argument '" + args[i] + "'");
-      throw UsageError("unknown flag '" + name + "'");
-    }
-    if (it->second.takes_value) {
-      if (!value) {
-        if (i + 1 >= args.size()) throw UsageError(name + ": needs a value");
-        value = args[++i];
-      }
-      if (value->empty()) throw UsageError(name + ": needs a non-empty value");
-    } else if (value) {
-      throw UsageError(name + ": takes no value");
-    }
-    it->second.apply(o, value.value_or(""));
+  cli::ArgReader a(args);
+  while (a.next()) {
+    if (a.isHelp()) o.help = true;
+    else if (a.is("--config")) o.config_path = a.path();
+    else if (a.is("--bind")) {
+      o.bind_address = a.path();
+      if (!validBindAddress(*o.bind_address)) a.fail("'" + *o.bind_address + "' is not a numeric IP address");
+    } else if (a.is("--port")) o.port = a.port();
+    else if (a.is("--video-port")) o.video_port = a.port();
+    else if (a.is("--video-port-file")) o.video_port_file = a.path();
+    else if (a.is("--video-dir")) o.video_dir = a.path();
+    else if (a.is("--no-video")) o.no_video = true;
+    else if (a.is("--runs-dir")) o.runs_dir = a.path();
+    else if (a.is("--no-record")) o.no_record = true;
+    else if (a.is("--certs")) o.certs_dir = a.path();
+    else if (a.is("--operator-socket")) o.operator_socket = a.path();
+    else if (a.is("--attach")) o.attach = a.path();
+    else if (a.is("--plaintext")) o.plaintext = true;
+    else if (a.is("--port-file")) o.port_file = a.path();
+    else if (a.is("--script")) o.script_path = a.path();
+    else if (a.is("--interactive")) o.interactive = true;
+    else if (a.is("--no-console")) o.no_console = true;
+    else a.unknown();
   }
   if (o.attach && args.size() != 2)
-    throw UsageError("--attach PATH takes no other flags (it only connects to a running server's operator socket)");
-  if (o.plaintext && o.certs_dir) throw UsageError("--plaintext cannot be combined with --certs");
+    throw cli::UsageError("--attach PATH takes no other flags (it only connects to a running server's operator socket)");
+  if (o.plaintext && o.certs_dir) throw cli::UsageError("--plaintext cannot be combined with --certs");
   if (o.no_console && (o.script_path || o.interactive))
-    throw UsageError("--no-console cannot be combined with --script or --interactive");
+    throw cli::UsageError("--no-console cannot be combined with --script or --interactive");
   return o;
 }
 

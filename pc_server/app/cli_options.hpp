@@ -5,15 +5,12 @@
 #include <string>
 #include <vector>
 
-#include "shared/config/config_node.hpp"
+#include "shared/util/cli_args.hpp"
 
 namespace inspect::server {
 
-/// A bad command line; main() prints what() and exits with status 2.
-class UsageError : public config::ConfigError {
- public:
-  using config::ConfigError::ConfigError;
-};
+/// A bad command line (the one error type of every program's command line).
+using cli::UsageError;
 
 /// Parsed command line; unset optionals mean "use the config file / default".
 struct CliOptions {

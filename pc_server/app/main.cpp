@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
     if (options.attach) return attachToOperatorSocket(*options.attach);
     return runServer(options);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "pc_server: %s (see --help)\n", e.what());
+    std::fprintf(stderr, "pc_server: %s\n", e.what());
     return 2;
   } catch (const inspect::config::ConfigError& e) {
     std::fprintf(stderr, "pc_server: %s\n", e.what());

@@ -193,8 +193,8 @@ bool Console::cmdReplay(const Args& args, const std::string&, int) {
     const double t = static_cast<double>(log.telemetry[i].robot_time_us()) * 1e-6 - t0;
     const double wait_s = t / speed - (nowS() - wall0);
     if (wait_s > 0 && !sleepPumping(wait_s)) return fail("replay", "stopped");
-    while (next_event < log.events.size() && log.events[next_event].first <= t)
-      out_ << "[" << fmtFixed(log.events[next_event].first, 2) << " s] " << log.events[next_event++].second << "\n";
+    for (; next_event < log.events.size() && log.events[next_event].first <= t; ++next_event)
+      out_ << "[" << fmtFixed(log.events[next_event].first, 2) << " s] " << log.events[next_event].second << "\n";
     if (t >= next_line || i + 1 == log.telemetry.size()) {
       snap.telemetry = log.telemetry[i];
       snap.telemetry.clear_video();  // no live stream behind a replay

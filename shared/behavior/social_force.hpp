@@ -39,7 +39,7 @@ struct SocialForceParams {
   // contact of two 0.25 m people) and Helbing et al. 2005 (A = 3 m/s^2,
   // B = 0.2 m), with a longer range so that two people meeting head-on at
   // 0.5 m/s pass with ~0.37 m between their bodies, ~0.48 m when 0.3 m
-  // offset (tests/pedestrians). The form ignores speed: at 1.3 m/s the gaps
+  // offset (tests/sim/pedestrians). The form ignores speed: at 1.3 m/s the gaps
   // shrink to ~0.05-0.1 m. Anisotropy
   // 0.35: between Helbing et al. 2005 (0.75) and Johansson, Helbing & Shukla
   // 2007 (fits of 0.06-0.12).

@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   sim::SimOptions opt;
   try {
     opt = sim::parseSimOptions(std::vector<std::string>(argv + 1, argv + argc));
-  } catch (const sim::UsageError& e) {
+  } catch (const cli::UsageError& e) {
     std::fprintf(stderr, "mcu_sim: %s\n", e.what());
     return 2;
   }

@@ -2,17 +2,12 @@
 // Command line of mcu_sim.
 #include <cstdint>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-namespace inspect::sim {
+#include "shared/util/cli_args.hpp"
 
-/// A bad command line; main() prints what() (it names the flag) and exits 2.
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+namespace inspect::sim {
 
 /// Parsed mcu_sim arguments.
 struct SimOptions {
@@ -28,7 +23,7 @@ struct SimOptions {
   bool help = false;
 };
 
-/// Parses argv (without argv[0]); throws UsageError naming the flag.
+/// Parses argv (without argv[0]); throws cli::UsageError naming the flag.
 SimOptions parseSimOptions(const std::vector<std::string>& args);
 /// The --help text.
 std::string simUsage();

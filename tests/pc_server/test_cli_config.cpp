@@ -70,13 +70,14 @@ TEST(ServerConfig, Video) {
 }
 
 TEST(Cli, ErrorsNameTheFlag) {
-  EXPECT_EQ(cliError({"--prot", "1"}), "unknown flag '--prot'");
+  EXPECT_EQ(cliError({"--prot", "1"}), "--prot: unknown option (see --help)");
   EXPECT_EQ(cliError({"--port", "70000"}), "--port: '70000' is not a port number (0-65535)");
   EXPECT_EQ(cliError({"--port", "12ab"}), "--port: '12ab' is not a port number (0-65535)");
-  EXPECT_EQ(cliError({"--port"}), "--port: needs a value");
+  EXPECT_EQ(cliError({"--port"}), "--port: missing value");
   EXPECT_EQ(cliError({"--bind", "localhost"}), "--bind: 'localhost' is not a numeric IP address");
   EXPECT_EQ(cliError({"--no-console=1"}), "--no-console: takes no value");
   EXPECT_EQ(cliError({"stray"}), "unexpected argument 'stray'");
+  EXPECT_EQ(cliError({"--runs-dir="}), "--runs-dir: empty value");
   EXPECT_NE(cliError({"--no-console", "--script", "x"}).find("cannot be combined"), std::string::npos);
 }
 

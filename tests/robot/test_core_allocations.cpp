@@ -78,7 +78,9 @@ TEST(CoreAllocations, IdleTicksAllocateNothing) {
 TEST(CoreAllocations, TeleopTicksAllocateNothing) {
   AwareRobot r;
   const auto resend = [&](int i) {
-    if (i % 10 == 0) ASSERT_EQ(r.send(teleop(0.2, 0.05)).status(), v1::Ack::ACCEPTED);
+    if (i % 10 == 0) {
+      ASSERT_EQ(r.send(teleop(0.2, 0.05)).status(), v1::Ack::ACCEPTED);
+    }
   };
   r.count(200, resend);
   EXPECT_EQ(r.h.core.mode(), v1::TELEOP);

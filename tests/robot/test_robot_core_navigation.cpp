@@ -502,7 +502,9 @@ TEST(RobotCoreGas, NoDataReadsAsNaNAndRaisesASensorFault) {
   auto tl = r.telemetry();
   ASSERT_EQ(countKind(r.events, v1::Event::ALARM_RAISED, v1::GasAlarm::SENSOR_FAULT), 1);
   for (const auto& e : r.events)
-    if (e.gas_alarm) EXPECT_EQ(e.gas_alarm->fault(), "no_data");
+    if (e.gas_alarm) {
+      EXPECT_EQ(e.gas_alarm->fault(), "no_data");
+    }
   EXPECT_TRUE(std::isnan(tl.gas(2)));
 }
 

@@ -12,7 +12,7 @@ namespace {
 std::string errorOf(const std::vector<std::string>& args) {
   try {
     (void)parseSimOptions(args);
-  } catch (const UsageError& e) {
+  } catch (const inspect::cli::UsageError& e) {
     return e.what();
   }
   return "";
@@ -56,9 +56,11 @@ TEST(SimOptions, ErrorsNameTheFlag) {
       {{"--world", "w", "--rate", "fast"}, "--rate: 'fast' is not a number"},
       {{"--world", "w", "--duration", "0"}, "--duration: 0 is out of range"},
       {{"--world", "w", "--duration", "-1"}, "--duration: -1 is out of range"},
-      {{"--world", "w", "--seed", "-3"}, "--seed: '-3' is not a non-negative integer"},
+      {{"--world", "w", "--seed", "-3"}, "--seed: '-3' is not a whole number in [0, "},
       {{"--world", "w", "--seed", "1.5"}, "--seed: '1.5'"},
       {{"--world", "w", "--truth"}, "--truth: missing value"},
+      {{"--world", "w", "--truth="}, "--truth: empty value"},
+      {{"--world", "w", "--people-wait-motion=1"}, "--people-wait-motion: takes no value"},
       {{"--world"}, "--world: missing value"},
   };
   for (const auto& c : cases) {

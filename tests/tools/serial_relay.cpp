@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "shared/util/cli_args.hpp"
 #include "shared/util/clock.hpp"
 #include "sim/mcu_sim/pty_port.hpp"
 
@@ -88,13 +89,6 @@ class Damage {
   std::exit(2);
 }
 
-double number(const char* s, const std::string& flag) {
-  char* end = nullptr;
-  const double v = std::strtod(s, &end);
-  if (*end != '\0' || v < 0) die(flag + ": '" + s + "' is not a non-negative number");
-  return v;
-}
-
 // Applies the complete lines of `buf` (commands from --control); keeps a partial last line.
 void controlCommands(std::string& buf, Direction& up, Direction& down) {
   for (auto nl = buf.find('\n'); nl != std::string::npos; nl = buf.find('\n')) {
@@ -125,35 +119,29 @@ int main(int argc, char** argv) {
   Direction up{"up", 1}, down{"down", 0};
   double garbage_per_s = 0;
   unsigned seed = 1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) die(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help") {
+  inspect::cli::readOrExit("serial_relay", argc, argv, [&](inspect::cli::ArgReader& a) {
+    if (a.isHelp()) {
       std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--mcu") {
-      mcu_path = value();
-    } else if (a == "--pty-link") {
-      link_path = value();
-    } else if (a == "--ber-up") {
-      up.ber = number(value(), a);
-    } else if (a == "--ber-down") {
-      down.ber = number(value(), a);
-    } else if (a == "--garbage-per-s") {
-      garbage_per_s = number(value(), a);
-    } else if (a == "--control") {
-      control_path = value();
-    } else if (a == "--seed") {
-      seed = static_cast<unsigned>(number(value(), a));
+      std::exit(0);
+    } else if (a.is("--mcu")) {
+      mcu_path = a.path();
+    } else if (a.is("--pty-link")) {
+      link_path = a.path();
+    } else if (a.is("--ber-up")) {
+      up.ber = a.number(0, 0.5);
+    } else if (a.is("--ber-down")) {
+      down.ber = a.number(0, 0.5);
+    } else if (a.is("--garbage-per-s")) {
+      garbage_per_s = a.number(0);
+    } else if (a.is("--control")) {
+      control_path = a.path();
+    } else if (a.is("--seed")) {
+      seed = static_cast<unsigned>(a.integer(0, 4294967295LL));
     } else {
-      die("unknown option '" + a + "'");
+      a.unknown();
     }
-  }
+  });
   if (mcu_path.empty() || link_path.empty()) die("--mcu and --pty-link are required");
-  if (up.ber > 0.5 || down.ber > 0.5) die("bit error rates must be <= 0.5");
 
   const int mcu = ::open(mcu_path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
   if (mcu < 0) die("cannot open " + mcu_path + ": " + std::strerror(errno));

@@ -40,6 +40,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "shared/util/cli_args.hpp"
 #include "shared/serial/frame_codec.hpp"
 #include "tests/support/stack.hpp"
 
@@ -1166,70 +1167,53 @@ Exit status: 0 all checks passed and targets met (or allowed), 1 otherwise, 2 ba
 KEEP_TEST_DIRS=1 keeps the programs' logs and truth files (the directories are printed).
 )";
 
-[[noreturn]] void usage(const std::string& msg) {
-  std::fprintf(stderr, "fault_inject: %s (see --help)\n", msg.c_str());
-  std::exit(2);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage(a + " needs a value");
-      return argv[++i];
-    };
-    auto number = [&](double lo, double hi) {
-      const std::string v = value();
-      char* end = nullptr;
-      const double d = std::strtod(v.c_str(), &end);
-      if (v.empty() || *end || !(d >= lo && d <= hi)) usage(a + ": '" + v + "' is not a number in [" + fmt("%g", lo) + ", " + fmt("%g", hi) + "]");
-      return d;
-    };
-    if (a == "--help" || a == "-h") {
+  inspect::cli::readOrExit("fault_inject", argc, argv, [&](inspect::cli::ArgReader& a) {
+    if (a.isHelp()) {
       std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--trials") {
-      o.trials = static_cast<int>(number(1, 10000));
-    } else if (a == "--faults") {
-      o.faults = split(value(), ',');
+      std::exit(0);
+    } else if (a.is("--trials")) {
+      o.trials = static_cast<int>(a.integer(1, 10000));
+    } else if (a.is("--faults")) {
+      o.faults = a.list();
       for (const auto& f : o.faults)
         if (std::none_of(faultDefs().begin(), faultDefs().end(), [&](const FaultDef& d) { return f == d.name; }))
-          usage("--faults: unknown fault '" + f + "'");
-    } else if (a == "--allow-miss") {
-      for (const auto& f : split(value(), ',')) o.allow_miss.insert(f);
-    } else if (a == "--margin-ms") {
-      o.margin_ms = number(0, 10000);
-    } else if (a == "--hold") {
-      o.hold_s = number(0.5, 30);
-    } else if (a == "--no-video") {
+          a.fail("unknown fault '" + f + "'");
+    } else if (a.is("--allow-miss")) {
+      for (const auto& f : a.list()) o.allow_miss.insert(f);
+    } else if (a.is("--margin-ms")) {
+      o.margin_ms = a.number(0, 10000);
+    } else if (a.is("--hold")) {
+      o.hold_s = a.number(0.5, 30);
+    } else if (a.is("--no-video")) {
       o.video = false;
-    } else if (a == "--ber") {
+    } else if (a.is("--ber")) {
       o.ber = true;
-    } else if (a == "--ber-rates") {
+    } else if (a.is("--ber-rates")) {
       o.ber_rates.clear();
-      for (const auto& r : split(value(), ',')) {
+      for (const auto& r : a.list()) {
         char* end = nullptr;
         const double d = std::strtod(r.c_str(), &end);
-        if (*end || !(d > 0 && d <= 0.5)) usage("--ber-rates: '" + r + "' is not a rate in (0, 0.5]");
+        if (*end || !(d > 0 && d <= 0.5)) a.fail("'" + r + "' is not a rate in (0, 0.5]");
         o.ber_rates.push_back(d);
       }
-    } else if (a == "--ber-seconds") {
-      o.ber_seconds = number(5, 3600);
-    } else if (a == "--garbage-per-s") {
-      o.garbage_per_s = number(0, 1000);
-    } else if (a == "--json") {
-      o.json = value();
-    } else if (a == "--seed") {
-      o.seed = static_cast<unsigned>(number(0, 4e9));
-    } else if (a == "--verbose") {
+    } else if (a.is("--ber-seconds")) {
+      o.ber_seconds = a.number(5, 3600);
+    } else if (a.is("--garbage-per-s")) {
+      o.garbage_per_s = a.number(0, 1000);
+    } else if (a.is("--json")) {
+      o.json = a.path();
+    } else if (a.is("--seed")) {
+      o.seed = static_cast<unsigned>(a.integer(0, 4294967295LL));
+    } else if (a.is("--verbose")) {
       o.verbose = true;
     } else {
-      usage("unknown option '" + a + "'");
+      a.unknown();
     }
-  }
+  });
   std::signal(SIGPIPE, SIG_IGN);
   std::string json;
   bool ok = true;

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "shared/util/cli_args.hpp"
 #include "shared/util/clock.hpp"
 
 namespace {
@@ -116,27 +117,22 @@ bool push(int to, std::string& buf) {
 
 int main(int argc, char** argv) {
   std::string listen_s = "127.0.0.1:0", target_s, port_file, control_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) die(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help") {
+  inspect::cli::readOrExit("tcp_fault_relay", argc, argv, [&](inspect::cli::ArgReader& a) {
+    if (a.isHelp()) {
       std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--listen") {
-      listen_s = value();
-    } else if (a == "--target") {
-      target_s = value();
-    } else if (a == "--port-file") {
-      port_file = value();
-    } else if (a == "--control") {
-      control_path = value();
+      std::exit(0);
+    } else if (a.is("--listen")) {
+      listen_s = a.path();
+    } else if (a.is("--target")) {
+      target_s = a.path();
+    } else if (a.is("--port-file")) {
+      port_file = a.path();
+    } else if (a.is("--control")) {
+      control_path = a.path();
     } else {
-      die("unknown option '" + a + "' (see --help)");
+      a.unknown();
     }
-  }
+  });
   if (target_s.empty() || control_path.empty()) die("--target and --control are required");
   const sockaddr_in target = parseAddr(target_s, "--target");
   const sockaddr_in local = parseAddr(listen_s, "--listen");

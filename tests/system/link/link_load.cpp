@@ -40,6 +40,7 @@
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
 
+#include "shared/util/cli_args.hpp"
 #include "shared/util/clock.hpp"
 #include "tests/support/process.hpp"
 #include "tests/system/link/server_harness.hpp"
@@ -79,60 +80,39 @@ void usage(std::ostream& o) {
        "  KEEP_TEST_DIRS=1 keeps the server's directories (logs, runs) under $TMPDIR.\n";
 }
 
-bool parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-      return argv[++i];
-    };
-    try {
-      if (a == "--robots") {
-        o.robots.clear();
-        std::stringstream ss(value());
-        std::string item;
-        while (std::getline(ss, item, ',')) {
-          const int n = std::stoi(item);
-          if (n < 1 || n > 500) throw std::invalid_argument("--robots: " + item + " is not in [1, 500]");
-          o.robots.push_back(n);
-        }
-        if (o.robots.empty()) throw std::invalid_argument("--robots: empty list");
-      } else if (a == "--seconds") {
-        o.seconds = std::stod(value());
-        if (!(o.seconds >= 1 && o.seconds <= 3600)) throw std::invalid_argument("--seconds must be in [1, 3600]");
-      } else if (a == "--warmup") {
-        o.warmup_s = std::stod(value());
-        if (!(o.warmup_s >= 0 && o.warmup_s <= 60)) throw std::invalid_argument("--warmup must be in [0, 60]");
-      } else if (a == "--idle") {
-        o.idle_s = std::stod(value());
-        if (!(o.idle_s >= 0.5 && o.idle_s <= 60)) throw std::invalid_argument("--idle must be in [0.5, 60]");
-      } else if (a == "--hz") {
-        o.hz = std::stod(value());
-        if (!(o.hz >= 1 && o.hz <= 1000)) throw std::invalid_argument("--hz must be in [1, 1000]");
-      } else if (a == "--threads") {
-        o.threads = std::stoi(value());
-        if (o.threads < 1 || o.threads > 16) throw std::invalid_argument("--threads must be in [1, 16]");
-      } else if (a == "--no-commands") {
-        o.commands = false;
-      } else if (a == "--json") {
-        o.json = value();
-      } else if (a == "--config") {
-        o.config = value();
-      } else if (a == "-h" || a == "--help") {
-        usage(std::cout);
-        std::exit(0);
-      } else {
-        throw std::invalid_argument("unknown argument '" + a + "'");
+void parse(int argc, char** argv, Options& o) {
+  cli::readOrExit("link_load", argc, argv, [&](cli::ArgReader& a) {
+    if (a.is("--robots")) {
+      o.robots.clear();
+      for (const auto& item : a.list()) {
+        char* end = nullptr;
+        const long n = std::strtol(item.c_str(), &end, 10);
+        if (*end || n < 1 || n > 500) a.fail("'" + item + "' is not a whole number in [1, 500]");
+        o.robots.push_back(static_cast<int>(n));
       }
-    } catch (const std::invalid_argument& e) {
-      std::cerr << "link_load: " << e.what() << " (see --help)\n";
-      return false;
-    } catch (const std::out_of_range&) {
-      std::cerr << "link_load: " << a << ": number out of range\n";
-      return false;
+    } else if (a.is("--seconds")) {
+      o.seconds = a.number(1, 3600);
+    } else if (a.is("--warmup")) {
+      o.warmup_s = a.number(0, 60);
+    } else if (a.is("--idle")) {
+      o.idle_s = a.number(0.5, 60);
+    } else if (a.is("--hz")) {
+      o.hz = a.number(1, 1000);
+    } else if (a.is("--threads")) {
+      o.threads = static_cast<int>(a.integer(1, 16));
+    } else if (a.is("--no-commands")) {
+      o.commands = false;
+    } else if (a.is("--json")) {
+      o.json = a.path();
+    } else if (a.is("--config")) {
+      o.config = a.path();
+    } else if (a.isHelp()) {
+      usage(std::cout);
+      std::exit(0);
+    } else {
+      a.unknown();
     }
-  }
-  return true;
+  });
 }
 
 double cpuSecondsSelf() {
@@ -463,7 +443,7 @@ void printTable(const std::vector<Result>& rs, const Options& o) {
 
 int main(int argc, char** argv) {
   Options opt;
-  if (!parse(argc, argv, opt)) return 2;
+  parse(argc, argv, opt);
   std::vector<Result> results;
   for (const int n : opt.robots) {
     std::fprintf(stderr, "link_load: %d robot(s): idle %.0f s, warm-up %.0f s, window %.0f s ...\n", n, opt.idle_s,

@@ -27,8 +27,9 @@ TEST_P(RearWheelRoundTrip, BetaToRatioAndBack) {
   EXPECT_NEAR(rearAngleFromRatio(k, kPaper), beta, 1e-9);
   // Eq 6 holds: tan(beta) = (L1 + L2 + L3 / cos(beta)) / R.
   const double r = turningRadiusFromRatio(k, kPaper.track_m);
-  if (beta != 0.0)
+  if (beta != 0.0) {
     EXPECT_NEAR(std::tan(beta), (kPaper.l1_m + kPaper.l2_m + kPaper.l3_m / std::cos(beta)) / r, 1e-9);
+  }
 }
 INSTANTIATE_TEST_SUITE_P(Angles, RearWheelRoundTrip, ::testing::Values(0.0, 1.0, 5.0, 10.0, 20.0, 35.0, 50.0, -10.0, -20.0));
 

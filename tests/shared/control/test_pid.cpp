@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "shared/control/pid_controller.hpp"
-#include "tests/unit/first_order.hpp"
+#include "tests/shared/control/first_order.hpp"
 
 using namespace inspect::control;
 

@@ -16,7 +16,7 @@
 #include "shared/fuzzy/fis_reader.hpp"
 #include "shared/fuzzy/lookup_surface.hpp"
 #include "tests/support/paths.hpp"
-#include "tests/unit/first_order.hpp"
+#include "tests/shared/control/first_order.hpp"
 
 using namespace inspect::control;
 namespace fz = inspect::fuzzy;
