@@ -160,7 +160,7 @@ int main(int argc, char** argv) {
     config::applyRobot(control, robot);
     const auto scheduler = config::loadScheduler(control);
 
-    std::vector<behavior::MapSegment> map;
+    std::vector<geometry::Segment> map;
     if (!cfg.map_file.empty()) {
       map = world::mapFromWorld(world::loadWorldFile(cfg.map_file));
       log::info("main", "map ", cfg.map_file, ": ", map.size(), " wall segments");

@@ -18,10 +18,10 @@ constexpr int kMaxSweeps = 5000;
 constexpr double kTimeSlack_s = 1e-9;
 
 bool boxesOverlap(const Segment& a, const Segment& b) {
-  return std::max(a.a.x_m, a.b.x_m) >= std::min(b.a.x_m, b.b.x_m) &&
-         std::max(b.a.x_m, b.b.x_m) >= std::min(a.a.x_m, a.b.x_m) &&
-         std::max(a.a.y_m, a.b.y_m) >= std::min(b.a.y_m, b.b.y_m) &&
-         std::max(b.a.y_m, b.b.y_m) >= std::min(a.a.y_m, a.b.y_m);
+  return std::max(a.a.x, a.b.x) >= std::min(b.a.x, b.b.x) &&
+         std::max(b.a.x, b.b.x) >= std::min(a.a.x, a.b.x) &&
+         std::max(a.a.y, a.b.y) >= std::min(b.a.y, b.b.y) &&
+         std::max(b.a.y, b.b.y) >= std::min(a.a.y, a.b.y);
 }
 
 }  // namespace
@@ -45,8 +45,8 @@ GasModel::GasModel(const World& world)
     const Stencil st = stencil(s.position);
     if (st.n == 0) {
       std::ostringstream os;
-      os << file_ << ": gas.sources[" << i << "]: no free grid cell is reachable from the leak at (" << s.position.x_m
-         << ", " << s.position.y_m << ") without crossing a wall; move it or use a smaller gas.cell_m";
+      os << file_ << ": gas.sources[" << i << "]: no free grid cell is reachable from the leak at (" << s.position.x
+         << ", " << s.position.y << ") without crossing a wall; move it or use a smaller gas.cell_m";
       throw config::ConfigError(os.str());
     }
     Emitter e{s, {}};
@@ -62,14 +62,14 @@ void GasModel::buildGrid(const World& world) {
   if (!box) throw config::ConfigError(file_ + ": gas.sources: a world with leaks needs walls or obstacles");
   for (const auto& w : world.walls) edges_.push_back(w);
   for (const auto& o : world.obstacles)
-    for (const auto& e : geom::edgesOf(o.polygon)) edges_.push_back(e);
+    for (const auto& e : geometry::edgesOf(o.polygon)) edges_.push_back(e);
 
   // Cell faces on multiples of h: walls on round coordinates then lie on faces.
   const double m = std::max(kMargin_m, 2.0 * h_);
-  x0_ = h_ * std::floor((box->lo.x_m - m) / h_);
-  y0_ = h_ * std::floor((box->lo.y_m - m) / h_);
-  nx_ = static_cast<int>(std::lround((h_ * std::ceil((box->hi.x_m + m) / h_) - x0_) / h_));
-  ny_ = static_cast<int>(std::lround((h_ * std::ceil((box->hi.y_m + m) / h_) - y0_) / h_));
+  x0_ = h_ * std::floor((box->lo.x - m) / h_);
+  y0_ = h_ * std::floor((box->lo.y - m) / h_);
+  nx_ = static_cast<int>(std::lround((h_ * std::ceil((box->hi.x + m) / h_) - x0_) / h_));
+  ny_ = static_cast<int>(std::lround((h_ * std::ceil((box->hi.y + m) / h_) - y0_) / h_));
   const double cells = static_cast<double>(nx_) * static_cast<double>(ny_);
   if (cells > static_cast<double>(kMaxCells)) {
     std::ostringstream os;
@@ -78,7 +78,7 @@ void GasModel::buildGrid(const World& world) {
     throw config::ConfigError(os.str());
   }
   // Positivity (every coefficient of the explicit update >= 0) bounds the step.
-  max_step_s_ = 1.0 / (4.0 * d_m2_s_ / (h_ * h_) + (std::abs(u_m_s_.x_m) + std::abs(u_m_s_.y_m)) / h_ + k_per_s_);
+  max_step_s_ = 1.0 / (4.0 * d_m2_s_ / (h_ * h_) + (std::abs(u_m_s_.x) + std::abs(u_m_s_.y)) / h_ + k_per_s_);
   std::vector<std::string> gases;
   for (const auto& s : world.gas.sources)
     if (std::find(gases.begin(), gases.end(), s.gas) == gases.end()) gases.push_back(s.gas);
@@ -105,25 +105,25 @@ void GasModel::buildGrid(const World& world) {
   for (const auto& o : world.obstacles) {
     double lx = 1e300, ly = 1e300, hx = -1e300, hy = -1e300;
     for (const auto& v : o.polygon.vertices) {
-      lx = std::min(lx, v.x_m), ly = std::min(ly, v.y_m), hx = std::max(hx, v.x_m), hy = std::max(hy, v.y_m);
+      lx = std::min(lx, v.x), ly = std::min(ly, v.y), hx = std::max(hx, v.x), hy = std::max(hy, v.y);
     }
     const auto [i0, i1] = rangeOf(lx, hx, x0_, nx_ - 1);
     const auto [j0, j1] = rangeOf(ly, hy, y0_, ny_ - 1);
     for (int j = std::max(j0, 0); j <= j1; ++j)
       for (int i = std::max(i0, 0); i <= i1; ++i)
-        if (geom::pointInPolygon(cellCentre(i, j), o.polygon)) solid_[index(i, j)] = 1;
+        if (geometry::pointInPolygon(cellCentre(i, j), o.polygon)) solid_[index(i, j)] = 1;
   }
   // Faces whose centre-to-centre segment crosses an edge: only cells near each edge can have one.
   for (const auto& e : edges_) {
-    const auto [i0, i1] = rangeOf(std::min(e.a.x_m, e.b.x_m) - h_, std::max(e.a.x_m, e.b.x_m) + h_, x0_, nx_);
-    const auto [j0, j1] = rangeOf(std::min(e.a.y_m, e.b.y_m) - h_, std::max(e.a.y_m, e.b.y_m) + h_, y0_, ny_);
+    const auto [i0, i1] = rangeOf(std::min(e.a.x, e.b.x) - h_, std::max(e.a.x, e.b.x) + h_, x0_, nx_);
+    const auto [j0, j1] = rangeOf(std::min(e.a.y, e.b.y) - h_, std::max(e.a.y, e.b.y) + h_, y0_, ny_);
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i <= i1; ++i) {
         const std::size_t idx = index(i, j);
         near_edge_[idx] = 1;
         const Vec2 c = cellCentre(i, j);
-        if (i < nx_ && geom::segmentsIntersect({c, cellCentre(i + 1, j)}, e)) block_e_[idx] = 1;
-        if (j < ny_ && geom::segmentsIntersect({c, cellCentre(i, j + 1)}, e)) block_n_[idx] = 1;
+        if (i < nx_ && geometry::segmentsIntersect({c, cellCentre(i + 1, j)}, e)) block_e_[idx] = 1;
+        if (j < ny_ && geometry::segmentsIntersect({c, cellCentre(i, j + 1)}, e)) block_n_[idx] = 1;
       }
     }
   }
@@ -132,8 +132,8 @@ void GasModel::buildGrid(const World& world) {
   // first-order upwind advection (u/h) from the upstream cell. Outside the
   // grid the air is clean (c = 0): an open edge absorbs.
   const double a = d_m2_s_ / (h_ * h_);
-  const double px = std::max(u_m_s_.x_m, 0.0) / h_, mx = std::max(-u_m_s_.x_m, 0.0) / h_;
-  const double py = std::max(u_m_s_.y_m, 0.0) / h_, my = std::max(-u_m_s_.y_m, 0.0) / h_;
+  const double px = std::max(u_m_s_.x, 0.0) / h_, mx = std::max(-u_m_s_.x, 0.0) / h_;
+  const double py = std::max(u_m_s_.y, 0.0) / h_, my = std::max(-u_m_s_.y, 0.0) / h_;
   in_e_.assign(total, 0.0);
   in_w_.assign(total, 0.0);
   in_n_.assign(total, 0.0);
@@ -161,14 +161,14 @@ void GasModel::buildGrid(const World& world) {
 bool GasModel::blocked(Vec2 a, Vec2 b) const {
   const Segment s{a, b};
   for (const auto& e : edges_)
-    if (boxesOverlap(s, e) && geom::segmentsIntersect(s, e)) return true;
+    if (boxesOverlap(s, e) && geometry::segmentsIntersect(s, e)) return true;
   return false;
 }
 
 GasModel::Stencil GasModel::stencil(Vec2 p) const {
   Stencil st;
   if (nx_ == 0) return st;
-  const double fx = (p.x_m - x0_) / h_ - 0.5, fy = (p.y_m - y0_) / h_ - 0.5;
+  const double fx = (p.x - x0_) / h_ - 0.5, fy = (p.y - y0_) / h_ - 0.5;
   if (!(fx >= -1.0 && fx < nx_ && fy >= -1.0 && fy < ny_)) return st;  // off the grid (or NaN)
   const int i0 = std::min(static_cast<int>(std::floor(fx)), nx_ - 1);
   const int j0 = std::min(static_cast<int>(std::floor(fy)), ny_ - 1);
@@ -200,7 +200,7 @@ int GasModel::field(std::string_view gas) const {
 }
 
 bool GasModel::inSolidCell(Vec2 p) const {
-  const double cx = std::floor((p.x_m - x0_) / h_), cy = std::floor((p.y_m - y0_) / h_);
+  const double cx = std::floor((p.x - x0_) / h_), cy = std::floor((p.y - y0_) / h_);
   return cx >= 0 && cx < nx_ && cy >= 0 && cy < ny_ && solid_[index(static_cast<int>(cx), static_cast<int>(cy))];
 }
 
@@ -308,8 +308,8 @@ bool GasModel::solveSteady(std::vector<double>& c, const Emitter& e) const {
   // 2 sqrt(a_in a_out) cos(pi h / L) per axis over the diagonal); exact for a
   // room that fills the grid, an estimate otherwise.
   const double a = d_m2_s_ / (h_ * h_);
-  const double px = std::max(u_m_s_.x_m, 0.0) / h_, mx = std::max(-u_m_s_.x_m, 0.0) / h_;
-  const double py = std::max(u_m_s_.y_m, 0.0) / h_, my = std::max(-u_m_s_.y_m, 0.0) / h_;
+  const double px = std::max(u_m_s_.x, 0.0) / h_, mx = std::max(-u_m_s_.x, 0.0) / h_;
+  const double py = std::max(u_m_s_.y, 0.0) / h_, my = std::max(-u_m_s_.y, 0.0) / h_;
   const double diag = 4.0 * a + px + mx + py + my + k_per_s_;
   const double rho = std::clamp((2.0 * std::sqrt((a + px) * (a + mx)) * std::cos(std::numbers::pi / nx_) +
                                  2.0 * std::sqrt((a + py) * (a + my)) * std::cos(std::numbers::pi / ny_)) /

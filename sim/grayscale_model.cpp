@@ -15,7 +15,7 @@ uint8_t GrayscaleModel::read(const World& world, const control::Pose2& pose) {
   uint8_t bits = 0;
   for (int i = 0; i < kChannels; ++i) {
     const Vec2 p = spotInRobot(i);
-    const Vec2 w{pose.x_m + c * p.x_m - s * p.y_m, pose.y_m + s * p.x_m + c * p.y_m};
+    const Vec2 w{pose.x_m + c * p.x - s * p.y, pose.y_m + s * p.x + c * p.y};
     if (onFloorLine(world, w)) bits = static_cast<uint8_t>(bits | (1u << i));
   }
   return bits;

@@ -8,7 +8,7 @@ namespace {
 // Sim times are whole milliseconds; this keeps start_s = 2.0 at t = 2.000 s.
 constexpr double kTimeEps_s = 1e-9;
 
-Eigen::Vector2d toEigen(Vec2 p) { return {p.x_m, p.y_m}; }
+Eigen::Vector2d toEigen(Vec2 p) { return {p.x, p.y}; }
 
 }  // namespace
 
@@ -26,7 +26,7 @@ void PedestrianCrowd::reportStart(std::size_t i, double t_s) const {
   if (!observer_) return;
   const auto& s = world_.pedestrians[i];
   char detail[160];
-  std::snprintf(detail, sizeof detail, "id=%s x=%.3f y=%.3f", s.id.c_str(), s.route.front().x_m, s.route.front().y_m);
+  std::snprintf(detail, sizeof detail, "id=%s x=%.3f y=%.3f", s.id.c_str(), s.route.front().x, s.route.front().y);
   observer_->onEvent(t_s, "pedestrian_start", detail);
 }
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "shared/behavior/social_force.hpp"
-#include "sim/circle.hpp"
+#include "shared/geometry/circle.hpp"
 #include "sim/sim_observer.hpp"
 #include "sim/world_names.hpp"
 

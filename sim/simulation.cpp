@@ -118,7 +118,7 @@ void Simulation::reportGasStart() {
   for (const auto& s : world_.gas.sources) {
     char detail[256];
     std::snprintf(detail, sizeof detail, "name=%s gas=%s x=%.3f y=%.3f rate=%g start_s=%s end_s=%s", s.name.c_str(),
-                  s.gas.c_str(), s.position.x_m, s.position.y_m, s.rate, fmtSeconds(s.start_s).c_str(),
+                  s.gas.c_str(), s.position.x, s.position.y, s.rate, fmtSeconds(s.start_s).c_str(),
                   fmtSeconds(s.end_s).c_str());
     observer_->onEvent(timeS(), "gas_source", detail);
   }
@@ -147,7 +147,7 @@ void Simulation::sampleGas(McuInputs& in) {
   if (observer_ && t_ms_ % kGasLogPeriod_ms == 0) {
     GasValues reading{};
     for (std::size_t i = 0; i < n; ++i) reading[i] = gas_sensors_.reading(i);
-    observer_->onGas({timeS(), inlet.x_m, inlet.y_m, {truth.data(), n}, {reading.data(), n}});
+    observer_->onGas({timeS(), inlet.x, inlet.y, {truth.data(), n}, {reading.data(), n}});
   }
 }
 

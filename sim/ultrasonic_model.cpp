@@ -22,7 +22,7 @@ std::optional<double> UltrasonicModel::trueRange(const World& world, const contr
     if (hit && (!best || *hit < *best)) best = hit;
     const Vec2 dir{std::cos(yaw), std::sin(yaw)};
     for (const auto& c : people) {
-      const auto t = geom::rayCircle(origin, dir, c);
+      const auto t = geometry::rayCircle(origin, dir, c);
       if (t && *t <= cfg_.max_range_m && (!best || *t < *best)) best = t;
     }
   }

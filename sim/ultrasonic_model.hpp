@@ -10,7 +10,7 @@
 
 #include "shared/config/robot_config.hpp"
 #include "shared/control/diff_drive.hpp"
-#include "sim/circle.hpp"
+#include "shared/geometry/circle.hpp"
 #include "sim/world_names.hpp"
 
 namespace inspect::sim {

@@ -3,7 +3,8 @@
 // the simulator reads and simulates worlds, the world format is a library
 // below it (docs/architecture.md).
 #include "shared/world/gas_spec.hpp"
-#include "shared/world/geometry.hpp"
+#include "shared/geometry/circle.hpp"
+#include "shared/geometry/polygon.hpp"
 #include "shared/world/pedestrian_script.hpp"
 #include "shared/world/world.hpp"
 
@@ -27,23 +28,15 @@ using world::Obstacle;
 using world::onFloorLine;
 using world::PedestrianPause;
 using world::PedestrianScript;
-using world::Polygon;
+using geometry::Circle;
+using geometry::Polygon;
 using world::readGasSpec;
 using world::readPedestrianScripts;
-using world::Segment;
+using geometry::Segment;
 using world::solidBounds;
 using world::solidEdges;
-using world::Vec2;
+using geometry::Vec2;
 using world::World;
-using world::pointText;
-
-namespace geom {
-using world::geom::edgesOf;
-using world::geom::pointInPolygon;
-using world::geom::pointSegmentDistance;
-using world::geom::raySegment;
-using world::geom::segmentsIntersect;
-using world::geom::signedArea;
-}  // namespace geom
+using geometry::pointText;
 
 }  // namespace inspect::sim

@@ -32,10 +32,10 @@ plot::Series wallSeries(const World& w) {
     s.x.insert(s.x.end(), {x0, x1, kNaN});
     s.y.insert(s.y.end(), {y0, y1, kNaN});
   };
-  for (const auto& e : w.walls) seg(e.a.x_m, e.a.y_m, e.b.x_m, e.b.y_m);
+  for (const auto& e : w.walls) seg(e.a.x, e.a.y, e.b.x, e.b.y);
   for (const auto& o : w.obstacles) {
     const auto& v = o.polygon.vertices;
-    for (std::size_t i = 0; i < v.size(); ++i) seg(v[i].x_m, v[i].y_m, v[(i + 1) % v.size()].x_m, v[(i + 1) % v.size()].y_m);
+    for (std::size_t i = 0; i < v.size(); ++i) seg(v[i].x, v[i].y, v[(i + 1) % v.size()].x, v[(i + 1) % v.size()].y);
   }
   return s;
 }

@@ -106,13 +106,7 @@ bool Console::cmdReport(const Args& args, const std::string&, int) {
       // The site map of an inspection route: walls and obstacle edges in the world frame.
       try {
         const auto w = world::loadWorldFile(f.path);
-        for (const auto& s : w.walls) in.walls.push_back({s.a.x_m, s.a.y_m, s.b.x_m, s.b.y_m});
-        for (const auto& o : w.obstacles)
-          for (std::size_t i = 0; i < o.polygon.vertices.size(); ++i) {
-            const auto& a = o.polygon.vertices[i];
-            const auto& b = o.polygon.vertices[(i + 1) % o.polygon.vertices.size()];
-            in.walls.push_back({a.x_m, a.y_m, b.x_m, b.y_m});
-          }
+        for (const auto& e : world::solidEdges(w)) in.walls.push_back(e.edge);
         in.have_map = true;
         in.start_x_m = w.start.x_m;
         in.start_y_m = w.start.y_m;

@@ -51,23 +51,15 @@ struct GasMapFigure {
   gas::ConcentrationMap::Peak peak;
   std::vector<gas::GasSample> path;  // the samples (positions)
   std::vector<const AlarmSpan*> alarms;
-  std::vector<RunReportInput::MapWall> walls;
+  std::vector<geometry::Segment> walls;
   std::string frame_name;
 };
 
-bool crosses(double ax, double ay, double bx, double by, const RunReportInput::MapWall& w) {
-  auto side = [](double ox, double oy, double px, double py, double qx, double qy) {
-    return (px - ox) * (qy - oy) - (py - oy) * (qx - ox);
-  };
-  const double d1 = side(w.x0_m, w.y0_m, w.x1_m, w.y1_m, ax, ay), d2 = side(w.x0_m, w.y0_m, w.x1_m, w.y1_m, bx, by);
-  const double d3 = side(ax, ay, bx, by, w.x0_m, w.y0_m), d4 = side(ax, ay, bx, by, w.x1_m, w.y1_m);
-  return d1 * d2 < 0 && d3 * d4 < 0;
-}
 
 // Cells of the map whose nearest sampled point is behind a wall: the kernel
 // does not know walls, so what it spreads through one is hidden.
 std::vector<char> behindWalls(const gas::ConcentrationMap& m, const std::vector<gas::GasSample>& path,
-                              const std::vector<RunReportInput::MapWall>& walls) {
+                              const std::vector<geometry::Segment>& walls) {
   std::vector<char> hidden(m.cols() * m.rows(), 0);
   if (walls.empty()) return hidden;
   std::vector<std::pair<double, double>> pts;  // the path thinned to ~0.1 m
@@ -81,7 +73,7 @@ std::vector<char> behindWalls(const gas::ConcentrationMap& m, const std::vector<
       for (const auto& [px, py] : pts)
         if (const double d = (px - x) * (px - x) + (py - y) * (py - y); d < best) best = d, bx = px, by = py;
       hidden[r * m.cols() + c] =
-          std::any_of(walls.begin(), walls.end(), [&](const RunReportInput::MapWall& w) { return crosses(x, y, bx, by, w); });
+          std::any_of(walls.begin(), walls.end(), [&](const geometry::Segment& w) { return geometry::segmentsCross({{x, y}, {bx, by}}, w); });
     }
   return hidden;
 }
@@ -122,7 +114,7 @@ std::string gasMapScript(const std::string& png_path, const GasMapFigure& f) {
     g << num(f.path[i].x_m) << ' ' << num(f.path[i].y_m) << '\n';
   }
   g << "EOD\n$walls << EOD\n";
-  for (const auto& w : f.walls) g << num(w.x0_m) << ' ' << num(w.y0_m) << '\n' << num(w.x1_m) << ' ' << num(w.y1_m) << "\n\n";
+  for (const auto& w : f.walls) g << num(w.a.x) << ' ' << num(w.a.y) << '\n' << num(w.b.x) << ' ' << num(w.b.y) << "\n\n";
   g << "EOD\n";
   const char* level_color[] = {"#999999", "#ff9f1c", "#e00000", "#8e44ad"};
   const char* label_color[] = {"#555555", "#8a4b00", "#a00000", "#5b2370"};  // darker: text on the map
@@ -257,15 +249,15 @@ std::vector<GasMapOutcome> gasMaps(const RunReportInput& in, const Frame& frame,
     const gas::Bounds b = gas::boundsAround(samples[static_cast<std::size_t>(ch.index)], 2.0);
     if (b.valid()) grow(b.x_min_m, b.y_min_m, b.x_max_m, b.y_max_m);
   }
-  std::vector<RunReportInput::MapWall> walls;
+  std::vector<geometry::Segment> walls;
   gas::LeakOptions options;
   if (frame.world)
     for (const auto& w : in.walls) {
-      if (!std::isfinite(w.x0_m + w.y0_m + w.x1_m + w.y1_m)) continue;
+      if (!std::isfinite(w.a.x + w.a.y + w.b.x + w.b.y)) continue;
       walls.push_back(w);
-      options.walls.push_back({w.x0_m, w.y0_m, w.x1_m, w.y1_m});
-      grow(std::min(w.x0_m, w.x1_m) - 0.2, std::min(w.y0_m, w.y1_m) - 0.2, std::max(w.x0_m, w.x1_m) + 0.2,
-           std::max(w.y0_m, w.y1_m) + 0.2);
+      options.walls.push_back(w);
+      grow(std::min(w.a.x, w.b.x) - 0.2, std::min(w.a.y, w.b.y) - 0.2, std::max(w.a.x, w.b.x) + 0.2,
+           std::max(w.a.y, w.b.y) + 0.2);
     }
   if (!bounds.valid()) return out;
   gas::MapOptions map_options;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "inspect/v1/link.pb.h"
+#include "shared/geometry/segment.hpp"
 
 namespace inspect::server {
 
@@ -20,11 +21,7 @@ struct RunReportInput {
 
   std::vector<v1::GasChannelInfo> gas_channels;            // from the robot's Hello; empty = unknown (names gas0..)
   std::vector<std::pair<double, v1::GasAlarm>> gas_alarms;  // run time t_s (as `events`) of each transition
-  /// A wall or obstacle edge of the site map.
-  struct MapWall {
-    double x0_m, y0_m, x1_m, y1_m;
-  };
-  std::vector<MapWall> walls;        // site map: walls and obstacle edges, world frame
+  std::vector<geometry::Segment> walls;  // site map: walls and obstacle edges, world frame
   bool have_map = false;             // true: draw in the world frame with `walls`
   double start_x_m = 0, start_y_m = 0, start_theta_rad = 0;  // world pose of the odometry origin
   std::string map_name;

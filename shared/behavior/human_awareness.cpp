@@ -25,15 +25,10 @@ SpeedPolicy parseSpeedPolicy(const std::string& s) {
 }
 
 HumanAwareness::HumanAwareness(const config::UltrasonicConfig& sonar, const AwarenessConfig& cfg,
-                               SpeedStrategy strategy, std::vector<MapSegment> map)
+                               SpeedStrategy strategy, std::vector<geometry::Segment> map)
     : cfg_(cfg), tracker_(sonar, cfg.tracker, map), classifier_(cfg.pattern), strategy_(std::move(strategy)) {
   walls_.reserve(map.size());
-  for (const auto& m : map) {
-    WallSegment w;
-    w.a_m = {m.x0, m.y0};
-    w.b_m = {m.x1, m.y1};
-    walls_.push_back(w);
-  }
+  for (const auto& m : map) walls_.push_back({m});
 }
 
 const Awareness& HumanAwareness::step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s) {

@@ -76,7 +76,7 @@ struct Awareness {
 class HumanAwareness {
  public:
   HumanAwareness(const config::UltrasonicConfig& sonar, const AwarenessConfig& cfg, SpeedStrategy strategy,
-                 std::vector<MapSegment> map = {});
+                 std::vector<geometry::Segment> map = {});
   /// One tick (pose in the odometry frame, ranges in m with < 0 = no echo).
   const Awareness& step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s);
   const Awareness& last() const { return last_; }

@@ -6,14 +6,6 @@
 
 namespace inspect::behavior {
 namespace {
-double segmentDistance(const MapSegment& s, double x, double y) {
-  const double dx = s.x1 - s.x0, dy = s.y1 - s.y0;
-  const double l2 = dx * dx + dy * dy;
-  double u = l2 > 0 ? ((x - s.x0) * dx + (y - s.y0) * dy) / l2 : 0.0;
-  u = std::clamp(u, 0.0, 1.0);
-  return std::hypot(x - (s.x0 + u * dx), y - (s.y0 + u * dy));
-}
-
 Eigen::Matrix2d beamCovariance(double yaw, double along, double across) {
   Eigen::Matrix2d rot;
   rot << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
@@ -22,7 +14,7 @@ Eigen::Matrix2d beamCovariance(double yaw, double along, double across) {
 }  // namespace
 
 HumanTracker::HumanTracker(const config::UltrasonicConfig& sonar, const HumanTrackerParams& params,
-                           std::vector<MapSegment> map)
+                           std::vector<geometry::Segment> map)
     : sonar_(sonar), p_(params), map_(std::move(map)),
       grid_(static_cast<std::size_t>(params.grid_size) * static_cast<std::size_t>(params.grid_size)) {
   tracks_.reserve(static_cast<std::size_t>(p_.max_tracks));
@@ -68,7 +60,7 @@ std::optional<std::pair<Eigen::Vector2d, Eigen::Matrix2d>> HumanTracker::triangu
 
 bool HumanTracker::nearMap(double x, double y) const {
   for (const auto& s : map_)
-    if (segmentDistance(s, x, y) < p_.map_margin_m) return true;
+    if (geometry::pointSegmentDistance({x, y}, s) < p_.map_margin_m) return true;
   return false;
 }
 

@@ -21,13 +21,10 @@
 
 #include "shared/config/robot_config.hpp"
 #include "shared/control/diff_drive.hpp"
+#include "shared/geometry/segment.hpp"
 
 namespace inspect::behavior {
 
-/// A static segment known to the robot (odometry frame), e.g. from the map.
-struct MapSegment {
-  double x0, y0, x1, y1;
-};
 
 struct HumanTrackerParams {
   double gate_m = 0.8;                // association gate (Euclidean, predicted position to point)
@@ -85,7 +82,7 @@ struct TrackerCounters {
 class HumanTracker {
  public:
   HumanTracker(const config::UltrasonicConfig& sonar, const HumanTrackerParams& params,
-               std::vector<MapSegment> map = {});
+               std::vector<geometry::Segment> map = {});
 
   /// One tick: robot pose (odometry frame), the 4 ranges (< 0 = no echo), time.
   void step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s);
@@ -114,7 +111,7 @@ class HumanTracker {
 
   config::UltrasonicConfig sonar_;
   HumanTrackerParams p_;
-  std::vector<MapSegment> map_;
+  std::vector<geometry::Segment> map_;  // static segments known to the robot (odometry frame), e.g. from the map
   std::vector<HumanTrack> tracks_;
   std::vector<Cell> grid_;
   double grid_origin_x_ = 0, grid_origin_y_ = 0;

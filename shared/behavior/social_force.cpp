@@ -70,10 +70,12 @@ double leftOffset(const Eigen::Vector2d& p, const Eigen::Vector2d& heading, cons
 
 // Position of the point of s nearest to p, as a fraction u in [0, 1] from a to b.
 double nearestFraction(const WallSegment& s, const Eigen::Vector2d& p) {
-  const Eigen::Vector2d e = s.b_m - s.a_m;
-  const double len2 = e.squaredNorm();
-  return len2 > 0.0 ? std::clamp((p - s.a_m).dot(e) / len2, 0.0, 1.0) : 0.0;
+  const geometry::Vec2 e = s.edge.b - s.edge.a;
+  const double len2 = dot(e, e);
+  return len2 > 0.0 ? std::clamp(dot(geometry::Vec2{p.x(), p.y()} - s.edge.a, e) / len2, 0.0, 1.0) : 0.0;
 }
+
+Eigen::Vector2d eigen(geometry::Vec2 v) { return {v.x, v.y}; }
 
 }  // namespace
 
@@ -116,9 +118,10 @@ SocialForce computeForce(const Agent& self, std::span<const Agent> others, WallV
 
   for (const WallSegment& s : walls) {
     const double u = nearestFraction(s, self.position_m);
-    const Eigen::Vector2d diff = self.position_m - (s.a_m + u * (s.b_m - s.a_m));
+    const Eigen::Vector2d a = eigen(s.edge.a), b = eigen(s.edge.b);
+    const Eigen::Vector2d diff = self.position_m - (a + u * (b - a));
     const double d = diff.norm();
-    const Eigen::Vector2d n = d > kTiny ? Eigen::Vector2d(diff / d) : unitOr(perp(s.b_m - s.a_m), side);
+    const Eigen::Vector2d n = d > kTiny ? Eigen::Vector2d(diff / d) : unitOr(perp(b - a), side);
     const bool shared_corner = (u <= 0.0 && s.a_joined) || (u >= 1.0 && s.b_joined);
     f.walls_m_s2 += (shared_corner ? 0.5 : 1.0) * push(n, d - self.radius_m, p.walls, kNoContact, heading, 0.0, 0.0);
   }

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "shared/config/config_node.hpp"
+#include "shared/geometry/segment.hpp"
 
 namespace inspect::behavior {
 
@@ -85,8 +86,7 @@ struct Agent {
 /// joined flag: both edges' nearest point is then that corner, and each
 /// pushes with half strength so the corner is not counted twice.
 struct WallSegment {
-  Eigen::Vector2d a_m = Eigen::Vector2d::Zero();
-  Eigen::Vector2d b_m = Eigen::Vector2d::Zero();
+  geometry::Segment edge;  // metres
   bool a_joined = false;
   bool b_joined = false;
 };

@@ -55,7 +55,7 @@ struct Fit {
 class Model {
  public:
   Model(std::vector<Bin> bins, double tau_s, const LeakOptions& o)
-      : bins_(std::move(bins)), walls_(o.reflect_walls ? o.walls : std::vector<WallSegment>{}),
+      : bins_(std::move(bins)), walls_(o.reflect_walls ? o.walls : std::vector<geometry::Segment>{}),
         image_max_m_(o.image_max_m) {
     for (double l : o.length_scales_m)
       if (l > 0.0) shapes_.emplace_back(l, std::max(o.source_radius_m, 1e-3));
@@ -81,11 +81,11 @@ class Model {
   void images(double sx, double sy) {
     img_.clear();
     for (const auto& w : walls_) {
-      const double ux = w.x1_m - w.x0_m, uy = w.y1_m - w.y0_m, len2 = ux * ux + uy * uy;
+      const double ux = w.b.x - w.a.x, uy = w.b.y - w.a.y, len2 = ux * ux + uy * uy;
       if (len2 < 1e-12) continue;
-      const double t = ((sx - w.x0_m) * ux + (sy - w.y0_m) * uy) / len2;
+      const double t = ((sx - w.a.x) * ux + (sy - w.a.y) * uy) / len2;
       if (t < 0.0 || t > 1.0) continue;
-      const double fx = w.x0_m + t * ux, fy = w.y0_m + t * uy;
+      const double fx = w.a.x + t * ux, fy = w.a.y + t * uy;
       const double h = std::hypot(sx - fx, sy - fy);
       if (h < 1e-6 || h > image_max_m_) continue;
       img_.push_back({2.0 * fx - sx, 2.0 * fy - sy});
@@ -180,7 +180,7 @@ class Model {
   std::vector<Shape> shapes_;
   std::vector<double> decay_, r_;
   static constexpr std::size_t kMaxImages = 4;
-  std::vector<WallSegment> walls_;
+  std::vector<geometry::Segment> walls_;
   double image_max_m_ = 1.5;
   std::vector<std::pair<double, double>> img_;
   std::vector<double> ri_;  // distances of the bins to each image, image-major
@@ -224,17 +224,6 @@ std::string num(double v) {
   return buf;
 }
 
-bool segmentsCross(double ax, double ay, double bx, double by, const WallSegment& w) {
-  auto cross = [](double ox, double oy, double px, double py, double qx, double qy) {
-    return (px - ox) * (qy - oy) - (py - oy) * (qx - ox);
-  };
-  const double d1 = cross(w.x0_m, w.y0_m, w.x1_m, w.y1_m, ax, ay);
-  const double d2 = cross(w.x0_m, w.y0_m, w.x1_m, w.y1_m, bx, by);
-  const double d3 = cross(ax, ay, bx, by, w.x0_m, w.y0_m);
-  const double d4 = cross(ax, ay, bx, by, w.x1_m, w.y1_m);
-  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
-}
-
 // Which candidate positions may hold the source: inside the bounds, within
 // reach of the path, and (with walls) in line of sight of one of the nearest
 // path points - a plume does not pass through walls.
@@ -255,8 +244,8 @@ class SearchArea {
     }
     if (near_.empty()) return false;
     if (walls_.empty()) return true;
-    if (band_m_ > 0.0 && std::none_of(walls_.begin(), walls_.end(), [&](const WallSegment& w) {
-          return distanceToSegment(x, y, w) <= band_m_;
+    if (band_m_ > 0.0 && std::none_of(walls_.begin(), walls_.end(), [&](const geometry::Segment& w) {
+          return geometry::pointSegmentDistance({x, y}, w) <= band_m_;
         }))
       return false;
     const std::size_t n = std::min<std::size_t>(12, near_.size());
@@ -264,7 +253,7 @@ class SearchArea {
     for (std::size_t i = 0; i < n; ++i) {
       // Not a structured binding: clang 14 cannot capture one in the lambda below.
       const double px = near_[i].second.first, py = near_[i].second.second;
-      if (std::none_of(walls_.begin(), walls_.end(), [&](const WallSegment& w) { return segmentsCross(x, y, px, py, w); }))
+      if (std::none_of(walls_.begin(), walls_.end(), [&](const geometry::Segment& w) { return geometry::segmentsCross({{x, y}, {px, py}}, w); }))
         return true;
     }
     return false;
@@ -283,15 +272,10 @@ class SearchArea {
   }
 
  private:
-  static double distanceToSegment(double x, double y, const WallSegment& w) {
-    const double ux = w.x1_m - w.x0_m, uy = w.y1_m - w.y0_m, len2 = ux * ux + uy * uy;
-    const double t = len2 > 0.0 ? std::clamp(((x - w.x0_m) * ux + (y - w.y0_m) * uy) / len2, 0.0, 1.0) : 0.0;
-    return std::hypot(x - (w.x0_m + t * ux), y - (w.y0_m + t * uy));
-  }
   Bounds bounds_;
   double reach_m_;
   double band_m_;
-  std::vector<WallSegment> walls_;
+  std::vector<geometry::Segment> walls_;
   std::vector<std::pair<double, double>> path_;
   mutable std::vector<std::pair<double, std::pair<double, double>>> near_;
 };

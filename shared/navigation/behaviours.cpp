@@ -71,7 +71,7 @@ Steer blendSteer(const control::Pose2& pose, Vec2 goal, const ObstacleSummary& o
   if (w <= 0.0 || norm(a) == 0.0) return gtg;
   // Eq 5.21 with unit vectors; w < 0.5 keeps the sum pointing goal-ward when
   // the two are opposite, so the blend itself never stalls the robot.
-  const Vec2 u = (1.0 - w) * unitAt(gtg.heading_rad) + w * a;
+  const Vec2 u = (1.0 - w) * geometry::unitAt(gtg.heading_rad) + w * a;
   return {angleOf(u), gtg.speed_m_s};
 }
 

@@ -5,9 +5,11 @@
 #include "shared/navigation/behaviours.hpp"
 #include "shared/navigation/mode.hpp"
 #include "shared/navigation/obstacle_memory.hpp"
-#include "shared/navigation/vec2.hpp"
+#include "shared/geometry/vec2.hpp"
 
 namespace inspect::navigation {
+
+using geometry::Vec2;
 
 /// Eq 5.24: the side whose boundary direction (Eq 5.23) makes an acute angle with the
 /// goal direction, dot(u_FW, u_GTG) > 0. When the goal lies straight behind the obstacle

@@ -98,7 +98,7 @@ void Navigator::switchTo(Mode m) {
 
 void Navigator::enterBoundary(const control::Pose2& pose, double distance_to_goal_m, Vec2 to_goal) {
   const Vec2 away = norm(obs_.avoid) > 0.0 ? obs_.avoid : obs_.away_from_nearest;
-  side_ = chooseSide(away, to_goal, unitAt(pose.theta_rad));  // Eq 5.24
+  side_ = chooseSide(away, to_goal, geometry::unitAt(pose.theta_rad));  // Eq 5.24
   d_tau_m_ = distance_to_goal_m;                              // reset: d_tau = |x - x_g| (Eq 5.25)
 }
 

@@ -18,9 +18,11 @@
 #include "shared/navigation/mode.hpp"
 #include "shared/navigation/navigation_params.hpp"
 #include "shared/navigation/obstacle_memory.hpp"
-#include "shared/navigation/vec2.hpp"
+#include "shared/geometry/vec2.hpp"
 
 namespace inspect::navigation {
+
+using geometry::Vec2;
 
 /// One tick's result: the command and what telemetry shows.
 struct NavigationOutput {

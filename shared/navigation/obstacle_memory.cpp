@@ -92,7 +92,7 @@ struct SideSum {
     const double dev = std::sqrt(std::max(0.0, (cxx - cyy) * (cxx - cyy) / 4.0 + cxy * cxy));
     const double l1 = mean + dev;
     const double l2 = mean - dev;
-    dir = unitAt(0.5 * std::atan2(2.0 * cxy, cxx - cyy));
+    dir = geometry::unitAt(0.5 * std::atan2(2.0 * cxy, cxx - cyy));
     line = l1 > kMinAlong_m * kMinAlong_m && l2 < kMaxAcross_m * kMaxAcross_m && l2 < kMaxFlatness * l1;
   }
   void extend(Vec2 p /* relative to the robot */) {
@@ -221,7 +221,7 @@ ObstacleSummary summarise(const ObstacleMemory& memory, const control::Pose2& po
       if (left.line && v.on_left) left.extend(p - x);
     }
   }
-  const Vec2 heading = unitAt(pose.theta_rad);
+  const Vec2 heading = geometry::unitAt(pose.theta_rad);
   right.finish(s.right, x, heading, params.follow_lookahead_m);
   left.finish(s.left, x, heading, params.follow_lookahead_m);
   if (s.any) {

@@ -16,9 +16,11 @@
 #include "shared/config/robot_config.hpp"
 #include "shared/control/diff_drive.hpp"
 #include "shared/navigation/navigation_params.hpp"
-#include "shared/navigation/vec2.hpp"
+#include "shared/geometry/vec2.hpp"
 
 namespace inspect::navigation {
+
+using geometry::Vec2;
 
 /// Number of ultrasonic sensors, in the wire order front-left, front-right, left, right.
 inline constexpr std::size_t kSonarCount = 4;

@@ -8,7 +8,7 @@ namespace inspect::robot {
 
 std::unique_ptr<behavior::HumanAwareness> makeAwareness(const config::RobotConfig& robot,
                                                         behavior::AwarenessConfig awareness,
-                                                        std::vector<behavior::MapSegment> map,
+                                                        std::vector<geometry::Segment> map,
                                                         const std::string& source) {
   awareness.robot_radius_m = robot.geometry.body_radius_m;
   try {

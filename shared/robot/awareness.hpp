@@ -16,7 +16,7 @@ namespace inspect::robot {
 /// when the rule base of `awareness.speed_fis` cannot be read.
 std::unique_ptr<behavior::HumanAwareness> makeAwareness(const config::RobotConfig& robot,
                                                         behavior::AwarenessConfig awareness,
-                                                        std::vector<behavior::MapSegment> map,
+                                                        std::vector<geometry::Segment> map,
                                                         const std::string& source);
 
 }  // namespace inspect::robot

@@ -35,8 +35,8 @@ GasSource readSource(const ConfigNode& n, std::size_t index, const World& world,
   if (!validName(s.name, 64, true)) n.fail("name", "'" + s.name + "' must be 1 to 64 letters, digits, '_', '-' or '.'");
   s.gas = n.requireString("gas");
   if (!validName(s.gas, 16, false)) n.fail("gas", "'" + s.gas + "' is not a gas channel name ([A-Za-z0-9_-]{1,16})");
-  s.position.x_m = n.requireNumber("x_m", -kMaxCoord_m, kMaxCoord_m);
-  s.position.y_m = n.requireNumber("y_m", -kMaxCoord_m, kMaxCoord_m);
+  s.position.x = n.requireNumber("x_m", -kMaxCoord_m, kMaxCoord_m);
+  s.position.y = n.requireNumber("y_m", -kMaxCoord_m, kMaxCoord_m);
   s.rate = n.requireNumber("rate", 0.0, 1e6);
   if (s.rate <= 0.0) n.fail("rate", "must be positive");
   s.start_s = n.number("start_s", 0.0, -kMaxTime_s, kMaxTime_s);
@@ -48,11 +48,11 @@ GasSource readSource(const ConfigNode& n, std::size_t index, const World& world,
   const auto box = solidBounds(world);
   if (!box) n.fail("x_m", "a world with leaks needs walls or obstacles (the gas grid covers their bounding box)");
   const Vec2 p = s.position;
-  if (p.x_m <= box->lo.x_m || p.x_m >= box->hi.x_m || p.y_m <= box->lo.y_m || p.y_m >= box->hi.y_m)
+  if (p.x <= box->lo.x || p.x >= box->hi.x || p.y <= box->lo.y || p.y >= box->hi.y)
     n.fail("x_m", "leak at " + pointText(p) + " lies outside the walls' bounding box " + pointText(box->lo) + " .. " +
                       pointText(box->hi));
   for (const auto& o : world.obstacles)
-    if (geom::pointInPolygon(p, o.polygon))
+    if (geometry::pointInPolygon(p, o.polygon))
       n.fail("x_m", "leak at " + pointText(p) + " lies inside obstacle '" + o.name + "'");
   if (clearance(world, p) < 1e-6) n.fail("x_m", "leak at " + pointText(p) + " lies on a wall or obstacle edge");
   return s;

@@ -41,7 +41,7 @@ PedestrianScript readOne(const config::ConfigNode& n, std::size_t index, const W
   }
   for (std::size_t i = 0; i + 1 < s.route.size(); ++i) {
     const Vec2 d = s.route[i + 1] - s.route[i];
-    if (std::hypot(d.x_m, d.y_m) < 1e-6)
+    if (std::hypot(d.x, d.y) < 1e-6)
       n.fail("route_m", "points " + std::to_string(i) + " and " + std::to_string(i + 1) + " are the same");
   }
   for (std::size_t i = 0; i < s.route.size(); ++i) {

@@ -6,9 +6,14 @@
 #include <vector>
 
 #include "shared/config/config_node.hpp"
-#include "shared/world/geometry.hpp"
+#include "shared/geometry/polygon.hpp"
 
 namespace inspect::world {
+
+using geometry::Polygon;
+using geometry::Segment;
+using geometry::Vec2;
+using geometry::pointText;
 
 struct World;
 

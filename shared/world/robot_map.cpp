@@ -4,19 +4,16 @@
 
 namespace inspect::world {
 
-std::vector<behavior::MapSegment> mapFromWorld(const World& w) {
+std::vector<Segment> mapFromWorld(const World& w) {
   // Odometry starts at (0, 0, 0) where the robot stands at start-up, so a
   // world point p is R(-theta0) (p - start) in the odometry frame.
   const double c = std::cos(w.start.theta_rad), s = std::sin(w.start.theta_rad);
-  const auto toOdometry = [&](const Eigen::Vector2d& p) {
-    const double dx = p.x() - w.start.x_m, dy = p.y() - w.start.y_m;
-    return Eigen::Vector2d(c * dx + s * dy, -s * dx + c * dy);
+  const auto toOdometry = [&](Vec2 p) {
+    const double dx = p.x - w.start.x_m, dy = p.y - w.start.y_m;
+    return Vec2{c * dx + s * dy, -s * dx + c * dy};
   };
-  std::vector<behavior::MapSegment> map;
-  for (const auto& e : solidEdges(w)) {
-    const Eigen::Vector2d a = toOdometry(e.a_m), b = toOdometry(e.b_m);
-    map.push_back({a.x(), a.y(), b.x(), b.y()});
-  }
+  std::vector<Segment> map;
+  for (const auto& e : solidEdges(w)) map.push_back({toOdometry(e.edge.a), toOdometry(e.edge.b)});
   return map;
 }
 

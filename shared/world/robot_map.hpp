@@ -11,6 +11,6 @@ namespace inspect::world {
 /// Every wall segment and obstacle edge of `w` (solidEdges), moved from
 /// the world frame into the odometry frame of a robot started at `w.start`
 /// (origin and x axis = the start pose), ready for behavior::HumanAwareness.
-std::vector<behavior::MapSegment> mapFromWorld(const World& w);
+std::vector<Segment> mapFromWorld(const World& w);
 
 }  // namespace inspect::world

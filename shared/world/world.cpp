@@ -54,7 +54,7 @@ std::vector<Segment> readSegments(const ConfigNode& n) {
   std::vector<Segment> out;
   if (single) {
     const Segment s{readPoint(n, "from_m"), readPoint(n, "to_m")};
-    if (std::hypot(s.b.x_m - s.a.x_m, s.b.y_m - s.a.y_m) < 1e-6) n.fail("to_m", "segment has zero length");
+    if (std::hypot(s.b.x - s.a.x, s.b.y - s.a.y) < 1e-6) n.fail("to_m", "segment has zero length");
     out.push_back(s);
     return out;
   }
@@ -66,21 +66,21 @@ std::vector<Segment> readSegments(const ConfigNode& n) {
     out.push_back({pts.back(), pts.front()});
   }
   for (std::size_t i = 0; i < out.size(); ++i)
-    if (std::hypot(out[i].b.x_m - out[i].a.x_m, out[i].b.y_m - out[i].a.y_m) < 1e-6)
+    if (std::hypot(out[i].b.x - out[i].a.x, out[i].b.y - out[i].a.y) < 1e-6)
       n.fail("points_m", "segment " + std::to_string(i) + " has zero length (repeated point)");
   return out;
 }
 
 Polygon readPolygon(const ConfigNode& n) {
   Polygon p{readPoints(n, "vertices_m", 3)};
-  if (std::abs(geom::signedArea(p)) < 1e-6) n.fail("vertices_m", "polygon has no area (degenerate)");
-  const auto edges = geom::edgesOf(p);
+  if (std::abs(geometry::signedArea(p)) < 1e-6) n.fail("vertices_m", "polygon has no area (degenerate)");
+  const auto edges = geometry::edgesOf(p);
   const std::size_t m = edges.size();
   for (std::size_t i = 0; i < m; ++i) {
     for (std::size_t j = i + 1; j < m; ++j) {
       const bool adjacent = j == i + 1 || (i == 0 && j == m - 1);
       if (adjacent) continue;
-      if (geom::segmentsIntersect(edges[i], edges[j]))
+      if (geometry::segmentsIntersect(edges[i], edges[j]))
         n.fail("vertices_m", "edges " + std::to_string(i) + " and " + std::to_string(j) +
                                  " cross or touch; an obstacle must be a simple polygon");
     }
@@ -92,9 +92,9 @@ Polygon readPolygon(const ConfigNode& n) {
 
 double clearance(const World& w, Vec2 p) {
   for (const auto& o : w.obstacles)
-    if (geom::pointInPolygon(p, o.polygon)) return 0.0;
+    if (geometry::pointInPolygon(p, o.polygon)) return 0.0;
   double best = std::numeric_limits<double>::infinity();
-  forEachSolidEdge(w, [&](const Segment& s) { best = std::min(best, geom::pointSegmentDistance(p, s)); });
+  forEachSolidEdge(w, [&](const Segment& s) { best = std::min(best, geometry::pointSegmentDistance(p, s)); });
   return best;
 }
 
@@ -102,7 +102,7 @@ std::optional<double> castRay(const World& w, Vec2 origin, double yaw_rad, doubl
   const Vec2 dir{std::cos(yaw_rad), std::sin(yaw_rad)};
   std::optional<double> best;
   forEachSolidEdge(w, [&](const Segment& s) {
-    const auto t = geom::raySegment(origin, dir, s);
+    const auto t = geometry::raySegment(origin, dir, s);
     if (t && *t <= max_range_m && (!best || *t < *best)) best = t;
   });
   return best;
@@ -110,19 +110,15 @@ std::optional<double> castRay(const World& w, Vec2 origin, double yaw_rad, doubl
 
 std::vector<behavior::WallSegment> solidEdges(const World& w) {
   std::vector<behavior::WallSegment> out;
-  forEachSolidEdge(w, [&](const Segment& s) {
-    behavior::WallSegment e;
-    e.a_m = {s.a.x_m, s.a.y_m};
-    e.b_m = {s.b.x_m, s.b.y_m};
-    out.push_back(e);
-  });
+  forEachSolidEdge(w, [&](const Segment& s) { out.push_back({s}); });
   // Corners of polylines and polygons (or separate walls meeting end to end).
-  const auto same = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q) { return (p - q).norm() < 1e-9; };
+  const auto same = [](Vec2 p, Vec2 q) { return norm(p - q) < 1e-9; };
   for (std::size_t i = 0; i < out.size(); ++i) {
     for (std::size_t j = 0; j < out.size(); ++j) {
       if (i == j) continue;
-      out[i].a_joined = out[i].a_joined || same(out[i].a_m, out[j].a_m) || same(out[i].a_m, out[j].b_m);
-      out[i].b_joined = out[i].b_joined || same(out[i].b_m, out[j].a_m) || same(out[i].b_m, out[j].b_m);
+      const Segment &p = out[i].edge, &q = out[j].edge;
+      out[i].a_joined = out[i].a_joined || same(p.a, q.a) || same(p.a, q.b);
+      out[i].b_joined = out[i].b_joined || same(p.b, q.a) || same(p.b, q.b);
     }
   }
   return out;
@@ -133,8 +129,8 @@ std::optional<Bounds> solidBounds(const World& w) {
   forEachSolidEdge(w, [&](const Segment& s) {
     for (const Vec2 p : {s.a, s.b}) {
       if (!b) b = Bounds{p, p};
-      b->lo = {std::min(b->lo.x_m, p.x_m), std::min(b->lo.y_m, p.y_m)};
-      b->hi = {std::max(b->hi.x_m, p.x_m), std::max(b->hi.y_m, p.y_m)};
+      b->lo = {std::min(b->lo.x, p.x), std::min(b->lo.y, p.y)};
+      b->hi = {std::max(b->hi.x, p.x), std::max(b->hi.y, p.y)};
     }
   });
   return b;
@@ -142,7 +138,7 @@ std::optional<Bounds> solidBounds(const World& w) {
 
 bool onFloorLine(const World& w, Vec2 p) {
   for (const auto& l : w.floor_lines)
-    if (geom::pointSegmentDistance(p, l.centre) <= l.width_m / 2.0) return true;
+    if (geometry::pointSegmentDistance(p, l.centre) <= l.width_m / 2.0) return true;
   return false;
 }
 

@@ -11,10 +11,15 @@
 #include "shared/control/diff_drive.hpp"
 #include "shared/control/plant_model.hpp"
 #include "shared/world/gas_spec.hpp"
-#include "shared/world/geometry.hpp"
+#include "shared/geometry/polygon.hpp"
 #include "shared/world/pedestrian_script.hpp"
 
 namespace inspect::world {
+
+using geometry::Polygon;
+using geometry::Segment;
+using geometry::Vec2;
+using geometry::pointText;
 
 /// World coordinates (walls, obstacles, people, gas sources) stay within
 /// +-kMaxCoord_m, a sane box that also keeps float error small.

@@ -57,7 +57,7 @@ struct Setup {
   std::shared_ptr<control::FuzzyGainScheduler> scheduler;
   behavior::AwarenessConfig awareness;
   std::unique_ptr<behavior::SpeedStrategy> strategy;
-  std::vector<behavior::MapSegment> map;
+  std::vector<geometry::Segment> map;
 };
 Setup* g_setup = nullptr;
 

@@ -405,15 +405,15 @@ obstacles:
                                           "map_test.yaml");
   const auto map = world::mapFromWorld(w);
   ASSERT_EQ(map.size(), 4u) << "one wall and three obstacle edges";
-  EXPECT_NEAR(map[0].x0, 2.0, 1e-12);
-  EXPECT_NEAR(map[0].y0, 0.0, 1e-12);
-  EXPECT_NEAR(map[0].x1, 2.0, 1e-12);
-  EXPECT_NEAR(map[0].y1, -2.0, 1e-12);
+  EXPECT_NEAR(map[0].a.x, 2.0, 1e-12);
+  EXPECT_NEAR(map[0].a.y, 0.0, 1e-12);
+  EXPECT_NEAR(map[0].b.x, 2.0, 1e-12);
+  EXPECT_NEAR(map[0].b.y, -2.0, 1e-12);
   // Every edge keeps its length, and the obstacle's first vertex (1, 5) is at odometry (1, 1).
   bool corner = false;
   for (const auto& m : map) {
-    corner = corner || (std::abs(m.x0 - 1.0) < 1e-12 && std::abs(m.y0 - 1.0) < 1e-12);
-    EXPECT_GT(std::hypot(m.x1 - m.x0, m.y1 - m.y0), 0.49);
+    corner = corner || (std::abs(m.a.x - 1.0) < 1e-12 && std::abs(m.a.y - 1.0) < 1e-12);
+    EXPECT_GT(std::hypot(m.b.x - m.a.x, m.b.y - m.a.y), 0.49);
   }
   EXPECT_TRUE(corner);
   // The start pose itself is the odometry origin: an empty world gives an empty map.

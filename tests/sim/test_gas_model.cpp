@@ -97,11 +97,11 @@ TEST(GasModel, FreeSpaceSteadyStateIsSymmetricAndMatchesBesselK0) {
   const Vec2 src{0.05, 0.05};
   double prev = std::numeric_limits<double>::infinity();
   for (double r : {0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 2.5, 3.0}) {
-    const double east = g.concentration(f, {src.x_m + r, src.y_m});
-    const double west = g.concentration(f, {src.x_m - r, src.y_m});
-    const double north = g.concentration(f, {src.x_m, src.y_m + r});
-    const double south = g.concentration(f, {src.x_m, src.y_m - r});
-    const double diag = g.concentration(f, {src.x_m + r / std::sqrt(2.0), src.y_m + r / std::sqrt(2.0)});
+    const double east = g.concentration(f, {src.x + r, src.y});
+    const double west = g.concentration(f, {src.x - r, src.y});
+    const double north = g.concentration(f, {src.x, src.y + r});
+    const double south = g.concentration(f, {src.x, src.y - r});
+    const double diag = g.concentration(f, {src.x + r / std::sqrt(2.0), src.y + r / std::sqrt(2.0)});
     const double exact = besselSolution(q, d, k, r);
     std::printf("GAS free space r=%.1f m: c=%.4f  K0 solution=%.4f  (%+.2f %%)  diagonal %+.2f %%\n", r, east, exact,
                 100.0 * (east / exact - 1.0), 100.0 * (diag / exact - 1.0));
@@ -136,7 +136,7 @@ TEST(GasModel, ExplicitStepsConvergeToTheSteadyState) {
     const int n = static_cast<int>(c.run_s / 0.05);
     for (int i = 1; i <= n; ++i) run.advanceTo(i * 0.05);
     for (Vec2 p : {Vec2{-0.5, 0.3}, Vec2{0.5, 0.3}, Vec2{-1.5, -1.0}, Vec2{2.0, 2.0}})
-      EXPECT_NEAR(run.concentration(0, p) / steady.concentration(0, p), 1.0, 1e-3) << c.params << p.x_m << "," << p.y_m;
+      EXPECT_NEAR(run.concentration(0, p) / steady.concentration(0, p), 1.0, 1e-3) << c.params << p.x << "," << p.y;
   }
 }
 
@@ -596,8 +596,8 @@ TEST(GasLab, SteadyPlumesRaiseAndClearAlarmsAlongTheRoute) {
       const Vec2 p{x, y};
       const double c = sim.trueConcentration(ch4, p), s = sim.trueConcentration(h2s, p),
                    o = sim.trueConcentration(o2, p);
-      const double d_valve = std::hypot(x - valve.x_m, y - valve.y_m);
-      const double d_drain = std::hypot(x - drain.x_m, y - drain.y_m);
+      const double d_valve = std::hypot(x - valve.x, y - valve.y);
+      const double d_drain = std::hypot(x - drain.x, y - drain.y);
       if (d_valve >= 3.0) {
         EXPECT_LT(c, gas.channels[ch4].alarm_low) << x << "," << y;
       }

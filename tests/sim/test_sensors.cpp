@@ -95,9 +95,9 @@ TEST(Ultrasonic, SideSensorsFollowTheRobotHeading) {
 }
 
 TEST(Grayscale, ChannelsAcrossTheFront) {
-  EXPECT_DOUBLE_EQ(GrayscaleModel::spotInRobot(0).y_m, 0.07);
-  EXPECT_DOUBLE_EQ(GrayscaleModel::spotInRobot(7).y_m, -0.07);
-  EXPECT_DOUBLE_EQ(GrayscaleModel::spotInRobot(3).x_m, GrayscaleModel::kRowX_m);
+  EXPECT_DOUBLE_EQ(GrayscaleModel::spotInRobot(0).y, 0.07);
+  EXPECT_DOUBLE_EQ(GrayscaleModel::spotInRobot(7).y, -0.07);
+  EXPECT_DOUBLE_EQ(GrayscaleModel::spotInRobot(3).x, GrayscaleModel::kRowX_m);
   // A 2.5 cm line along x under the robot's centre: the middle channels see it.
   const World w = worldOf("floor_lines:\n  - {from_m: [-1, 0], to_m: [1, 0], width_m: 0.025}\n", "w.yaml");
   EXPECT_EQ(GrayscaleModel::read(w, {}), 0b00011000);

@@ -17,7 +17,7 @@ struct Circle {
 
 // Echo of each sensor: nearest hit of 7 rays across its cone against circles and segments (+- noise).
 inline std::array<double, 4> echoes(const config::UltrasonicConfig& u, const control::Pose2& pose,
-                             const std::vector<Circle>& people, const std::vector<behavior::MapSegment>& walls,
+                             const std::vector<Circle>& people, const std::vector<geometry::Segment>& walls,
                              std::mt19937* rng = nullptr) {
   std::array<double, 4> out{};
   std::uniform_real_distribution<double> noise(-u.noise_m, u.noise_m);
@@ -35,10 +35,10 @@ inline std::array<double, 4> echoes(const config::UltrasonicConfig& u, const con
       if (t > 0) best = std::min(best, t);
     }
     for (const auto& w : walls) {
-      const double ex = w.x1 - w.x0, ey = w.y1 - w.y0, den = dx * ey - dy * ex;
+      const double ex = w.b.x - w.a.x, ey = w.b.y - w.a.y, den = dx * ey - dy * ex;
       if (std::abs(den) < 1e-12) continue;
-      const double t = ((w.x0 - ox) * ey - (w.y0 - oy) * ex) / den;
-      const double v = ((w.x0 - ox) * dy - (w.y0 - oy) * dx) / den;
+      const double t = ((w.a.x - ox) * ey - (w.a.y - oy) * ex) / den;
+      const double v = ((w.a.x - ox) * dy - (w.a.y - oy) * dx) / den;
       if (t > 0 && v >= 0 && v <= 1) best = std::min(best, t);
     }
     }

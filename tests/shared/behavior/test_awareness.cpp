@@ -68,7 +68,7 @@ TEST(HumanTracker, ATrackASensorSeesThroughIsDroppedNotCoasted) {
   const control::Pose2 robot{0, 0, 0};
   // An oncoming person straight ahead, then gone (stepped out of view behind a
   // shelf end): the front sensors now hear the far wall at 4 m.
-  const std::vector<behavior::MapSegment> far_wall{{4.2, -3, 4.2, 3}};
+  const std::vector<geometry::Segment> far_wall{{4.2, -3, 4.2, 3}};
   int k = 0;
   for (; k < 200; ++k) tr.step(robot, echoes(u, robot, {{3.0 - 0.5 * k * 0.01, 0.0, 0.25}}, {}), k * 0.01);
   ASSERT_NE(tr.nearest(robot), nullptr);

@@ -41,7 +41,7 @@ TEST(HumanTracker, AWallAheadIsNotAPerson) {
   const config::UltrasonicConfig u;
   HumanTracker tr(u, {});
   const control::Pose2 robot{0, 0, 0};
-  const std::vector<behavior::MapSegment> wall = {{2.0, -3, 2.0, 3}};
+  const std::vector<geometry::Segment> wall = {{2.0, -3, 2.0, 3}};
   std::mt19937 rng(4);
   int person_ticks = 0;
   for (int k = 0; k < 500; ++k) {
@@ -54,7 +54,7 @@ TEST(HumanTracker, AWallAheadIsNotAPerson) {
 
 TEST(HumanTracker, KnownMapWallsAreDroppedWhileDriving) {
   const config::UltrasonicConfig u;
-  const std::vector<behavior::MapSegment> walls = {{-1, 1.2, 20, 1.2}, {-1, -1.2, 20, -1.2}};
+  const std::vector<geometry::Segment> walls = {{-1, 1.2, 20, 1.2}, {-1, -1.2, 20, -1.2}};
   HumanTracker tr(u, {}, walls);
   std::mt19937 rng(5);
   int person_ticks = 0;

@@ -108,7 +108,7 @@ TEST(PedestrianCrowd, AbsentBeforeStartThenWalksTheRouteAndStops) {
   EXPECT_LT(crowd.agent(0).velocity_m_s.norm(), 1e-3) << "stands at the end";
   ASSERT_EQ(crowd.circles().size(), 1u);
   EXPECT_DOUBLE_EQ(crowd.circles()[0].radius_m, 0.25);
-  EXPECT_DOUBLE_EQ(crowd.circles()[0].centre.x_m, crowd.agent(0).position_m.x());
+  EXPECT_DOUBLE_EQ(crowd.circles()[0].centre.x, crowd.agent(0).position_m.x());
 }
 
 TEST(PedestrianCrowd, PausesAtAWaypoint) {

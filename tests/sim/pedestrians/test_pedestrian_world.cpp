@@ -21,7 +21,7 @@ using inspect::test::worldOf;
 
 std::string errorOf(const std::string& yaml) { return inspect::test::worldError(yaml, "peds.yaml"); }
 
-double dist(Vec2 a, Vec2 b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+double dist(Vec2 a, Vec2 b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
 }  // namespace
 
@@ -52,8 +52,8 @@ social_force:
   EXPECT_DOUBLE_EQ(p.speed_m_s, 1.2);
   EXPECT_DOUBLE_EQ(p.start_s, 2.5);
   ASSERT_EQ(p.route.size(), 3u);
-  EXPECT_DOUBLE_EQ(p.route[2].x_m, 4.0);
-  EXPECT_DOUBLE_EQ(p.route[2].y_m, 3.0);
+  EXPECT_DOUBLE_EQ(p.route[2].x, 4.0);
+  EXPECT_DOUBLE_EQ(p.route[2].y, 3.0);
   ASSERT_EQ(p.pauses.size(), 2u);
   EXPECT_EQ(p.pauses[0].at, 1u);
   EXPECT_DOUBLE_EQ(p.pauses[0].duration_s, 2.0);
@@ -162,10 +162,10 @@ TEST(PedestrianWorld, ShippedCrossingLoads) {
   ASSERT_GE(p.route.size(), 2u);
   const Vec2 a = p.route.front(), b = p.route.back();
   // Front-left to front-right, crossing the robot's line y = 0 3..4.5 m ahead.
-  EXPECT_GT(a.x_m, 0.0);
-  EXPECT_GT(a.y_m, 1.0);
-  EXPECT_LT(b.y_m, -1.0);
-  const double x_cross = a.x_m + (b.x_m - a.x_m) * a.y_m / (a.y_m - b.y_m);
+  EXPECT_GT(a.x, 0.0);
+  EXPECT_GT(a.y, 1.0);
+  EXPECT_LT(b.y, -1.0);
+  const double x_cross = a.x + (b.x - a.x) * a.y / (a.y - b.y);
   EXPECT_GT(x_cross, 3.0);
   EXPECT_LT(x_cross, 4.5);
   EXPECT_NEAR(dist(a, {0, 0}), 5.5, 0.2);
@@ -175,7 +175,7 @@ TEST(PedestrianWorld, ShippedCrossingLoads) {
   EXPECT_GT(clearance(w, {x_cross, 4.0}), 1.25);
   EXPECT_LT(clearance(w, {x_cross, 4.0}), 1.5);
   // The straight 0.5 m/s runs of both reach the crossing within ~1 s of each other.
-  const double t_person = std::abs(a.y_m) / p.speed_m_s;
+  const double t_person = std::abs(a.y) / p.speed_m_s;
   const double t_robot = x_cross / 0.5;
   EXPECT_NEAR(t_person, t_robot, 1.0);
 }
@@ -189,9 +189,9 @@ TEST(PedestrianWorld, ShippedEncounteringLoads) {
   EXPECT_DOUBLE_EQ(p.speed_m_s, 0.5);
   const Vec2 a = p.route.front(), b = p.route.back();
   EXPECT_NEAR(dist(a, {0, 0}), 5.5, 0.2);
-  EXPECT_NEAR(a.y_m, 0.6, 1e-9);  // lateral offset
-  EXPECT_NEAR(b.y_m, 0.6, 1e-9);
-  EXPECT_LT(b.x_m, 0.0);          // walks towards and past the robot
+  EXPECT_NEAR(a.y, 0.6, 1e-9);  // lateral offset
+  EXPECT_NEAR(b.y, 0.6, 1e-9);
+  EXPECT_LT(b.x, 0.0);          // walks towards and past the robot
   // A ~3 m wide aisle.
   const double width = clearance(w, {0.0, 0.0}) * 2;
   EXPECT_NEAR(width, 3.0, 0.3);

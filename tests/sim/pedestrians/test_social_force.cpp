@@ -38,9 +38,12 @@ void aimAt(Agent& a, const V& goal) {
 }
 
 double wallDistance(const WallSegment& s, const V& p) {
-  const V e = s.b_m - s.a_m;
-  const double u = std::clamp((p - s.a_m).dot(e) / e.squaredNorm(), 0.0, 1.0);
-  return (p - (s.a_m + u * e)).norm();
+  return inspect::geometry::pointSegmentDistance({p.x(), p.y()}, s.edge);
+}
+
+// A wall from a to b (Eigen points), its ends joined to other walls or not.
+WallSegment wallOf(const V& a, const V& b, bool a_joined = false, bool b_joined = false) {
+  return {{{a.x(), a.y()}, {b.x(), b.y()}}, a_joined, b_joined};
 }
 
 }  // namespace
@@ -104,7 +107,7 @@ class HeadOn : public ::testing::TestWithParam<HeadOnCase> {};
 TEST_P(HeadOn, PassEachOtherWithoutOverlap) {
   const auto c = GetParam();
   const SocialForceParams p;
-  const std::vector<WallSegment> walls{{V(-20, -1.5), V(40, -1.5)}, {V(-20, 1.5), V(40, 1.5)}};
+  const std::vector<WallSegment> walls{wallOf(V(-20, -1.5), V(40, -1.5)), wallOf(V(-20, 1.5), V(40, 1.5))};
   std::vector<Agent> a{walker(V(0, c.offset_m / 2), V(1, 0), c.speed_m_s),
                        walker(V(10, -c.offset_m / 2), V(-1, 0), c.speed_m_s)};
   std::vector<V> scratch(2);
@@ -143,7 +146,7 @@ TEST(SocialForce, DeadAheadPassesKeepingRight) {
 
 TEST(SocialForce, WalkingAlongAWallKeepsClearance) {
   const SocialForceParams p;
-  const std::vector<WallSegment> wall{{V(-10, 0), V(40, 0)}};
+  const std::vector<WallSegment> wall{wallOf(V(-10, 0), V(40, 0))};
   Agent a = walker(V(0, 0.30), V(1, 0));  // starts 5 cm off the wall with its body
   double min_c = 1e9;
   for (int k = 0; k < 20000; ++k) {
@@ -158,7 +161,7 @@ TEST(SocialForce, WalkingAlongAWallKeepsClearance) {
 
 TEST(SocialForce, WalkingIntoAWallStopsBeforeIt) {
   const SocialForceParams p;
-  const std::vector<WallSegment> wall{{V(2, -5), V(2, 5)}};
+  const std::vector<WallSegment> wall{wallOf(V(2, -5), V(2, 5))};
   Agent a = walker(V(0, 0), V(1, 0));  // wants to walk through the wall at x = 2
   double max_x = -1e9;
   for (int k = 0; k < 20000; ++k) {
@@ -172,7 +175,7 @@ TEST(SocialForce, WalkingIntoAWallStopsBeforeIt) {
 std::vector<WallSegment> box(double x0, double y0, double x1, double y1) {
   const V c[4] = {V(x0, y0), V(x1, y0), V(x1, y1), V(x0, y1)};
   std::vector<WallSegment> w;
-  for (int i = 0; i < 4; ++i) w.push_back({c[i], c[(i + 1) % 4], true, true});
+  for (int i = 0; i < 4; ++i) w.push_back(wallOf(c[i], c[(i + 1) % 4], true, true));
   return w;
 }
 
@@ -202,12 +205,12 @@ TEST(SocialForce, A80cmDoorwayIsPassableAt05MetresPerSecond) {
 TEST(SocialForce, ASharedCornerCountsOnce) {
   const SocialForceParams p;
   // Two edges of a polygon meeting at (1, 1).
-  const std::vector<WallSegment> joined{{V(1, 0), V(1, 1), true, true}, {V(1, 1), V(0, 1), true, true}};
+  const std::vector<WallSegment> joined{wallOf(V(1, 0), V(1, 1), true, true), wallOf(V(1, 1), V(0, 1), true, true)};
   std::vector<WallSegment> loose = joined;
   for (auto& w : loose) w.a_joined = w.b_joined = false;
   Agent a;
   a.position_m = V(1.3, 1.3);  // beyond the corner (1, 1): both edges' nearest point is the corner
-  const std::vector<WallSegment> corner_edge{{V(1, 0), V(1, 1)}};
+  const std::vector<WallSegment> corner_edge{wallOf(V(1, 0), V(1, 1))};
   const V single = computeForce(a, {}, corner_edge, nullptr, p).walls_m_s2;
   EXPECT_TRUE(computeForce(a, {}, joined, nullptr, p).walls_m_s2.isApprox(single, 1e-9));
   EXPECT_TRUE(computeForce(a, {}, loose, nullptr, p).walls_m_s2.isApprox(2 * single, 1e-9));
@@ -255,7 +258,7 @@ TEST(SocialForce, CoincidentAndDegenerateInputGiveFiniteForces) {
   Agent robot;
   robot.position_m = V(1, 1);
   robot.radius_m = 0.35;
-  const std::vector<WallSegment> walls{{V(0, 1), V(2, 1)}, {V(1, 1), V(1, 1)}};
+  const std::vector<WallSegment> walls{wallOf(V(0, 1), V(2, 1)), wallOf(V(1, 1), V(1, 1))};
   Agent still;
   still.position_m = V(1, 1);
   const auto f = computeForce(still, {}, walls, &robot, p);
@@ -352,7 +355,7 @@ TEST(PredictPath, PersonHeadingForTheRobotIsPredictedToGoAround) {
   Agent person;  // 5.5 m ahead, walking at it
   person.position_m = V(5.5, 0.0);
   person.velocity_m_s = V(-0.5, 0.0);
-  const std::vector<WallSegment> walls{{V(-5, -1.5), V(15, -1.5)}, {V(-5, 1.5), V(15, 1.5)}};
+  const std::vector<WallSegment> walls{wallOf(V(-5, -1.5), V(15, -1.5)), wallOf(V(-5, 1.5), V(15, 1.5))};
   std::array<V, 100> out;  // 10 s at 0.1 s, caller-owned: no allocation
   ASSERT_EQ(predictPath(person, &robot, walls, p, 0.1, out), out.size());
   double min_d = 1e9;

@@ -1,9 +1,10 @@
 #pragma once
-// Planar vectors for the navigation behaviours (odometry or robot frame,
-// metres or unitless directions). Header-only, pure.
+// The plane's one vector type: a point or a direction (world, odometry or
+// robot frame; metres, or unitless for directions). Header-only, pure.
 #include <cmath>
+#include <string>
 
-namespace inspect::navigation {
+namespace inspect::geometry {
 
 /// A point or a direction in the plane.
 struct Vec2 {
@@ -14,6 +15,7 @@ struct Vec2 {
 inline Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }
 inline Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
 inline Vec2 operator*(double k, Vec2 a) { return {k * a.x, k * a.y}; }
+inline bool operator==(Vec2 a, Vec2 b) { return a.x == b.x && a.y == b.y; }
 /// Scalar product; its sign tells acute (> 0) from obtuse (< 0) angles (Eqs 5.24, 5.27).
 inline double dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
 /// z of the 3-D cross product: positive when b lies counter-clockwise of a.
@@ -32,11 +34,14 @@ inline Vec2 rotated(Vec2 a, double angle_rad) {
   const double s = std::sin(angle_rad);
   return {c * a.x - s * a.y, s * a.x + c * a.y};
 }
-/// Unit vector at world angle angle_rad.
+/// Unit vector at angle angle_rad.
 inline Vec2 unitAt(double angle_rad) { return {std::cos(angle_rad), std::sin(angle_rad)}; }
 /// Angle of a in [-pi, pi] (atan2).
 inline double angleOf(Vec2 a) { return std::atan2(a.y, a.x); }
 /// True when both components are finite.
 inline bool isFinite(Vec2 a) { return std::isfinite(a.x) && std::isfinite(a.y); }
 
-}  // namespace inspect::navigation
+/// "(x, y)" for messages about the world ("%g": "(1.5, -2)").
+std::string pointText(Vec2 p);
+
+}  // namespace inspect::geometry
