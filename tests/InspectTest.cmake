@@ -60,6 +60,15 @@ add_library(inspect_test_support STATIC
 target_link_libraries(inspect_test_support PUBLIC inspect_test_paths Threads::Threads)
 target_compile_options(inspect_test_support PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})
 
+# The one fake robot (tests/support/fake_robot): its messages, the fleet robot
+# (asynchronous, many per io_context); the scripted robot is header-only.
+add_library(inspect_fake_robot STATIC
+  ${PROJECT_SOURCE_DIR}/tests/support/fake_robot/robot_messages.cpp
+  ${PROJECT_SOURCE_DIR}/tests/support/fake_robot/fleet_robot.cpp)
+target_compile_options(inspect_fake_robot PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})
+target_link_libraries(inspect_fake_robot PUBLIC inspect_test_support inspect_shared inspect_tls inspect_proto
+                      OpenSSL::SSL Boost::headers Threads::Threads)
+
 
 # inspect_test_program(<name> SOURCES <files...> [LIBS <libs...>] [PROGRAMS <targets...>] [NO_UNITY])
 # A test program: its sources (one translation unit unless NO_UNITY), the

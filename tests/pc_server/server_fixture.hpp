@@ -13,7 +13,7 @@
 #include "pc_server/link/link_server.hpp"
 #include "pc_server/link/robot_registry.hpp"
 #include "shared/util/clock.hpp"
-#include "test_robot.hpp"
+#include "tests/support/fake_robot/scripted_robot.hpp"
 
 namespace inspect::test {
 

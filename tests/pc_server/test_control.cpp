@@ -61,7 +61,7 @@ class ControlTest : public ServerFixture {
     return n;
   }
 
-  TestRobot robot_;
+  ScriptedRobot robot_;
   server::ControlArbiter control_;
   Session alice_, bob_;
 };

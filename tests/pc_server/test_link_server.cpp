@@ -13,14 +13,14 @@ namespace {
 
 class LinkServerTest : public ServerFixture {};
 
-std::vector<TestRobot::Received> commandsOf(const TestRobot& r, Body kind_of_body = Body::kCommand) {
-  std::vector<TestRobot::Received> out;
+std::vector<ScriptedRobot::Received> commandsOf(const ScriptedRobot& r, Body kind_of_body = Body::kCommand) {
+  std::vector<ScriptedRobot::Received> out;
   for (const auto& m : r.received())
     if (m.env.body_case() == kind_of_body) out.push_back(m);
   return out;
 }
 
-int teleopsBetween(const TestRobot& r, Clock::time_point from, Clock::time_point to) {
+int teleopsBetween(const ScriptedRobot& r, Clock::time_point from, Clock::time_point to) {
   int n = 0;
   for (const auto& m : commandsOf(r))
     if (m.env.command().has_teleop() && m.t >= from && m.t < to) ++n;
@@ -31,7 +31,7 @@ int teleopsBetween(const TestRobot& r, Clock::time_point from, Clock::time_point
 
 TEST_F(LinkServerTest, HandshakeAcceptedAndHeartbeatsFlow) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   const auto reply = r.hello("robot1");
   ASSERT_TRUE(reply);
@@ -51,7 +51,7 @@ TEST_F(LinkServerTest, HandshakeAcceptedAndHeartbeatsFlow) {
 
 TEST_F(LinkServerTest, VersionMismatchRejectedWithReason) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   const auto reply = r.hello("robot1", net::kProtocolVersion + 1);
   ASSERT_TRUE(reply);
@@ -65,7 +65,7 @@ TEST_F(LinkServerTest, VersionMismatchRejectedWithReason) {
 TEST_F(LinkServerTest, BadRobotIdRejected) {
   startServer();
   for (const std::string& bad : {std::string(""), std::string("bad id"), std::string(65, 'a'), std::string("r/1")}) {
-    TestRobot r;
+    ScriptedRobot r;
     ASSERT_TRUE(r.connect(port_));
     const auto reply = r.hello(bad);
     ASSERT_TRUE(reply) << bad;
@@ -74,11 +74,11 @@ TEST_F(LinkServerTest, BadRobotIdRejected) {
     EXPECT_TRUE(r.waitClosed(2000ms));
   }
   // Not UTF-8: the Envelope itself does not parse (proto3 strings), so no reply, just a close.
-  TestRobot binary;
+  ScriptedRobot binary;
   ASSERT_TRUE(binary.connect(port_));
   EXPECT_FALSE(binary.hello("r\xff"));
   EXPECT_TRUE(binary.waitClosed(2000ms));
-  TestRobot ok;
+  ScriptedRobot ok;
   ASSERT_TRUE(ok.connect(port_));
   const auto reply = ok.hello(std::string(64, 'a') + "");
   ASSERT_TRUE(reply);
@@ -87,7 +87,7 @@ TEST_F(LinkServerTest, BadRobotIdRejected) {
 
 TEST_F(LinkServerTest, MessageBeforeHelloCloses) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   v1::Envelope e;
   e.mutable_telemetry()->mutable_pose()->set_x_m(1);
@@ -100,7 +100,7 @@ TEST_F(LinkServerTest, MessageBeforeHelloCloses) {
 
 TEST_F(LinkServerTest, RobotSendingServerMessagesIsClosed) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   v1::Envelope e;
@@ -113,7 +113,7 @@ TEST_F(LinkServerTest, RobotSendingServerMessagesIsClosed) {
 
 TEST_F(LinkServerTest, GarbageThatDoesNotParseCloses) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   // A valid length prefix around bytes that are not an Envelope (field 0 is illegal).
@@ -125,11 +125,11 @@ TEST_F(LinkServerTest, GarbageThatDoesNotParseCloses) {
 
 TEST_F(LinkServerTest, OversizeFrameClosesOnlyThatSession) {
   startServer();
-  TestRobot good;
+  ScriptedRobot good;
   ASSERT_TRUE(good.connect(port_));
   ASSERT_TRUE(good.hello("good"));
   good.startPump(50);
-  TestRobot bad;
+  ScriptedRobot bad;
   ASSERT_TRUE(bad.connect(port_));
   ASSERT_TRUE(bad.hello("bad"));
   ASSERT_TRUE(eventually([&] { return snap("good") && snap("good")->telemetry_count > 5; }));
@@ -152,7 +152,7 @@ TEST_F(LinkServerTest, OversizeFrameClosesOnlyThatSession) {
 
 TEST_F(LinkServerTest, TruncatedFrameThenClose) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
@@ -167,13 +167,13 @@ TEST_F(LinkServerTest, TruncatedFrameThenClose) {
 
 TEST_F(LinkServerTest, DuplicateRobotIdReplacesOldSession) {
   startServer();
-  TestRobot first;
+  ScriptedRobot first;
   ASSERT_TRUE(first.connect(port_));
   ASSERT_TRUE(first.hello("robot1"));
   ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
   const std::string first_address = snap("robot1")->address;
 
-  TestRobot second;
+  ScriptedRobot second;
   ASSERT_TRUE(second.connect(port_));
   const auto reply = second.hello("robot1");
   ASSERT_TRUE(reply);
@@ -191,7 +191,7 @@ TEST_F(LinkServerTest, DuplicateRobotIdReplacesOldSession) {
 
 TEST_F(LinkServerTest, TelemetryEventsAndAcksReachTheRegistry) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   v1::Envelope e;
@@ -230,7 +230,7 @@ TEST_F(LinkServerTest, TelemetryEventsAndAcksReachTheRegistry) {
 
 TEST_F(LinkServerTest, TelemetryRateIsMeasured) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(50);
@@ -250,7 +250,7 @@ TEST_F(LinkServerTest, TelemetryRateIsMeasured) {
 
 TEST_F(LinkServerTest, DriveResendsTeleopAt20Hz) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(0);
@@ -280,7 +280,7 @@ TEST_F(LinkServerTest, DriveResendsTeleopAt20Hz) {
 
 TEST_F(LinkServerTest, StopEndsTheResend) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(0);
@@ -315,7 +315,7 @@ TEST_F(LinkServerTest, StopEndsTheResend) {
 TEST_F(LinkServerTest, HungConsoleStopsTheResend) {
   startServer();
   link_->setConsoleWatchdog(200ms);
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(0);
@@ -341,7 +341,7 @@ TEST_F(LinkServerTest, HungConsoleStopsTheResend) {
 TEST_F(LinkServerTest, ClosingTheSessionClearsTheSetPoint) {
   startServer();
   {
-    TestRobot r;
+    ScriptedRobot r;
     ASSERT_TRUE(r.connect(port_));
     ASSERT_TRUE(r.hello("robot1"));
     r.startPump(0);
@@ -351,7 +351,7 @@ TEST_F(LinkServerTest, ClosingTheSessionClearsTheSetPoint) {
   }
   ASSERT_TRUE(eventually([&] { return !connected("robot1"); }));
   EXPECT_EQ(link_->setTeleop("robot1", 0.2, 0), 0u) << "not connected: nothing to send to";
-  TestRobot again;
+  ScriptedRobot again;
   ASSERT_TRUE(again.connect(port_));
   ASSERT_TRUE(again.hello("robot1"));
   again.startPump(0);
@@ -361,7 +361,7 @@ TEST_F(LinkServerTest, ClosingTheSessionClearsTheSetPoint) {
 
 TEST_F(LinkServerTest, SessionTimeoutClosesSilentRobot) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   const auto t0 = Clock::now();
   ASSERT_TRUE(r.hello("robot1"));
@@ -375,7 +375,7 @@ TEST_F(LinkServerTest, SessionTimeoutClosesSilentRobot) {
 
 TEST_F(LinkServerTest, HeartbeatsKeepTheSessionAlive) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(0);
@@ -388,7 +388,7 @@ TEST_F(LinkServerTest, HandshakeTimeoutClosesSilentConnection) {
   auto c = testConfig();
   c.handshake_timeout_s = 0.3;
   startServer(c);
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   const auto t0 = Clock::now();
   ASSERT_TRUE(r.waitClosed(2000ms));
@@ -398,7 +398,7 @@ TEST_F(LinkServerTest, HandshakeTimeoutClosesSilentConnection) {
 
 TEST_F(LinkServerTest, CommandIdsAreUniqueAcrossRobots) {
   startServer();
-  TestRobot a, b;
+  ScriptedRobot a, b;
   ASSERT_TRUE(a.connect(port_));
   ASSERT_TRUE(a.hello("a"));
   ASSERT_TRUE(b.connect(port_));
@@ -423,10 +423,10 @@ TEST_F(LinkServerTest, CommandIdsAreUniqueAcrossRobots) {
 
 TEST_F(LinkServerTest, StopClosesAllSessions) {
   startServer();
-  TestRobot a;
+  ScriptedRobot a;
   ASSERT_TRUE(a.connect(port_));
   ASSERT_TRUE(a.hello("a"));
-  TestRobot pending;  // still in the handshake
+  ScriptedRobot pending;  // still in the handshake
   ASSERT_TRUE(pending.connect(port_));
   ASSERT_TRUE(eventually([&] { return link_->sessionCount() == 2; }));
   link_->stop();
@@ -443,7 +443,7 @@ TEST_F(ServerFixture, StaleTelemetryOfAMovingRobotSendsOneEStop) {
   // not look stale merely because a shared machine did not schedule it.
   config.telemetry_stale_s = 0.6;
   startServer(config);
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(50);  // mode TELEOP: moving

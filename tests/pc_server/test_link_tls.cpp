@@ -57,7 +57,7 @@ TEST_F(LinkTlsTest, RobotWithItsOwnCertificateIsAccepted) {
 
 TEST_F(LinkTlsTest, RobotIdMustMatchItsCertificate) {
   startServer();
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port_));
   ASSERT_TRUE(r.handshake("robot2")) << r.tlsError();
   const auto reply = r.hello("robot1");  // robot2's certificate, robot1's id
@@ -70,11 +70,11 @@ TEST_F(LinkTlsTest, RobotIdMustMatchItsCertificate) {
 
 TEST_F(LinkTlsTest, PlaintextRobotIsRefusedAndOthersAreServed) {
   startServer();
-  TestRobot good;
+  ScriptedRobot good;
   ASSERT_TRUE(good.connect(port_));
   ASSERT_TRUE(good.hello("good"));
   good.startPump(50);
-  TestRobot plain(TestRobot::Mode::kPlaintext);
+  ScriptedRobot plain(ScriptedRobot::Mode::kPlaintext);
   ASSERT_TRUE(plain.connect(port_));
   EXPECT_FALSE(plain.hello("robot1").has_value());
   EXPECT_TRUE(plain.waitClosed(2000ms));
@@ -85,7 +85,7 @@ TEST_F(LinkTlsTest, PlaintextRobotIsRefusedAndOthersAreServed) {
 
 TEST_F(LinkTlsTest, CertificateOfAnotherCaIsRefused) {
   startServer();
-  TestRobot r(TestRobot::Mode::kTls, testCertsDir({"robot1"}, "test_certs_other_ca"));
+  ScriptedRobot r(ScriptedRobot::Mode::kTls, testCertsDir({"robot1"}, "test_certs_other_ca"));
   ASSERT_TRUE(r.connect(port_));
   EXPECT_FALSE(r.hello("robot1").has_value());
   EXPECT_FALSE(r.tlsError().empty());
@@ -98,7 +98,7 @@ TEST_F(LinkTlsTest, CertificateOfAnotherCaIsRefused) {
 
 TEST_F(LinkTlsTest, RobotWithoutCertificateIsRefused) {
   startServer();
-  TestRobot r(TestRobot::Mode::kTlsNoCertificate);
+  ScriptedRobot r(ScriptedRobot::Mode::kTlsNoCertificate);
   ASSERT_TRUE(r.connect(port_));
   EXPECT_FALSE(r.hello("robot1").has_value());
   EXPECT_FALSE(snap("robot1").has_value());
@@ -128,7 +128,7 @@ TEST_F(LinkTlsTest, PlaintextOnlyWhenBothSidesAskForIt) {
   auto config = testConfig();
   config.tls.plaintext = true;
   startServer(config);
-  TestRobot r(TestRobot::Mode::kPlaintext);
+  ScriptedRobot r(ScriptedRobot::Mode::kPlaintext);
   ASSERT_TRUE(r.connect(port_));
   const auto reply = r.hello("robot1");
   ASSERT_TRUE(reply.has_value());

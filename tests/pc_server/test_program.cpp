@@ -13,7 +13,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "test_robot.hpp"
+#include "tests/support/fake_robot/scripted_robot.hpp"
 #include "tests/support/paths.hpp"
 
 using namespace inspect;
@@ -143,7 +143,7 @@ TEST(Program, ScriptWithARobotPasses) {
            script.string()});
   const uint16_t port = p.waitPort(port_file);
   ASSERT_GT(port, 0);
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(50);
@@ -219,7 +219,7 @@ TEST(Program, NoConsoleServesUntilSigterm) {
            "--no-console"});
   const uint16_t port = p.waitPort(port_file);
   ASSERT_GT(port, 0);
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(20);
@@ -283,7 +283,7 @@ TEST(Program, AttachedOperatorObservesAndIsRefusedMotionWhileTheConsoleControls)
            "--operator-socket", sock.string(), "--script", script.string()});
   const uint16_t port = p.waitPort(port_file);
   ASSERT_GT(port, 0);
-  TestRobot r;
+  ScriptedRobot r;
   ASSERT_TRUE(r.connect(port));
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(50);

@@ -2,7 +2,7 @@
 //
 // For each fleet size N it starts one real pc_server (mutual TLS, recording
 // on into a temporary runs directory, no video), connects N simulated robots
-// (tests/system/link/sim_robot.hpp: Hello, heartbeats every 100 ms, telemetry at
+// (tests/support/fake_robot/fleet_robot.hpp: Hello, heartbeats every 100 ms, telemetry at
 // --hz with realistic content and sequence numbers, an Ack for every
 // command, each robot with its own certificate), starts a recorded run for
 // every robot from the console, and measures over --seconds:
@@ -44,7 +44,7 @@
 #include "shared/util/clock.hpp"
 #include "tests/support/process.hpp"
 #include "tests/system/link/server_harness.hpp"
-#include "tests/system/link/sim_robot.hpp"
+#include "tests/support/fake_robot/fleet_robot.hpp"
 #include "tests/support/test_certs.hpp"
 
 namespace {
@@ -52,6 +52,9 @@ namespace {
 namespace asio = boost::asio;
 using namespace inspect;
 using namespace inspect::linktest;
+using inspect::test::FleetRobot;
+using inspect::test::FleetRobotOptions;
+using inspect::test::robotId;
 using Clock = std::chrono::steady_clock;
 
 struct Options {
@@ -204,7 +207,7 @@ Result runOne(const Options& opt, int n) {
       if (t.joinable()) t.join();
   };
 
-  std::vector<std::shared_ptr<SimRobot>> robots;
+  std::vector<std::shared_ptr<FleetRobot>> robots;
   auto fail = [&](const std::string& why) {
     r.error = why;
     for (auto& rb : robots) rb->close();
@@ -216,13 +219,13 @@ Result runOne(const Options& opt, int n) {
   };
   try {
     for (int i = 0; i < n; ++i) {
-      SimRobotOptions so;
+      FleetRobotOptions so;
       so.id = ids[i];
       so.certs_dir = certs;
       so.port = server.port();
       so.telemetry_hz = opt.hz;
       so.seed = static_cast<uint32_t>(1000 + i);
-      robots.push_back(std::make_shared<SimRobot>(*iocs[static_cast<std::size_t>(i % opt.threads)], so));
+      robots.push_back(std::make_shared<FleetRobot>(*iocs[static_cast<std::size_t>(i % opt.threads)], so));
       robots.back()->start();
     }
   } catch (const std::exception& e) {

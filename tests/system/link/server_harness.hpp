@@ -91,7 +91,7 @@ class ServerUnderTest {
 
 /// One telemetry message as a run's MCAP recorded it.
 struct RecordedTelemetry {
-  uint64_t seq = 0;          // Telemetry.serial.frames_ok (SimRobot's telemetry sequence number)
+  uint64_t seq = 0;          // Telemetry.serial.frames_ok (FleetRobot's telemetry sequence number)
   uint64_t send_us = 0;      // MCAP publish_time (= Envelope.send_time_us, the sender's CLOCK_MONOTONIC)
   uint64_t log_time_ns = 0;  // MCAP log_time: the server's receive time (CLOCK_MONOTONIC) as wall-clock ns
 };

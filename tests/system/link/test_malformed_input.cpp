@@ -26,13 +26,16 @@
 #include "tests/support/process.hpp"
 #include "tests/system/link/attack_conn.hpp"
 #include "tests/system/link/server_harness.hpp"
-#include "tests/system/link/sim_robot.hpp"
+#include "tests/support/fake_robot/fleet_robot.hpp"
 #include "tests/support/test_certs.hpp"
 
 namespace inspect::linktest {
 namespace {
 
 namespace asio = boost::asio;
+using test::FleetRobot;
+using test::FleetRobotOptions;
+using test::robotId;
 using Clock = std::chrono::steady_clock;
 
 constexpr double kHandshakeTimeout = 2.0;  // the test's server config (default 5 s)
@@ -128,15 +131,15 @@ TEST_F(LinkAttackTest, ServerSurvivesAndGoodRobotsLoseNothing) {
 
   // ---- three good robots, recorded, telemetry at 100 Hz throughout ----
   IoThread good_io;
-  std::vector<std::shared_ptr<SimRobot>> good;
+  std::vector<std::shared_ptr<FleetRobot>> good;
   for (int i = 0; i < kGood; ++i) {
-    SimRobotOptions o;
+    FleetRobotOptions o;
     o.id = good_ids_[static_cast<std::size_t>(i)];
     o.certs_dir = certs_;
     o.port = server_.port();
     o.telemetry_hz = 100;
     o.seed = static_cast<uint32_t>(7 + i);
-    good.push_back(std::make_shared<SimRobot>(good_io.ioc, o));
+    good.push_back(std::make_shared<FleetRobot>(good_io.ioc, o));
     good.back()->start();
   }
   ASSERT_TRUE(test::waitUntil(
@@ -350,12 +353,12 @@ TEST_F(LinkAttackTest, ServerSurvivesAndGoodRobotsLoseNothing) {
 
   // ---- flood: an authenticated robot sends telemetry as fast as the link takes it for 3 s ----
   IoThread flood_io;
-  SimRobotOptions fo;
+  FleetRobotOptions fo;
   fo.id = "flood001";
   fo.certs_dir = certs_;
   fo.port = server_.port();
   fo.telemetry_hz = 0;
-  auto flood = std::make_shared<SimRobot>(flood_io.ioc, fo);
+  auto flood = std::make_shared<FleetRobot>(flood_io.ioc, fo);
   flood->start();
   ASSERT_TRUE(test::waitUntil([&] { return flood->stats().accepted || flood->stats().closed; }, 10.0));
   ASSERT_TRUE(flood->stats().accepted) << flood->closeReason();
@@ -375,15 +378,15 @@ TEST_F(LinkAttackTest, ServerSurvivesAndGoodRobotsLoseNothing) {
   const bool flood_closed_by_server = flood->stats().closed;
   const std::string flood_close_reason = flood->closeReason();
   // The server has processed the whole flood before the robot hangs up.
-  const std::vector<std::shared_ptr<SimRobot>> flooders = {flood};
+  const std::vector<std::shared_ptr<FleetRobot>> flooders = {flood};
   EXPECT_TRUE(server_.drain(flooders, "flood drain", 20.0)) << "the flood was not processed within 20 s";
   flood->close();
   test::sleepS(0.3);
 
   // ---- afterwards the server still takes a new robot ----
-  SimRobotOptions lo = fo;
+  FleetRobotOptions lo = fo;
   lo.id = "late001";
-  auto late = std::make_shared<SimRobot>(flood_io.ioc, lo);
+  auto late = std::make_shared<FleetRobot>(flood_io.ioc, lo);
   late->start();
   const bool late_ok = test::waitUntil([&] { return late->stats().accepted || late->stats().closed; }, 10.0) &&
                        late->stats().accepted;

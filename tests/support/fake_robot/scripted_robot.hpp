@@ -1,5 +1,6 @@
 #pragma once
-// A minimal robot for the link tests: a blocking POSIX socket with TLS on top
+// The fake robot, scripted: one test drives it message by message (the server's
+// link, TLS and console tests). A blocking POSIX socket with TLS on top
 // (OpenSSL directly, with the certificate of the robot id it says Hello with,
 // from tests/support/test_certs.hpp), the shared delimited framing and an optional
 // background pump (heartbeats, telemetry, automatic Acks). Every wait is
@@ -30,6 +31,7 @@
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/link_version.hpp"
 #include "shared/net/robot_id.hpp"
+#include "tests/support/fake_robot/robot_messages.hpp"
 #include "tests/support/test_certs.hpp"
 
 namespace inspect::test {
@@ -37,7 +39,7 @@ namespace inspect::test {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-class TestRobot {
+class ScriptedRobot {
  public:
   struct Received {
     Clock::time_point t;
@@ -49,16 +51,16 @@ class TestRobot {
   /// or TLS with a certificate of another CA (`certs_dir`).
   enum class Mode { kTls, kPlaintext, kTlsNoCertificate };
   // OpenSSL writes with write(2): a server that closed must not kill the test with SIGPIPE.
-  TestRobot() { std::signal(SIGPIPE, SIG_IGN); }
-  explicit TestRobot(Mode mode, std::string certs_dir = "") : mode_(mode), certs_dir_(std::move(certs_dir)) {
+  ScriptedRobot() { std::signal(SIGPIPE, SIG_IGN); }
+  explicit ScriptedRobot(Mode mode, std::string certs_dir = "") : mode_(mode), certs_dir_(std::move(certs_dir)) {
     std::signal(SIGPIPE, SIG_IGN);
   }
-  ~TestRobot() {
+  ~ScriptedRobot() {
     stopPump();
     close();
   }
-  TestRobot(const TestRobot&) = delete;
-  TestRobot& operator=(const TestRobot&) = delete;
+  ScriptedRobot(const ScriptedRobot&) = delete;
+  ScriptedRobot& operator=(const ScriptedRobot&) = delete;
 
   /// TCP connect; the TLS handshake follows with the first send (with the
   /// certificate of the Hello's robot id, else of `cert_id_` = "robot1").
@@ -132,10 +134,7 @@ class TestRobot {
   /// Sends Hello and returns the HelloReply (skipping nothing else: it must come first).
   std::optional<v1::HelloReply> hello(const std::string& id, uint32_t version = net::kProtocolVersion) {
     v1::Envelope e;
-    e.mutable_hello()->set_robot_id(id);
-    e.mutable_hello()->set_protocol_version(version);
-    e.mutable_hello()->add_capabilities("teleop");
-    e.mutable_hello()->set_software_version("test");
+    *e.mutable_hello() = minimalHello(id, version);
     if (!send(e)) return std::nullopt;
     const auto r = receive(2000ms);
     if (!r || !r->has_hello_reply()) return std::nullopt;
@@ -165,12 +164,7 @@ class TestRobot {
   }
 
   /// Decides the Ack of a Command; default ACCEPTED. Set before startPump.
-  std::function<v1::Ack(const v1::Command&)> ack_policy = [](const v1::Command& c) {
-    v1::Ack a;
-    a.set_command_id(c.id());
-    a.set_status(v1::Ack::ACCEPTED);
-    return a;
-  };
+  std::function<v1::Ack(const v1::Command&)> ack_policy = acceptedAck;
   bool auto_ack = true;
 
   std::vector<Received> received() const {

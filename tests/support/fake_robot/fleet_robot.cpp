@@ -1,4 +1,4 @@
-#include "tests/system/link/sim_robot.hpp"
+#include "tests/support/fake_robot/fleet_robot.hpp"
 
 #include <netinet/in.h>
 #include <netinet/tcp.h>
@@ -15,8 +15,9 @@
 
 #include "shared/net/link_version.hpp"
 #include "shared/util/clock.hpp"
+#include "tests/support/fake_robot/robot_messages.hpp"
 
-namespace inspect::linktest {
+namespace inspect::test {
 
 namespace asio = boost::asio;
 using asio::ip::tcp;
@@ -27,21 +28,6 @@ constexpr double kWheelRadius = 0.200;  // config/robot.yaml geometry
 constexpr double kTrack = 0.438;
 constexpr std::size_t kFloodBatch = 64;
 
-void addGas(v1::Hello& h, const char* name, const char* gas, const char* unit, const char* sensor, double lo, double hi,
-            bool falling, double t90, double max, double background) {
-  auto* c = h.add_gas_channels();
-  c->set_name(name);
-  c->set_gas(gas);
-  c->set_unit(unit);
-  c->set_sensor(sensor);
-  c->set_alarm_low(lo);
-  c->set_alarm_high(hi);
-  c->set_falling(falling);
-  c->set_t90_s(t90);
-  c->set_range_min(0);
-  c->set_range_max(max);
-  c->set_background(background);
-}
 }  // namespace
 
 std::string robotId(const std::string& prefix, int index) {
@@ -50,26 +36,26 @@ std::string robotId(const std::string& prefix, int index) {
   return prefix + buf;
 }
 
-SimRobot::SimRobot(asio::io_context& ioc, SimRobotOptions options)
+FleetRobot::FleetRobot(asio::io_context& ioc, FleetRobotOptions options)
     : options_(std::move(options)),
       strand_(asio::make_strand(ioc)),
       hb_timer_(strand_),
       tlm_timer_(strand_),
       rng_(options_.seed) {}
 
-SimRobot::~SimRobot() = default;
+FleetRobot::~FleetRobot() = default;
 
-std::string SimRobot::closeReason() const {
+std::string FleetRobot::closeReason() const {
   std::lock_guard lk(info_mu_);
   return close_reason_;
 }
 
-std::string SimRobot::localAddress() const {
+std::string FleetRobot::localAddress() const {
   std::lock_guard lk(info_mu_);
   return local_address_;
 }
 
-void SimRobot::start() {
+void FleetRobot::start() {
   const std::string& d = options_.certs_dir;
   tls_ = net::makeTlsContext({d + "/ca.pem", d + "/" + options_.id + ".pem", d + "/" + options_.id + ".key"},
                              net::TlsRole::kClient);
@@ -79,7 +65,7 @@ void SimRobot::start() {
   stream_->socket().async_connect(ep, [self = shared_from_this()](const error_code& ec) { self->onConnected(ec); });
 }
 
-SimRobot::TcpBytes SimRobot::tcpBytes() const {
+FleetRobot::TcpBytes FleetRobot::tcpBytes() const {
   TcpBytes b;
   const int fd = fd_;
   if (fd < 0) return b;
@@ -93,7 +79,7 @@ SimRobot::TcpBytes SimRobot::tcpBytes() const {
   return b;
 }
 
-void SimRobot::onConnected(const error_code& ec) {
+void FleetRobot::onConnected(const error_code& ec) {
   if (ec) return fail("connect: " + ec.message());
   error_code ignored;
   stream_->socket().set_option(tcp::no_delay(true), ignored);
@@ -107,41 +93,18 @@ void SimRobot::onConnected(const error_code& ec) {
     if (e) return self->fail("TLS handshake: " + net::describeHandshakeError(e, self->stream_->ssl()));
     self->up_ = true;
     v1::Envelope env;
-    auto* h = env.mutable_hello();
-    h->set_robot_id(self->options_.id);
-    h->set_protocol_version(net::kProtocolVersion);
-    for (const char* c : {"teleop", "track", "navigate", "video", "gas", "ptz", "gains"}) h->add_capabilities(c);
-    h->set_software_version("link_load sim robot");
-    addGas(*h, "CH4", "methane", "%LEL", "catalytic", 10, 20, false, 6, 100, 0);
-    addGas(*h, "H2S", "hydrogen sulfide", "ppm", "electrochemical", 5, 10, false, 8, 100, 0);
-    addGas(*h, "CO", "carbon monoxide", "ppm", "electrochemical", 35, 100, false, 10, 1000, 0);
-    addGas(*h, "O2", "oxygen", "%vol", "electrochemical", 19.5, 18.0, true, 8, 30, 20.9);
-    h->set_gas_inlet_x_m(0.25);
-    h->set_gas_inlet_y_m(0.0);
-    auto* g = h->mutable_gains();
-    g->set_kp(9.0);
-    g->set_ki(2.0);
-    g->set_kd(3.0);
-    g->set_ke(1.0);
-    g->set_kec(0.1);
-    g->set_k1(3.0);
-    g->set_k2(1.0);
-    g->set_k3(1.0);
-    g->set_a1(-2.0);
-    g->set_a2(-4.0);
-    g->set_a3(-2.0);
-    h->set_fis_name("fuzzy_pid");
+    *env.mutable_hello() = fullHello(self->options_.id, "link_load sim robot");
     self->queue(env);
     self->doRead();
   });
 }
 
-void SimRobot::doRead() {
+void FleetRobot::doRead() {
   stream_->asyncReadSome(asio::buffer(rx_buf_),
                          [self = shared_from_this()](const error_code& ec, std::size_t n) { self->onRead(ec, n); });
 }
 
-void SimRobot::onRead(const error_code& ec, std::size_t n) {
+void FleetRobot::onRead(const error_code& ec, std::size_t n) {
   if (!up_) return;
   if (ec) {
     if (ec == asio::error::eof || ec == asio::ssl::error::stream_truncated) return fail("closed by the server");
@@ -162,7 +125,7 @@ void SimRobot::onRead(const error_code& ec, std::size_t n) {
   doRead();
 }
 
-void SimRobot::handle(const v1::Envelope& env) {
+void FleetRobot::handle(const v1::Envelope& env) {
   if (env.has_hello_reply()) {
     if (!env.hello_reply().accepted()) {
       stats_.rejected = true;
@@ -184,14 +147,13 @@ void SimRobot::handle(const v1::Envelope& env) {
   } else if (env.has_command()) {
     ++stats_.commands_received;
     v1::Envelope a;
-    a.mutable_ack()->set_command_id(env.command().id());
-    a.mutable_ack()->set_status(v1::Ack::ACCEPTED);
+    *a.mutable_ack() = acceptedAck(env.command());
     queue(a);
     ++stats_.acks_sent;
   }
 }
 
-void SimRobot::armHeartbeat() {
+void FleetRobot::armHeartbeat() {
   hb_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
     if (ec || !self->up_) return;
     v1::Envelope env;
@@ -207,7 +169,7 @@ void SimRobot::armHeartbeat() {
   });
 }
 
-void SimRobot::startTelemetry() {
+void FleetRobot::startTelemetry() {
   asio::post(strand_, [self = shared_from_this()] {
     if (self->telemetry_on_ || self->options_.telemetry_hz <= 0) return;
     self->telemetry_on_ = true;
@@ -221,7 +183,7 @@ void SimRobot::startTelemetry() {
   });
 }
 
-void SimRobot::stopTelemetry() {
+void FleetRobot::stopTelemetry() {
   asio::post(strand_, [self = shared_from_this()] {
     self->telemetry_on_ = false;
     ++self->tlm_generation_;
@@ -229,7 +191,7 @@ void SimRobot::stopTelemetry() {
   });
 }
 
-void SimRobot::armTelemetry(uint64_t generation) {
+void FleetRobot::armTelemetry(uint64_t generation) {
   tlm_timer_.async_wait([self = shared_from_this(), generation](const error_code& ec) {
     if (ec || !self->up_ || generation != self->tlm_generation_) return;
     self->sendTelemetryNow();
@@ -242,14 +204,14 @@ void SimRobot::armTelemetry(uint64_t generation) {
   });
 }
 
-void SimRobot::sendTelemetryNow() {
+void FleetRobot::sendTelemetryNow() {
   const uint64_t now_us = monoNowUs();
   fillTelemetry(*tlm_env_.mutable_telemetry(), now_us);
   tlm_env_.set_send_time_us(now_us);
   queue(tlm_env_);
 }
 
-void SimRobot::fillTelemetry(v1::Telemetry& t, uint64_t now_us) {
+void FleetRobot::fillTelemetry(v1::Telemetry& t, uint64_t now_us) {
   const uint64_t n = ++stats_.telemetry_sent;
   t_s_ += 1.0 / std::max(1.0, options_.telemetry_hz);
   // Driving a 2 m circle at 0.3 m/s with a person nearby now and then; sensor noise on top.
@@ -327,14 +289,14 @@ void SimRobot::fillTelemetry(v1::Telemetry& t, uint64_t now_us) {
   t.set_mcu_time_us(n * 10000);
 }
 
-void SimRobot::flood(std::chrono::milliseconds duration) {
+void FleetRobot::flood(std::chrono::milliseconds duration) {
   asio::post(strand_, [self = shared_from_this(), duration] {
     self->flood_until_ = Clock::now() + duration;
     self->flushWrites();
   });
 }
 
-void SimRobot::sendEvent(const std::string& text) {
+void FleetRobot::sendEvent(const std::string& text) {
   asio::post(strand_, [self = shared_from_this(), text] {
     v1::Envelope env;
     env.mutable_event()->set_kind(v1::Event::INFO);
@@ -344,7 +306,7 @@ void SimRobot::sendEvent(const std::string& text) {
   });
 }
 
-void SimRobot::queue(v1::Envelope& env) {
+void FleetRobot::queue(v1::Envelope& env) {
   if (!up_) return;
   env.set_seq(++tx_seq_);
   if (!env.has_telemetry()) env.set_send_time_us(monoNowUs());
@@ -356,7 +318,7 @@ void SimRobot::queue(v1::Envelope& env) {
   if (!writing_) flushWrites();
 }
 
-void SimRobot::flushWrites() {
+void FleetRobot::flushWrites() {
   if (!up_ || writing_) return;
   if (pending_.empty() && Clock::now() < flood_until_) {
     for (std::size_t i = 0; i < kFloodBatch; ++i) {
@@ -382,7 +344,7 @@ void SimRobot::flushWrites() {
   });
 }
 
-void SimRobot::fail(const std::string& why) {
+void FleetRobot::fail(const std::string& why) {
   if (stats_.closed) return;
   {
     std::lock_guard lk(info_mu_);
@@ -396,8 +358,8 @@ void SimRobot::fail(const std::string& why) {
   if (stream_) stream_->close();
 }
 
-void SimRobot::close() {
+void FleetRobot::close() {
   asio::post(strand_, [self = shared_from_this()] { self->fail("closed by us"); });
 }
 
-}  // namespace inspect::linktest
+}  // namespace inspect::test

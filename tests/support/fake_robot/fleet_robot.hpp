@@ -1,5 +1,6 @@
 #pragma once
-// A simulated robot for the link load generator and the malformed-input test:
+// The fake robot, as a fleet: many of them on one io_context (the link load
+// generator and the malformed-input test):
 // the real protocol over mutual TLS (net::makeTlsContext + net::LinkStream,
 // the same code robot_client uses, with the certificate made for its id),
 // Hello with the gas channels and gains of config/robot.yaml, heartbeats,
@@ -29,9 +30,9 @@
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/tls.hpp"
 
-namespace inspect::linktest {
+namespace inspect::test {
 
-struct SimRobotOptions {
+struct FleetRobotOptions {
   std::string id;
   std::string certs_dir;        // <dir>/ca.pem, <dir>/<id>.pem, <dir>/<id>.key
   uint16_t port = 0;            // 127.0.0.1:port
@@ -41,7 +42,7 @@ struct SimRobotOptions {
 };
 
 /// Counters; read from any thread.
-struct SimRobotStats {
+struct FleetRobotStats {
   std::atomic<bool> accepted{false};
   std::atomic<bool> rejected{false};
   std::atomic<bool> closed{false};          // the link ended (server closed it, or an error)
@@ -56,13 +57,13 @@ struct SimRobotStats {
   std::atomic<int64_t> max_write_backlog{0};      // bytes waiting behind a write in flight (peak)
 };
 
-class SimRobot : public std::enable_shared_from_this<SimRobot> {
+class FleetRobot : public std::enable_shared_from_this<FleetRobot> {
  public:
   using Clock = std::chrono::steady_clock;
-  SimRobot(boost::asio::io_context& ioc, SimRobotOptions options);
-  ~SimRobot();
-  SimRobot(const SimRobot&) = delete;
-  SimRobot& operator=(const SimRobot&) = delete;
+  FleetRobot(boost::asio::io_context& ioc, FleetRobotOptions options);
+  ~FleetRobot();
+  FleetRobot(const FleetRobot&) = delete;
+  FleetRobot& operator=(const FleetRobot&) = delete;
 
   /// Connects, TLS handshake, Hello; heartbeats start with the accepted HelloReply.
   /// Throws net::TlsError when the certificate files cannot be used.
@@ -81,7 +82,7 @@ class SimRobot : public std::enable_shared_from_this<SimRobot> {
   void close();
 
   const std::string& id() const { return options_.id; }
-  const SimRobotStats& stats() const { return stats_; }
+  const FleetRobotStats& stats() const { return stats_; }
   /// Why the link ended ("" while it is up).
   std::string closeReason() const;
   /// The local "127.0.0.1:port" of the connection (what the server logs), "" before connecting.
@@ -108,7 +109,7 @@ class SimRobot : public std::enable_shared_from_this<SimRobot> {
   void flushWrites();
   void fail(const std::string& why);
 
-  SimRobotOptions options_;
+  FleetRobotOptions options_;
   boost::asio::strand<boost::asio::io_context::executor_type> strand_;
   std::shared_ptr<boost::asio::ssl::context> tls_;
   std::unique_ptr<net::LinkStream> stream_;
@@ -131,7 +132,7 @@ class SimRobot : public std::enable_shared_from_this<SimRobot> {
   std::mt19937 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};
   double t_s_ = 0;        // simulated time of the motion model
-  SimRobotStats stats_;
+  FleetRobotStats stats_;
   mutable std::mutex info_mu_;
   std::string close_reason_;
   std::string local_address_;
@@ -140,4 +141,4 @@ class SimRobot : public std::enable_shared_from_this<SimRobot> {
 /// "load001" ... for index 1 ...
 std::string robotId(const std::string& prefix, int index);
 
-}  // namespace inspect::linktest
+}  // namespace inspect::test
