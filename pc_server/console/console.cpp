@@ -202,13 +202,18 @@ std::optional<std::string> Console::connectedRobot(const std::string& cmd) {
 
 std::optional<v1::Ack> Console::waitAck(const std::string& robot_id, uint64_t command_id) {
   const int64_t deadline = deadlineAfter(options_.ack_timeout_s);
+  WakeSignal& arrived = registry_.ackSignal();
   for (;;) {
+    const uint64_t seen = arrived.generation();  // before looking: an Ack after the look moves it
     if (auto a = registry_.ack(robot_id, command_id)) return a;
-    if (clock_->nowNs() >= deadline) return std::nullopt;
+    const int64_t now = clock_->nowNs();
+    if (now >= deadline) return std::nullopt;
     pump();
-    // Acks come back within a millisecond or two on a working link; polling
-    // finely keeps 'drive' + 'wait T' close to T of motion.
-    if (!clock_->sleep(options_.ack_poll_period_s)) return std::nullopt;
+    // Woken by the Ack itself (a millisecond or two on a working link, so
+    // 'drive' + 'wait T' stays close to T of motion); the console's status
+    // line and events are pumped at least every ack_pump_period_s meanwhile.
+    const double left_s = static_cast<double>(deadline - now) * 1e-9;
+    if (!clock_->waitSignal(std::min(left_s, options_.ack_pump_period_s), arrived, seen)) return std::nullopt;
   }
 }
 

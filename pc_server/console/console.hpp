@@ -31,7 +31,7 @@ class Console {
   struct Options {
     double ack_timeout_s = 1.0;    // stop/estop/resume/drive wait this long for the Ack
     double poll_period_s = 0.02;   // expect ... within, wait
-    double ack_poll_period_s = 0.001;  // waiting for a command's Ack
+    double ack_pump_period_s = 0.05;  // waiting for a command's Ack: status and events printed this often
     double max_v_m_s = 1.0;        // drive limits (the keyboard gauge uses the same)
     double max_w_rad_s = 2.0;
   };

@@ -4,10 +4,13 @@
 // pc_server runs it on CLOCK_MONOTONIC with sleeps that a stop request
 // interrupts; the console's tests run it on a clock they advance themselves
 // (tests/pc_server/manual_clock.hpp), so that `wait 10` takes no time and an
-// expect's timeout is exact, on any machine.
+// expect's timeout is exact, on any machine. Acks are waited for on the
+// registry's WakeSignal: the console wakes when one arrives, not by polling.
+#include <algorithm>
 #include <cstdint>
 
 #include "pc_server/app/stop_flag.hpp"
+#include "pc_server/link/wake_signal.hpp"
 #include "shared/util/clock.hpp"
 
 namespace inspect::server {
@@ -19,6 +22,9 @@ class ConsoleClock {
   virtual int64_t nowNs() = 0;
   /// Waits `seconds`, or less when the stop is requested; false when it was.
   virtual bool sleep(double seconds) = 0;
+  /// Waits at most `seconds` for `signal` to move past generation `seen`
+  /// (returns early when it does); false when the stop was requested.
+  virtual bool waitSignal(double seconds, WakeSignal& signal, uint64_t seen) = 0;
 };
 
 /// The real clock: CLOCK_MONOTONIC, sleeps that StopFlag::request() ends.
@@ -27,6 +33,17 @@ class SteadyConsoleClock final : public ConsoleClock {
   explicit SteadyConsoleClock(StopFlag& stop) : stop_(stop) {}
   int64_t nowNs() override { return monoNowNs(); }
   bool sleep(double seconds) override { return stop_.sleepFor(steadyDuration(seconds)); }
+  bool waitSignal(double seconds, WakeSignal& signal, uint64_t seen) override {
+    // The stop is seen within kStopCheck_s (it has no way into the signal).
+    constexpr double kStopCheck_s = 0.05;
+    const int64_t deadline = monoNowNs() + static_cast<int64_t>(seconds * 1e9);
+    for (;;) {
+      if (stop_.requested()) return false;
+      const double left_s = static_cast<double>(deadline - monoNowNs()) * 1e-9;
+      if (left_s <= 0 || signal.waitChange(seen, steadyDuration(std::min(left_s, kStopCheck_s)))) break;
+    }
+    return !stop_.requested();
+  }
 
  private:
   StopFlag& stop_;

@@ -186,12 +186,15 @@ void RobotRegistry::onEvent(const std::string& id, uint64_t serial, const v1::Ev
 }
 
 void RobotRegistry::onAck(const std::string& id, uint64_t serial, const v1::Ack& a) {
-  std::lock_guard lk(mu_);
-  Entry* e = current(id, serial);
-  if (!e) return;
-  e->acks[a.command_id()] = a;
-  // Command ids increase, so the smallest ids are the oldest.
-  while (e->acks.size() > kMaxAcksPerRobot) e->acks.erase(e->acks.begin());
+  {
+    std::lock_guard lk(mu_);
+    Entry* e = current(id, serial);
+    if (!e) return;
+    e->acks[a.command_id()] = a;
+    // Command ids increase, so the smallest ids are the oldest.
+    while (e->acks.size() > kMaxAcksPerRobot) e->acks.erase(e->acks.begin());
+  }
+  ack_signal_.notify();
 }
 
 RobotSnapshot RobotRegistry::makeSnapshot(const std::string& id, const Entry& e, int64_t now_ns) const {

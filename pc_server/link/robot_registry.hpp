@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "pc_server/link/wake_signal.hpp"
 #include "inspect/v1/link.pb.h"
 
 namespace inspect::server {
@@ -83,6 +84,8 @@ class RobotRegistry {
   std::string firstConnected() const;
   /// The latest Ack of a command (bounded history per robot).
   std::optional<v1::Ack> ack(const std::string& id, uint64_t command_id) const;
+  /// Moves with every Ack recorded (onAck): what a console waiting for one sleeps on.
+  WakeSignal& ackSignal() { return ack_signal_; }
   /// Events received since the last call, oldest first (one consumer; the
   /// operator sessions use eventsSince, each with its own cursor).
   std::vector<PendingEvent> takeEvents();
@@ -137,6 +140,7 @@ class RobotRegistry {
   RobotSnapshot makeSnapshot(const std::string& id, const Entry& e, int64_t now_ns) const;
 
   mutable std::mutex mu_;
+  WakeSignal ack_signal_;
   std::map<std::string, Entry> robots_;
   uint64_t connect_counter_ = 0;
   std::deque<PendingEvent> pending_;  // the newest kMaxPendingEvents; pending_[i] has number first_event_ + i

@@ -37,6 +37,23 @@ class ManualClock final : public server::ConsoleClock {
     return !stop_.requested();
   }
 
+  /// As sleep(), but returns at the first scheduled event after which `signal`
+  /// has moved past `seen` (the clock then stands at that event's time).
+  bool waitSignal(double seconds, server::WakeSignal& signal, uint64_t seen) override {
+    if (stop_.requested()) return false;
+    ++sleeps_;
+    const int64_t until = now_ns_.load() + std::max<int64_t>(1, std::llround(seconds * 1e9));
+    while (!due_.empty() && due_.begin()->first <= until) {
+      auto next = due_.extract(due_.begin());
+      now_ns_.store(next.key());
+      next.mapped()();
+      if (stop_.requested()) return false;
+      if (signal.generation() != seen) return true;
+    }
+    now_ns_.store(until);
+    return !stop_.requested();
+  }
+
   /// Runs `fn` when the clock passes `after_s` from now.
   void at(double after_s, std::function<void()> fn) {
     due_.emplace(now_ns_.load() + std::llround(after_s * 1e9), std::move(fn));

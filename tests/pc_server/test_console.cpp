@@ -247,9 +247,34 @@ TEST_F(ConsoleTest, EstopResumeAckMessages) {
   std::tie(ok, out) = run("stop");
   EXPECT_FALSE(ok);
   EXPECT_EQ(out, "robot1: stop: no ack within 1 s\n");
-  // It waited the Ack timeout, polling every millisecond: no more, no less.
+  // It waited the Ack timeout, no more, no less, asleep on the registry's Ack
+  // signal (waking every 50 ms only to print the status line and events).
   EXPECT_NEAR(clock_.elapsedS() - t0, 1.0, 1e-6);
-  EXPECT_EQ(clock_.sleeps(), 1000);
+  EXPECT_EQ(clock_.sleeps(), 20);
+}
+
+TEST_F(ConsoleTest, AnAckWakesTheConsoleWhenItArrives) {
+  connectRobot();
+  sink_.reply = std::nullopt;  // the Ack comes later, from the "link"
+  clock_.at(0.3, [this] {
+    v1::Ack a;
+    a.set_command_id(1);  // the first command the sink sends
+    a.set_status(v1::Ack::ACCEPTED);
+    registry_.onAck("robot1", kSerial, a);
+  });
+  const double t0 = clock_.elapsedS();
+  const auto [ok, out] = run("stop");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_NEAR(clock_.elapsedS() - t0, 0.3, 1e-6) << "woken by the Ack, not at the next poll";
+  EXPECT_EQ(clock_.sleeps(), 6);  // five 50 ms waits, then the one the Ack ended
+}
+
+TEST(WakeSignal, NoLostWakeUp) {
+  WakeSignal s;
+  const uint64_t seen = s.generation();
+  s.notify();  // between the look and the wait
+  EXPECT_TRUE(s.waitChange(seen, std::chrono::hours(1)));  // returns at once
+  EXPECT_FALSE(s.waitChange(s.generation(), std::chrono::milliseconds(1)));
 }
 
 TEST_F(ConsoleTest, RobotsTableAndStatusLine) {
