@@ -21,37 +21,11 @@ class ManualClock final : public server::ConsoleClock {
   explicit ManualClock(server::StopFlag& stop) : stop_(stop), start_ns_(monoNowNs()), now_ns_(start_ns_) {}
 
   int64_t nowNs() override { return now_ns_.load(); }
-  bool sleep(double seconds) override {
-    if (stop_.requested()) return false;
-    ++sleeps_;
-    // At least a nanosecond: a wait always moves the clock on, as a real one would.
-    const int64_t until = now_ns_.load() + std::max<int64_t>(1, std::llround(seconds * 1e9));
-    // What falls due on the way runs at its own time, in order.
-    while (!due_.empty() && due_.begin()->first <= until) {
-      auto next = due_.extract(due_.begin());
-      now_ns_.store(next.key());
-      next.mapped()();
-      if (stop_.requested()) return false;  // a stop ends the sleep then, as StopFlag::sleepFor does
-    }
-    now_ns_.store(until);
-    return !stop_.requested();
-  }
-
+  bool sleep(double seconds) override { return advance(seconds, [] { return false; }); }
   /// As sleep(), but returns at the first scheduled event after which `signal`
   /// has moved past `seen` (the clock then stands at that event's time).
   bool waitSignal(double seconds, server::WakeSignal& signal, uint64_t seen) override {
-    if (stop_.requested()) return false;
-    ++sleeps_;
-    const int64_t until = now_ns_.load() + std::max<int64_t>(1, std::llround(seconds * 1e9));
-    while (!due_.empty() && due_.begin()->first <= until) {
-      auto next = due_.extract(due_.begin());
-      now_ns_.store(next.key());
-      next.mapped()();
-      if (stop_.requested()) return false;
-      if (signal.generation() != seen) return true;
-    }
-    now_ns_.store(until);
-    return !stop_.requested();
+    return advance(seconds, [&] { return signal.generation() != seen; });
   }
 
   /// Runs `fn` when the clock passes `after_s` from now.
@@ -64,6 +38,24 @@ class ManualClock final : public server::ConsoleClock {
   int sleeps() const { return sleeps_; }
 
  private:
+  // Moves the clock on by `seconds`, running what falls due on the way at its
+  // own time, in order; stops early after an event once `woken()` holds.
+  bool advance(double seconds, const std::function<bool()>& woken) {
+    if (stop_.requested()) return false;
+    ++sleeps_;
+    // At least a nanosecond: a wait always moves the clock on, as a real one would.
+    const int64_t until = now_ns_.load() + std::max<int64_t>(1, std::llround(seconds * 1e9));
+    while (!due_.empty() && due_.begin()->first <= until) {
+      auto next = due_.extract(due_.begin());
+      now_ns_.store(next.key());
+      next.mapped()();
+      if (stop_.requested()) return false;  // a stop ends the sleep then, as StopFlag::sleepFor does
+      if (woken()) return true;
+    }
+    now_ns_.store(until);
+    return !stop_.requested();
+  }
+
   server::StopFlag& stop_;
   const int64_t start_ns_;
   std::atomic<int64_t> now_ns_;
