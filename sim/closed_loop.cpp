@@ -10,6 +10,18 @@
 
 namespace inspect::sim {
 
+TrackTrace trackTrace(const std::vector<double>& px, const std::vector<double>& py,
+                      const std::vector<ClosedLoopSample>& samples) {
+  TrackTrace t;
+  t.distance_m = distanceFromPath(px, py, samples);
+  for (const auto& s : samples) {
+    t.x_m.push_back(s.pose.x_m);
+    t.y_m.push_back(s.pose.y_m);
+    t.t_s.push_back(s.t_s);
+  }
+  return t;
+}
+
 std::vector<double> distanceFromPath(const std::vector<double>& px, const std::vector<double>& py,
                                      const std::vector<ClosedLoopSample>& samples) {
   std::vector<double> out;

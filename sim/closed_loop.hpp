@@ -73,6 +73,15 @@ ClosedLoopResult runClosedLoop(const ClosedLoopConfig& cfg, std::unique_ptr<cont
 std::vector<double> distanceFromPath(const std::vector<double>& px, const std::vector<double>& py,
                                      const std::vector<ClosedLoopSample>& samples);
 
+/// A run as the trajectory plots draw it (Fig 18 and the tuning report): its
+/// path (x, y), and its distance from the reference polyline over time.
+struct TrackTrace {
+  std::vector<double> x_m, y_m;    // the robot's path
+  std::vector<double> t_s, distance_m;  // distanceFromPath over time
+};
+TrackTrace trackTrace(const std::vector<double>& px, const std::vector<double>& py,
+                      const std::vector<ClosedLoopSample>& samples);
+
 /// Convergence time of a series: the time after which |value| stays <= band.
 double convergenceTime(const std::vector<double>& t, const std::vector<double>& value, double band);
 

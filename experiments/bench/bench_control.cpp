@@ -24,12 +24,12 @@
 #include "shared/control/fuzzy_pid.hpp"
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
+#include "shared/util/cli_args.hpp"
 #include "sim/closed_loop.hpp"
+#include "tests/support/paths.hpp"
 
 #ifdef INSPECT_HAVE_FUZZYLITE
 #include <fl/Headers.h>
-#include "shared/util/cli_args.hpp"
-#include "tests/support/paths.hpp"
 #endif
 
 namespace {
@@ -101,21 +101,16 @@ int main(int argc, char** argv) {
     }
   });
 
-  config::RobotConfig robot;
-  config::ControlConfig ctl;
-  fuzzy::Fis fis;
+  config::TrackingSetup loaded;
   try {
-    robot = config::loadRobotConfigFile(robot_path);
-    ctl = config::loadControlConfigFile(control_path);
-    config::applyRobot(ctl, robot);
-    fis = fuzzy::readFisFile(ctl.fis_path);
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "bench_control: %s\n", e.what());
-    return 2;
-  } catch (const fuzzy::FisError& e) {
+    loaded = config::loadTrackingSetup(robot_path, control_path);
+  } catch (const std::runtime_error& e) {  // ConfigError, FisError
     std::fprintf(stderr, "bench_control: %s\n", e.what());
     return 2;
   }
+  const config::RobotConfig& robot = loaded.robot;
+  const config::ControlConfig& ctl = loaded.control;
+  const fuzzy::Fis& fis = loaded.fis;
   const control::FuzzyPidParams& p = ctl.tracker.fuzzy;
   const std::string fis_shown = std::filesystem::path(ctl.fis_path).lexically_normal().string();
   auto direct = std::make_shared<control::FuzzyGainScheduler>(fis, false);

@@ -133,14 +133,11 @@ int main(int argc, char** argv) {
 
   tuning::TuneSetup setup;
   try {
-    setup.robot = config::loadRobotConfigFile(robot_path);
-    setup.control = config::loadControlConfigFile(control_path);
-    config::applyRobot(setup.control, setup.robot);
-    setup.fis = fuzzy::readFisFile(setup.control.fis_path);
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "bench_tuning: %s\n", e.what());
-    return 2;
-  } catch (const fuzzy::FisError& e) {
+    auto loaded = config::loadTrackingSetup(robot_path, control_path);
+    setup.robot = std::move(loaded.robot);
+    setup.control = std::move(loaded.control);
+    setup.fis = std::move(loaded.fis);
+  } catch (const std::runtime_error& e) {  // ConfigError, FisError
     std::fprintf(stderr, "bench_tuning: %s\n", e.what());
     return 2;
   }

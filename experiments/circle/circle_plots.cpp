@@ -49,12 +49,11 @@ std::string writePlots(const Options& o, const std::vector<const Run*>& runs, co
     for (const Run* r : runs) {
       auto actual = series(label(r->controller), colorOf(r->controller));
       auto d = series(label(r->controller), colorOf(r->controller), 1);
-      d.y = sim::distanceFromPath(ref.x, ref.y, r->result.samples);
-      for (const auto& smp : r->result.samples) {
-        actual.x.push_back(smp.pose.x_m);
-        actual.y.push_back(smp.pose.y_m);
-        d.x.push_back(smp.t_s);
-      }
+      auto trace = sim::trackTrace(ref.x, ref.y, r->result.samples);
+      actual.x = std::move(trace.x_m);
+      actual.y = std::move(trace.y_m);
+      d.x = std::move(trace.t_s);
+      d.y = std::move(trace.distance_m);
       whole.series.push_back(std::move(actual));
       dist.series.push_back(std::move(d));
     }

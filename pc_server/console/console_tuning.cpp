@@ -68,10 +68,10 @@ Console::TuningState* Console::tuning(const std::string& cmd) {
   if (tuning_) return tuning_.get();
   try {
     auto t = std::make_shared<TuningState>();
-    t->robot = config::loadRobotConfigFile(tuning_robot_config_);
-    t->control = config::loadControlConfigFile(tuning_control_config_);
-    config::applyRobot(t->control, t->robot);
-    t->fis = fuzzy::readFisFile(t->control.fis_path);
+    auto loaded = config::loadTrackingSetup(tuning_robot_config_, tuning_control_config_);
+    t->robot = std::move(loaded.robot);
+    t->control = std::move(loaded.control);
+    t->fis = std::move(loaded.fis);
     t->paper.fuzzy = t->control.tracker.fuzzy;
     t->paper.aux = t->control.tracker.aux;
     t->working = t->paper;

@@ -193,12 +193,11 @@ std::vector<plot::Panel> trajectoryPanels(const Comparison& c, const TuneReferen
   for (std::size_t i = 0; i < c.rows.size(); ++i) {
     auto s = series(c.rows[i].label, colorOf(i));
     auto d = series(c.rows[i].label, colorOf(i), 1);
-    d.y = sim::distanceFromPath(r.x, r.y, c.rows[i].trace.samples);
-    for (const auto& smp : c.rows[i].trace.samples) {
-      s.x.push_back(smp.pose.x_m);
-      s.y.push_back(smp.pose.y_m);
-      d.x.push_back(smp.t_s);
-    }
+    auto trace = sim::trackTrace(r.x, r.y, c.rows[i].trace.samples);
+    s.x = std::move(trace.x_m);
+    s.y = std::move(trace.y_m);
+    d.x = std::move(trace.t_s);
+    d.y = std::move(trace.distance_m);
     xy.series.push_back(std::move(s));
     dist.series.push_back(std::move(d));
   }

@@ -64,6 +64,15 @@ void applyRobot(ControlConfig& c, const RobotConfig& robot) {
   c.tracker.max_wheel_speed_rad_s = robot.limits.max_wheel_speed_rad_s;
 }
 
+TrackingSetup loadTrackingSetup(const std::string& robot_path, const std::string& control_path) {
+  TrackingSetup s;
+  s.robot = loadRobotConfigFile(robot_path);
+  s.control = loadControlConfigFile(control_path);
+  applyRobot(s.control, s.robot);
+  s.fis = fuzzy::readFisFile(s.control.fis_path);
+  return s;
+}
+
 std::shared_ptr<control::FuzzyGainScheduler> loadScheduler(const ControlConfig& c) {
   try {
     return std::make_shared<control::FuzzyGainScheduler>(fuzzy::readFisFile(c.fis_path), c.use_lookup);

@@ -6,6 +6,7 @@
 #include "shared/config/config_node.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/control/trajectory_tracker.hpp"
+#include "shared/fuzzy/fis.hpp"
 
 namespace inspect::config {
 
@@ -22,6 +23,16 @@ ControlConfig loadControlConfig(const ConfigNode& root, const std::string& base_
 ControlConfig loadControlConfigFile(const std::string& path);
 /// Copies geometry and limits of the robot into the tracker parameters.
 void applyRobot(ControlConfig& c, const RobotConfig& robot);
+/// The robot, its tracking controllers and their fuzzy system, as the
+/// closed-loop runs need them (the experiments, the benchmarks, the tuner).
+struct TrackingSetup {
+  RobotConfig robot;
+  ControlConfig control;  // applyRobot done
+  fuzzy::Fis fis;         // control.fis_path read
+};
+/// Reads both files, applies the robot, reads the fis. Throws ConfigError or fuzzy::FisError.
+TrackingSetup loadTrackingSetup(const std::string& robot_path, const std::string& control_path);
+
 /// Loads the fuzzy-PID scheduler named by the config. Throws ConfigError.
 std::shared_ptr<control::FuzzyGainScheduler> loadScheduler(const ControlConfig& c);
 

@@ -13,69 +13,41 @@ int GasConfig::find(const std::string& name) const {
   return -1;
 }
 
+namespace {
+
+// One row of the default table: what differs between the four sensors.
+GasChannel channel(const char* name, const char* gas, const char* unit, const char* sensor, double scale,
+                   double range_max, double t90_s, double noise, double alarm_low, double alarm_high,
+                   double hysteresis) {
+  GasChannel c;
+  c.name = name;
+  c.gas = gas;
+  c.unit = unit;
+  c.sensor = sensor;
+  c.scale = scale;
+  c.range_max = range_max;
+  c.t90_s = t90_s;
+  c.noise = noise;
+  c.alarm_low = alarm_low;
+  c.alarm_high = alarm_high;
+  c.hysteresis = hysteresis;
+  c.min_duration_s = 1.0;
+  return c;
+}
+
+}  // namespace
+
 GasConfig defaultGasConfig() {
   GasConfig g;
-  GasChannel ch4;
-  ch4.name = "CH4";
-  ch4.gas = "methane";
-  ch4.unit = "%LEL";
-  ch4.sensor = "catalytic";
-  ch4.scale = 0.01;
-  ch4.range_max = 100.0;
-  ch4.t90_s = 6.0;
-  ch4.noise = 0.3;
-  ch4.alarm_low = 10.0;
-  ch4.alarm_high = 20.0;
-  ch4.hysteresis = 2.0;
-  ch4.min_duration_s = 1.0;
-  g.channels.push_back(ch4);
-
-  GasChannel h2s;
-  h2s.name = "H2S";
-  h2s.gas = "hydrogen sulfide";
-  h2s.unit = "ppm";
-  h2s.sensor = "electrochemical";
-  h2s.scale = 0.01;
-  h2s.range_max = 100.0;
-  h2s.t90_s = 8.0;
-  h2s.noise = 0.2;
-  h2s.alarm_low = 5.0;
-  h2s.alarm_high = 10.0;
-  h2s.hysteresis = 1.0;
-  h2s.min_duration_s = 1.0;
-  g.channels.push_back(h2s);
-
-  GasChannel co;
-  co.name = "CO";
-  co.gas = "carbon monoxide";
-  co.unit = "ppm";
-  co.sensor = "electrochemical";
-  co.scale = 0.1;
-  co.range_max = 1000.0;
-  co.t90_s = 10.0;
-  co.noise = 1.0;
-  co.alarm_low = 35.0;
-  co.alarm_high = 100.0;
-  co.hysteresis = 5.0;
-  co.min_duration_s = 1.0;
+  // name, gas, unit, sensor, scale (unit per count), range max, T90 (s), noise, A1, A2, hysteresis
+  g.channels.push_back(channel("CH4", "methane", "%LEL", "catalytic", 0.01, 100.0, 6.0, 0.3, 10.0, 20.0, 2.0));
+  g.channels.push_back(channel("H2S", "hydrogen sulfide", "ppm", "electrochemical", 0.01, 100.0, 8.0, 0.2, 5.0, 10.0, 1.0));
+  GasChannel co = channel("CO", "carbon monoxide", "ppm", "electrochemical", 0.1, 1000.0, 10.0, 1.0, 35.0, 100.0, 5.0);
   co.cross.push_back({"H2S", 0.1});
   g.channels.push_back(co);
-
-  GasChannel o2;
-  o2.name = "O2";
-  o2.gas = "oxygen";
-  o2.unit = "%vol";
-  o2.sensor = "electrochemical";
-  o2.scale = 0.01;
-  o2.range_max = 30.0;
-  o2.t90_s = 8.0;
-  o2.noise = 0.03;
+  GasChannel o2 = channel("O2", "oxygen", "%vol", "electrochemical", 0.01, 30.0, 8.0, 0.03, 19.5, 18.0, 0.3);
   o2.background = 20.9;
   o2.direction = AlarmDirection::Falling;
-  o2.alarm_low = 19.5;
-  o2.alarm_high = 18.0;
-  o2.hysteresis = 0.3;
-  o2.min_duration_s = 1.0;
   o2.cross.push_back({"CH4", -0.0105});  // 1 %LEL CH4 = 0.05 %vol displaces 0.0105 %vol O2
   g.channels.push_back(o2);
   return g;

@@ -7,14 +7,11 @@
 #include <vector>
 
 #include "shared/config/config_node.hpp"
-#include "shared/geometry/polygon.hpp"
+#include "shared/geometry/vec2.hpp"
 
 namespace inspect::world {
 
-using geometry::Polygon;
-using geometry::Segment;
 using geometry::Vec2;
-using geometry::pointText;
 
 struct World;
 
