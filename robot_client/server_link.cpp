@@ -102,12 +102,12 @@ void ServerLink::onConnected() {
   h->add_capabilities("teleop");
   h->add_capabilities("video");
   h->add_capabilities("ptz");
-  if (!gas_channels_.empty()) h->add_capabilities("gas");
-  for (const auto& g : gas_channels_) *h->add_gas_channels() = g;
-  h->set_gas_inlet_x_m(gas_inlet_x_m_);
-  h->set_gas_inlet_y_m(gas_inlet_y_m_);
+  if (!hello_.gas_channels.empty()) h->add_capabilities("gas");
+  for (const auto& g : hello_.gas_channels) *h->add_gas_channels() = g;
+  h->set_gas_inlet_x_m(hello_.inlet_x_m);
+  h->set_gas_inlet_y_m(hello_.inlet_y_m);
   h->set_software_version(INSPECT_VERSION);
-  if (hello_filler_) hello_filler_(*h);
+  if (hello_.filler) hello_.filler(*h);
   send(hello);
   doRead();
 }
@@ -176,7 +176,7 @@ void ServerLink::doRead() {
         }
         up_ = true;
         last_rx_ns_ = monoNowNs();
-        ++connects_;
+        ++counts_.connects;
         backoff_s_ = cfg_.reconnect_min_s;
         handshake_timer_.cancel();
         last_error_.clear();
@@ -214,7 +214,7 @@ void ServerLink::heartbeat() {
 void ServerLink::send(v1::Envelope& env) {
   if (!connected_) return;
   if (tx_queue_.size() >= kMaxQueued) {
-    ++dropped_;
+    ++counts_.dropped;
     return;
   }
   env.set_seq(next_seq_++);

@@ -32,12 +32,12 @@ class ServerLink {
   void start(Handlers h);
   /// Gas channels announced in every Hello (set before start()).
   void setGasChannels(std::vector<v1::GasChannelInfo> channels, double inlet_x_m, double inlet_y_m) {
-    gas_channels_ = std::move(channels);
-    gas_inlet_x_m_ = inlet_x_m;
-    gas_inlet_y_m_ = inlet_y_m;
+    hello_.gas_channels = std::move(channels);
+    hello_.inlet_x_m = inlet_x_m;
+    hello_.inlet_y_m = inlet_y_m;
   }
   /// Called to complete every Hello just before it is sent.
-  void setHelloFiller(std::function<void(v1::Hello&)> f) { hello_filler_ = std::move(f); }
+  void setHelloFiller(std::function<void(v1::Hello&)> f) { hello_.filler = std::move(f); }
   void stop();
 
   /// Queues an envelope (seq and send time are filled in). Dropped when the
@@ -45,8 +45,8 @@ class ServerLink {
   void send(v1::Envelope& env);
 
   bool isUp() const { return up_; }
-  uint64_t connects() const { return connects_; }
-  uint64_t dropped() const { return dropped_; }
+  uint64_t connects() const { return counts_.connects; }
+  uint64_t dropped() const { return counts_.dropped; }
 
  private:
   void connect();
@@ -60,9 +60,11 @@ class ServerLink {
 
   boost::asio::io_context& io_;
   ClientConfig cfg_;
-  std::vector<v1::GasChannelInfo> gas_channels_;
-  double gas_inlet_x_m_ = 0.0, gas_inlet_y_m_ = 0.0;
-  std::function<void(v1::Hello&)> hello_filler_;
+  struct HelloParts {  // what every Hello carries besides the id and the version
+    std::vector<v1::GasChannelInfo> gas_channels;
+    double inlet_x_m = 0.0, inlet_y_m = 0.0;
+    std::function<void(v1::Hello&)> filler;
+  } hello_;
   Handlers h_;
   boost::asio::ip::tcp::resolver resolver_;
   std::shared_ptr<boost::asio::ssl::context> tls_;  // null: --plaintext
@@ -78,8 +80,10 @@ class ServerLink {
   bool stopped_ = false;
   double backoff_s_;
   uint64_t next_seq_ = 1;
-  uint64_t connects_ = 0;
-  uint64_t dropped_ = 0;
+  struct Counts {
+    uint64_t connects = 0;
+    uint64_t dropped = 0;  // envelopes not queued: link down or queue full
+  } counts_;
   uint64_t generation_ = 0;
   int64_t last_rx_ns_ = 0;
   static constexpr double kDeadAfterS = 0.8;  // invalidates handlers of an old connection

@@ -57,42 +57,39 @@ Simulation::Simulation(const config::RobotConfig& robot, World world, uint64_t s
       ultrasonic_(robot.ultrasonic, subSeed(seed, 1)),
       mcu_(robot, subSeed(seed, 2), observer),
       observer_(observer),
-      crowd_(world_, observer),
-      body_radius_m_(robot.geometry.body_radius_m),
-      wheel_radius_m_(robot.geometry.wheel_radius_m),
-      track_m_(robot.geometry.track_m),
-      person_contact_(world_.pedestrians.size(), false),
-      gas_cfg_(robot.gas),
-      gas_(checkGasNames(robot.gas, world_)),
-      gas_sensors_(robot.gas, resolveGasFaults(robot.gas, world_), subSeed(seed, 3)),
-      gas_fault_on_(world_.gas.faults.size(), false) {
-  checkStartPose(world_, body_radius_m_);
+      body_{robot.geometry.body_radius_m, robot.geometry.wheel_radius_m, robot.geometry.track_m},
+      people_{.crowd = PedestrianCrowd(world_, observer), .contact = std::vector<bool>(world_.pedestrians.size(), false)},
+      gas_{.cfg = robot.gas,
+           .model = GasModel(checkGasNames(robot.gas, world_)),
+           .sensors = GasSensors(robot.gas, resolveGasFaults(robot.gas, world_), subSeed(seed, 3)),
+           .fault_on = std::vector<bool>(world_.gas.faults.size(), false)} {
+  checkStartPose(world_, body_.radius_m);
   state_.pose = world_.start;
-  for (const auto& ch : gas_cfg_.channels) {
+  for (const auto& ch : gas_.cfg.channels) {
     GasChannelMap m;
     m.background = ch.background;
-    m.field = gas_.field(ch.name);
+    m.field = gas_.model.field(ch.name);
     for (const auto& x : ch.cross)
-      if (const int f = gas_.field(x.gas); f >= 0) m.cross.emplace_back(f, x.factor);
-    gas_map_.push_back(std::move(m));
+      if (const int f = gas_.model.field(x.gas); f >= 0) m.cross.emplace_back(f, x.factor);
+    gas_.channel_maps.push_back(std::move(m));
   }
   // The sensors have been standing at the start pose: no start-up transient.
   const GasValues truth = trueGas(gasInlet());
-  gas_sensors_.settle(truth);
+  gas_.sensors.settle(truth);
 }
 
 Vec2 Simulation::gasInlet() const {
   const auto& p = state_.pose;
   const double c = std::cos(p.theta_rad), s = std::sin(p.theta_rad);
-  return {p.x_m + c * gas_cfg_.inlet_x_m - s * gas_cfg_.inlet_y_m,
-          p.y_m + s * gas_cfg_.inlet_x_m + c * gas_cfg_.inlet_y_m};
+  return {p.x_m + c * gas_.cfg.inlet_x_m - s * gas_.cfg.inlet_y_m,
+          p.y_m + s * gas_.cfg.inlet_x_m + c * gas_.cfg.inlet_y_m};
 }
 
 Simulation::GasValues Simulation::trueGas(Vec2 p) const {
   GasValues fields{}, out{};
-  gas_.concentrations(p, fields);
-  for (std::size_t i = 0; i < gas_map_.size() && i < out.size(); ++i) {
-    const auto& m = gas_map_[i];
+  gas_.model.concentrations(p, fields);
+  for (std::size_t i = 0; i < gas_.channel_maps.size() && i < out.size(); ++i) {
+    const auto& m = gas_.channel_maps[i];
     double v = m.background + (m.field >= 0 ? fields[static_cast<std::size_t>(m.field)] : 0.0);
     for (const auto& [f, factor] : m.cross) v += factor * fields[static_cast<std::size_t>(f)];
     out[i] = v;
@@ -101,18 +98,18 @@ Simulation::GasValues Simulation::trueGas(Vec2 p) const {
 }
 
 double Simulation::trueConcentration(int channel, Vec2 p) const {
-  if (channel < 0 || static_cast<std::size_t>(channel) >= std::min(gas_map_.size(), GasValues{}.size()))
+  if (channel < 0 || static_cast<std::size_t>(channel) >= std::min(gas_.channel_maps.size(), GasValues{}.size()))
     return std::numeric_limits<double>::quiet_NaN();
   return trueGas(p)[static_cast<std::size_t>(channel)];
 }
 
 void Simulation::reportGasStart() {
-  if (gas_reported_) return;
-  gas_reported_ = true;
+  if (gas_.reported) return;
+  gas_.reported = true;
   if (!observer_) return;
-  if (!gas_cfg_.channels.empty()) {
+  if (!gas_.cfg.channels.empty()) {
     std::string d;
-    for (const auto& c : gas_cfg_.channels) d += (d.empty() ? "" : " ") + c.name + "=" + c.unit;
+    for (const auto& c : gas_.cfg.channels) d += (d.empty() ? "" : " ") + c.name + "=" + c.unit;
     observer_->onEvent(timeS(), "gas_channels", d);
   }
   for (const auto& s : world_.gas.sources) {
@@ -125,13 +122,13 @@ void Simulation::reportGasStart() {
 }
 
 void Simulation::sampleGas(McuInputs& in) {
-  const std::size_t n = std::min(gas_map_.size(), GasValues{}.size());
+  const std::size_t n = std::min(gas_.channel_maps.size(), GasValues{}.size());
   if (n == 0) return;
-  const auto& faults = gas_sensors_.faults();
+  const auto& faults = gas_.sensors.faults();
   for (std::size_t i = 0; i < faults.size(); ++i) {
     const bool on = timeS() >= faults[i].start_s && timeS() < faults[i].end_s;
-    if (on == gas_fault_on_[i]) continue;
-    gas_fault_on_[i] = on;
+    if (on == gas_.fault_on[i]) continue;
+    gas_.fault_on[i] = on;
     if (observer_) {
       const auto& f = world_.gas.faults[i];
       observer_->onEvent(timeS(), on ? "gas_fault_start" : "gas_fault_end",
@@ -141,12 +138,12 @@ void Simulation::sampleGas(McuInputs& in) {
   const Vec2 inlet = gasInlet();
   const GasValues truth = trueGas(inlet);
   const double dt_s =
-      last_gas_sample_ms_ < 0 ? 0.0 : static_cast<double>(static_cast<int64_t>(t_ms_) - last_gas_sample_ms_) / 1000.0;
-  last_gas_sample_ms_ = static_cast<int64_t>(t_ms_);
-  in.gas_raw = gas_sensors_.sample(timeS(), dt_s, {truth.data(), n});
+      gas_.last_sample_ms < 0 ? 0.0 : static_cast<double>(static_cast<int64_t>(t_ms_) - gas_.last_sample_ms) / 1000.0;
+  gas_.last_sample_ms = static_cast<int64_t>(t_ms_);
+  in.gas_raw = gas_.sensors.sample(timeS(), dt_s, {truth.data(), n});
   if (observer_ && t_ms_ % kGasLogPeriod_ms == 0) {
     GasValues reading{};
-    for (std::size_t i = 0; i < n; ++i) reading[i] = gas_sensors_.reading(i);
+    for (std::size_t i = 0; i < n; ++i) reading[i] = gas_.sensors.reading(i);
     observer_->onGas({timeS(), inlet.x, inlet.y, {truth.data(), n}, {reading.data(), n}});
   }
 }
@@ -154,9 +151,9 @@ void Simulation::sampleGas(McuInputs& in) {
 behavior::Agent Simulation::robotBody() const {
   behavior::Agent r;
   r.position_m = {state_.pose.x_m, state_.pose.y_m};
-  const double v = control::twistFromWheels(state_.wheel, wheel_radius_m_, track_m_).v_m_s;
+  const double v = control::twistFromWheels(state_.wheel, body_.wheel_radius_m, body_.track_m).v_m_s;
   r.velocity_m_s = {v * std::cos(state_.pose.theta_rad), v * std::sin(state_.pose.theta_rad)};
-  r.radius_m = body_radius_m_;
+  r.radius_m = body_.radius_m;
   return r;
 }
 
@@ -165,7 +162,7 @@ void Simulation::receive(std::span<const uint8_t> bytes) { mcu_.receive(bytes, t
 void Simulation::emitFrame() {
   McuInputs in;
   in.truth = state_;
-  in.ultrasonic_mm = ultrasonic_.measureAllMm(world_, state_.pose, crowd_.circles());
+  in.ultrasonic_mm = ultrasonic_.measureAllMm(world_, state_.pose, people_.crowd.circles());
   in.grayscale = GrayscaleModel::read(world_, state_.pose);
   sampleGas(in);
   const auto frame = mcu_.sendSensorFrame(t_ms_, in, tx_);
@@ -175,54 +172,54 @@ void Simulation::emitFrame() {
 
 void Simulation::emitPedestrians() {
   if (!observer_) return;
-  for (std::size_t i = 0; i < crowd_.size(); ++i) {
-    if (!crowd_.present(i)) continue;
-    const auto& a = crowd_.agent(i);
+  for (std::size_t i = 0; i < people_.crowd.size(); ++i) {
+    if (!people_.crowd.present(i)) continue;
+    const auto& a = people_.crowd.agent(i);
     const double dist = std::hypot(a.position_m.x() - state_.pose.x_m, a.position_m.y() - state_.pose.y_m);
-    observer_->onPedestrian({timeS(), crowd_.script(i).id, a.position_m.x(), a.position_m.y(), a.velocity_m_s.x(),
+    observer_->onPedestrian({timeS(), people_.crowd.script(i).id, a.position_m.x(), a.position_m.y(), a.velocity_m_s.x(),
                              a.velocity_m_s.y(), dist});
   }
 }
 
 void Simulation::checkPersonContacts() {
-  for (std::size_t i = 0; i < crowd_.size(); ++i) {
-    if (!crowd_.present(i)) continue;
-    const auto& a = crowd_.agent(i);
+  for (std::size_t i = 0; i < people_.crowd.size(); ++i) {
+    if (!people_.crowd.present(i)) continue;
+    const auto& a = people_.crowd.agent(i);
     const double gap = std::hypot(a.position_m.x() - state_.pose.x_m, a.position_m.y() - state_.pose.y_m) -
-                       body_radius_m_ - a.radius_m;
-    if (gap < 0.0 && !person_contact_[i]) {
-      person_contact_[i] = true;
-      ++person_collisions_;
+                       body_.radius_m - a.radius_m;
+    if (gap < 0.0 && !people_.contact[i]) {
+      people_.contact[i] = true;
+      ++people_.collisions;
       if (observer_) {
         char detail[192];
         std::snprintf(detail, sizeof detail, "id=%s x=%.3f y=%.3f person_x=%.3f person_y=%.3f",
-                      crowd_.script(i).id.c_str(), state_.pose.x_m, state_.pose.y_m, a.position_m.x(),
+                      people_.crowd.script(i).id.c_str(), state_.pose.x_m, state_.pose.y_m, a.position_m.x(),
                       a.position_m.y());
         observer_->onEvent(timeS(), "collision_person", detail);
       }
-    } else if (person_contact_[i] && gap > kContactRelease_m) {
-      person_contact_[i] = false;
+    } else if (people_.contact[i] && gap > kContactRelease_m) {
+      people_.contact[i] = false;
     }
   }
 }
 
 void Simulation::step() {
   mcu_.tick(t_ms_);
-  crowd_.reportInitial();
+  people_.crowd.reportInitial();
   reportGasStart();
-  if (t_ms_ % kGasPeriod_ms == 0) gas_.advanceTo(timeS());  // fields at t for this step's frame
+  if (t_ms_ % kGasPeriod_ms == 0) gas_.model.advanceTo(timeS());  // fields at t for this step's frame
   if (t_ms_ % kFramePeriod_ms == 0) emitFrame();
   const double dt_s = static_cast<double>(kStep_ms) / 1000.0;
   // Both from the state at t: the people react to where the robot is now.
-  if (people_wait_ && !people_started_) {
+  if (people_.wait_for_motion && !people_.started) {
     const auto sp = mcu_.setpoints();
     if (sp.left_rad_s != 0.0 || sp.right_rad_s != 0.0) {
-      people_started_ = true;
-      people_t0_s_ = timeS();
+      people_.started = true;
+      people_.t0_s = timeS();
       if (observer_) observer_->onEvent(timeS(), "people_clock_start", "first wheel motion");
     }
   }
-  if (!people_wait_ || people_started_) crowd_.step(timeS() - people_t0_s_, dt_s, robotBody());
+  if (!people_.wait_for_motion || people_.started) people_.crowd.step(timeS() - people_.t0_s, dt_s, robotBody());
   const auto r = plant_.step(state_, motor_delay_.apply(timeS(), mcu_.setpoints()), dt_s);
   state_ = r.state;
   checkPersonContacts();
@@ -235,7 +232,7 @@ void Simulation::step() {
                     state_.pose.theta_rad);
       observer_->onEvent(timeS(), "collision", detail);
     }
-  } else if (in_contact_ && r.clearance_m > body_radius_m_ + kContactRelease_m) {
+  } else if (in_contact_ && r.clearance_m > body_.radius_m + kContactRelease_m) {
     in_contact_ = false;
   }
   t_ms_ += kStep_ms;

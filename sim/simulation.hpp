@@ -43,9 +43,9 @@ class Simulation {
   /// When on, the pedestrians stand at their start points and their clock
   /// (start_s, pauses) starts at the first non-zero wheel set-point, so that a
   /// scenario plays the same whenever the robot starts. Off by default.
-  void setPeopleWaitForMotion(bool on) { people_wait_ = on; }
+  void setPeopleWaitForMotion(bool on) { people_.wait_for_motion = on; }
   /// Sim time at which the pedestrians' clock started (0 unless waiting; < 0 while still waiting).
-  double peopleClockStartS() const { return people_wait_ && !people_started_ ? -1.0 : people_t0_s_; }
+  double peopleClockStartS() const { return people_.wait_for_motion && !people_.started ? -1.0 : people_.t0_s; }
 
   /// Bytes from the host, applied at the current sim time.
   void receive(std::span<const uint8_t> bytes);
@@ -62,16 +62,16 @@ class Simulation {
   const McuEmulator& mcu() const { return mcu_; }
   const World& world() const { return world_; }
   uint64_t collisions() const { return collisions_; }
-  const PedestrianCrowd& pedestrians() const { return crowd_; }
+  const PedestrianCrowd& pedestrians() const { return people_.crowd; }
   /// Robot-person contacts so far (one per contact, like collisions()).
-  uint64_t personCollisions() const { return person_collisions_; }
+  uint64_t personCollisions() const { return people_.collisions; }
   /// The robot's body as the pedestrians see it (true pose and velocity).
   behavior::Agent robotBody() const;
 
   /// The gas concentration fields (as of the last 50 ms update).
-  const GasModel& gas() const { return gas_; }
+  const GasModel& gas() const { return gas_.model; }
   /// The simulated gas sensors (responses, last readings).
-  const GasSensors& gasSensors() const { return gas_sensors_; }
+  const GasSensors& gasSensors() const { return gas_.sensors; }
   /// World position of the gas sampling inlet at the current pose.
   Vec2 gasInlet() const;
   /// What gas channel `channel` (slot of robot.gas) would truly read at p now,
@@ -100,28 +100,36 @@ class Simulation {
   UltrasonicModel ultrasonic_;
   McuEmulator mcu_;
   SimObserver* observer_;
-  PedestrianCrowd crowd_;
   PlantState state_;
   uint64_t t_ms_ = 0;
   bool in_contact_ = false;
   uint64_t collisions_ = 0;
-  double body_radius_m_;
-  double wheel_radius_m_;
-  double track_m_;
-  std::vector<bool> person_contact_;  // per pedestrian: overlapping the robot now
-  uint64_t person_collisions_ = 0;
   std::vector<uint8_t> tx_;
-  bool people_wait_ = false;
-  bool people_started_ = false;
-  double people_t0_s_ = 0.0;
-  // Gas: fields, sensors, how channels read the fields.
-  config::GasConfig gas_cfg_;
-  GasModel gas_;
-  GasSensors gas_sensors_;
-  std::vector<GasChannelMap> gas_map_;
-  std::vector<bool> gas_fault_on_;  // per scripted fault: active at the last frame
-  bool gas_reported_ = false;
-  int64_t last_gas_sample_ms_ = -1;
+
+  struct Body {  // robot.yaml geometry
+    double radius_m;
+    double wheel_radius_m;
+    double track_m;
+  } body_;
+
+  struct People {
+    PedestrianCrowd crowd;
+    std::vector<bool> contact;     // per pedestrian: overlapping the robot now
+    uint64_t collisions = 0;
+    bool wait_for_motion = false;  // their clock starts at the robot's first wheel motion
+    bool started = false;
+    double t0_s = 0.0;
+  } people_;
+
+  struct Gas {  // fields, sensors, how channels read the fields
+    config::GasConfig cfg;
+    GasModel model;
+    GasSensors sensors;
+    std::vector<GasChannelMap> channel_maps{};
+    std::vector<bool> fault_on;  // per scripted fault: active at the last frame
+    bool reported = false;
+    int64_t last_sample_ms = -1;
+  } gas_;
 };
 
 }  // namespace inspect::sim

@@ -203,11 +203,13 @@ class Console {
     std::string name;
   };
   std::vector<Run> runs_;
-  std::shared_ptr<TuningState> tuning_;
-  std::atomic<bool> tune_cancel_{false};  // Ctrl-C during tune (StopFlag's interrupt target)
-  std::string tuning_robot_config_ = "config/robot.yaml";
-  std::string tuning_control_config_ = "config/control.yaml";
-  std::string tuning_dir_ = "runs/tuning";
+  struct Tuning {  // the tuning host's state (console_tuning.cpp)
+    std::shared_ptr<TuningState> state;  // made on the first tuning command
+    std::atomic<bool> cancel{false};     // Ctrl-C during tune (StopFlag's interrupt target)
+    std::string robot_config = "config/robot.yaml";
+    std::string control_config = "config/control.yaml";
+    std::string dir = "runs/tuning";
+  } tune_;
 };
 
 }  // namespace inspect::server

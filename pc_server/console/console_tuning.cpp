@@ -58,17 +58,17 @@ std::string sessionStamp() {
 }  // namespace
 
 void Console::setTuningPaths(std::string robot_config, std::string control_config, std::string dir) {
-  tuning_robot_config_ = std::move(robot_config);
-  tuning_control_config_ = std::move(control_config);
-  tuning_dir_ = std::move(dir);
-  tuning_.reset();
+  tune_.robot_config = std::move(robot_config);
+  tune_.control_config = std::move(control_config);
+  tune_.dir = std::move(dir);
+  tune_.state.reset();
 }
 
 Console::TuningState* Console::tuning(const std::string& cmd) {
-  if (tuning_) return tuning_.get();
+  if (tune_.state) return tune_.state.get();
   try {
     auto t = std::make_shared<TuningState>();
-    auto loaded = config::loadTrackingSetup(tuning_robot_config_, tuning_control_config_);
+    auto loaded = config::loadTrackingSetup(tune_.robot_config, tune_.control_config);
     t->robot = std::move(loaded.robot);
     t->control = std::move(loaded.control);
     t->fis = std::move(loaded.fis);
@@ -76,12 +76,12 @@ Console::TuningState* Console::tuning(const std::string& cmd) {
     t->paper.aux = t->control.tracker.aux;
     t->working = t->paper;
     t->plant = sim::nominalPlant(t->robot);
-    tuning_ = std::move(t);
+    tune_.state = std::move(t);
   } catch (const std::exception& e) {
     fail(cmd, std::string("cannot load the tuning configs: ") + e.what());
     return nullptr;
   }
-  return tuning_.get();
+  return tune_.state.get();
 }
 
 // ------------------------------------------------------------------ identify
@@ -294,7 +294,7 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
        << setup.seeds << " noise seeds); Ctrl-C stops and keeps the best so far\n";
   out_.flush();
 
-  std::atomic<bool>& cancel = tune_cancel_;  // outlives the command: the signal handler may still hold it
+  std::atomic<bool>& cancel = tune_.cancel;  // outlives the command: the signal handler may still hold it
   cancel.store(false);
   stop_.setInterruptTarget(&cancel);
   const bool tty = alarm_style_;  // an interactive terminal: one redrawn progress line
@@ -352,9 +352,9 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
   out_ << tuning::comparisonTable(cmp);
   const std::string robot = selected_;
   std::string session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot);
-  for (int n = 2; fs::exists(tuning_dir_ + "/" + session) && n < 1000; ++n)  // two sessions in one second
+  for (int n = 2; fs::exists(tune_.dir + "/" + session) && n < 1000; ++n)  // two sessions in one second
     session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot) + "-" + std::to_string(n);
-  const std::string dir = tuning_dir_ + "/" + session;
+  const std::string dir = tune_.dir + "/" + session;
   try {
     const auto files = tuning::writeTuningSession(dir, setup, result, cmp, ts->fis);
     for (const auto& n : files.notes) out_ << "  note: " << n << "\n";

@@ -57,15 +57,15 @@ RobotSession::RobotSession(Strand strand, asio::ip::tcp::socket socket,
   stream_.socket().set_option(asio::ip::tcp::no_delay(true), ec);  // small frames, latency matters
 }
 
-std::string RobotSession::who() const { return robot_id_.empty() ? address_ : robot_id_ + " (" + address_ + ")"; }
+std::string RobotSession::who() const { return peer_.robot_id.empty() ? address_ : peer_.robot_id + " (" + address_ + ")"; }
 
 void RobotSession::start() {
   asio::post(strand_, [self = shared_from_this()] {
-    self->last_rx_ = Clock::now();
+    self->live_.last_rx = Clock::now();
     self->handshake_timer_.expires_after(seconds(self->config_.handshake_timeout_s));
     self->handshake_timer_.async_wait([self](const error_code& ec) {
-      if (ec || self->closed_ || self->accepted_ || self->rejecting_) return;
-      self->closeNow(std::string(self->cert_name_.empty() && self->stream_.tls() ? "no TLS handshake" : "no Hello") +
+      if (ec || self->closed_ || self->peer_.accepted || self->peer_.rejecting) return;
+      self->closeNow(std::string(self->peer_.cert_name.empty() && self->stream_.tls() ? "no TLS handshake" : "no Hello") +
                          " within " + fmtShort(self->config_.handshake_timeout_s) + " s (handshake timeout)",
                      log::Level::kWarn);
     });
@@ -77,8 +77,8 @@ void RobotSession::start() {
         return;
       }
       if (self->stream_.tls()) {
-        self->cert_name_ = net::peerCommonName(self->stream_.ssl());
-        log::debug(log::tag::kLink, self->address_, ": TLS up, robot certificate CN=", self->cert_name_);
+        self->peer_.cert_name = net::peerCommonName(self->stream_.ssl());
+        log::debug(log::tag::kLink, self->address_, ": TLS up, robot certificate CN=", self->peer_.cert_name);
       } else {
         log::warn(log::tag::kLink, self->address_, ": UNAUTHENTICATED plaintext connection (--plaintext)");
       }
@@ -95,10 +95,10 @@ void RobotSession::close(std::string reason) {
 
 void RobotSession::sendCommand(v1::Command cmd) {
   asio::post(strand_, [self = shared_from_this(), cmd = std::move(cmd)] {
-    if (self->closed_ || !self->accepted_) return;
+    if (self->closed_ || !self->peer_.accepted) return;
     if (cmd.has_stop() || cmd.has_estop()) {
-      self->teleop_active_ = false;
-      ++self->teleop_generation_;
+      self->teleop_.active = false;
+      ++self->teleop_.generation;
       self->teleop_timer_.cancel();
     }
     v1::Envelope env;
@@ -109,11 +109,11 @@ void RobotSession::sendCommand(v1::Command cmd) {
 
 void RobotSession::setTeleop(double v_m_s, double w_rad_s, uint64_t first_id) {
   asio::post(strand_, [self = shared_from_this(), v_m_s, w_rad_s, first_id] {
-    if (self->closed_ || !self->accepted_) return;
-    self->teleop_active_ = true;
-    self->teleop_v_m_s_ = v_m_s;
-    self->teleop_w_rad_s_ = w_rad_s;
-    const uint64_t gen = ++self->teleop_generation_;
+    if (self->closed_ || !self->peer_.accepted) return;
+    self->teleop_.active = true;
+    self->teleop_.v_m_s = v_m_s;
+    self->teleop_.w_rad_s = w_rad_s;
+    const uint64_t gen = ++self->teleop_.generation;
     self->teleop_timer_.cancel();
     self->sendTeleopNow(first_id);
     self->teleop_timer_.expires_after(seconds(1.0 / self->config_.teleop_resend_hz));
@@ -123,8 +123,8 @@ void RobotSession::setTeleop(double v_m_s, double w_rad_s, uint64_t first_id) {
 
 void RobotSession::clearTeleop() {
   asio::post(strand_, [self = shared_from_this()] {
-    self->teleop_active_ = false;
-    ++self->teleop_generation_;
+    self->teleop_.active = false;
+    ++self->teleop_.generation;
     self->teleop_timer_.cancel();
   });
 }
@@ -136,9 +136,9 @@ void RobotSession::doRead() {
 
 void RobotSession::onRead(const error_code& ec, std::size_t n) {
   if (closed_) return;
-  if (rejecting_) {
+  if (peer_.rejecting) {
     // Discard whatever the rejected robot still sends; its closing ends the linger.
-    if (ec) closeNow(reject_reason_, log::Level::kDebug);
+    if (ec) closeNow(peer_.reject_reason, log::Level::kDebug);
     else doRead();
     return;
   }
@@ -158,7 +158,7 @@ void RobotSession::onRead(const error_code& ec, std::size_t n) {
     }
     return;
   }
-  last_rx_ = Clock::now();
+  live_.last_rx = Clock::now();
   decoder_.append(rx_buf_.data(), n);
   for (;;) {
     std::span<const uint8_t> frame;
@@ -169,7 +169,7 @@ void RobotSession::onRead(const error_code& ec, std::size_t n) {
       return;
     }
     if (!handleFrame(frame)) return;
-    if (rejecting_) break;
+    if (peer_.rejecting) break;
   }
   doRead();
 }
@@ -182,7 +182,7 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
     return false;
   }
   const auto body = env.body_case();
-  if (!accepted_) {
+  if (!peer_.accepted) {
     if (body != v1::Envelope::kHello) {
       closeNow(std::string("protocol error: first message must be Hello, got ") + bodyName(body), log::Level::kWarn);
       return false;
@@ -192,26 +192,26 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
   }
   switch (body) {
     case v1::Envelope::kHeartbeat:
-      return true;  // last_rx_ already counts it
+      return true;  // live_.last_rx already counts it
     case v1::Envelope::kTelemetry: {
       const auto& t = env.telemetry();
-      last_telemetry_ = Clock::now();
-      stale_stopped_ = false;
-      robot_moving_ = t.mode() == v1::TELEOP || t.mode() == v1::TRACKING || t.mode() == v1::NAVIGATING ||
+      live_.last_telemetry = Clock::now();
+      live_.stale_stopped = false;
+      live_.robot_moving = t.mode() == v1::TELEOP || t.mode() == v1::TRACKING || t.mode() == v1::NAVIGATING ||
                       t.mode() == v1::WHEEL_TEST || t.cmd_v_m_s() != 0.0 || t.cmd_w_rad_s() != 0.0;
     }
-      registry_.onTelemetry(robot_id_, serial_, env.telemetry(), monoNowNs());
-      server_.observe(robot_id_, address_, env, true, monoNowUs());
+      registry_.onTelemetry(peer_.robot_id, serial_, env.telemetry(), monoNowNs());
+      server_.observe(peer_.robot_id, address_, env, true, monoNowUs());
       return true;
     case v1::Envelope::kEvent:
-      registry_.onEvent(robot_id_, serial_, env.event(), monoNowNs());
-      server_.observe(robot_id_, address_, env, true, monoNowUs());
+      registry_.onEvent(peer_.robot_id, serial_, env.event(), monoNowNs());
+      server_.observe(peer_.robot_id, address_, env, true, monoNowUs());
       if (server_.logEvents())
-        log::info(log::tag::kLink, "[", robot_id_, "] ", v1::Event::Kind_Name(env.event().kind()), ": ", env.event().text());
+        log::info(log::tag::kLink, "[", peer_.robot_id, "] ", v1::Event::Kind_Name(env.event().kind()), ": ", env.event().text());
       return true;
     case v1::Envelope::kAck:
-      registry_.onAck(robot_id_, serial_, env.ack());
-      server_.observe(robot_id_, address_, env, true, monoNowUs());
+      registry_.onAck(peer_.robot_id, serial_, env.ack());
+      server_.observe(peer_.robot_id, address_, env, true, monoNowUs());
       return true;
     case v1::Envelope::kHello:
       closeNow("protocol error: second Hello after the handshake", log::Level::kWarn);
@@ -230,8 +230,8 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
 
 void RobotSession::handleHello(const v1::Hello& hello) {
   if (const auto why = helloRejection(hello)) rejectHello(*why);
-  else if (stream_.tls() && hello.robot_id() != cert_name_)
-    rejectHello("robot id '" + hello.robot_id() + "' does not match its certificate (CN '" + cert_name_ +
+  else if (stream_.tls() && hello.robot_id() != peer_.cert_name)
+    rejectHello("robot id '" + hello.robot_id() + "' does not match its certificate (CN '" + peer_.cert_name +
                 "'): a robot may only connect as the id its certificate was made for");
   else acceptHello(hello);
 }
@@ -239,8 +239,8 @@ void RobotSession::handleHello(const v1::Hello& hello) {
 void RobotSession::rejectHello(const std::string& reason) {
   log::warn(log::tag::kLink, address_, ": handshake rejected: ", reason);
   handshake_timer_.cancel();
-  rejecting_ = true;
-  reject_reason_ = "handshake rejected: " + reason;
+  peer_.rejecting = true;
+  peer_.reject_reason = "handshake rejected: " + reason;
   v1::Envelope env;
   auto* r = env.mutable_hello_reply();
   r->set_accepted(false);
@@ -251,20 +251,20 @@ void RobotSession::rejectHello(const std::string& reason) {
   // Bound the linger: a robot that neither reads nor closes is dropped anyway.
   handshake_timer_.expires_after(kRejectLinger);
   handshake_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
-    if (!ec) self->closeNow(self->reject_reason_, log::Level::kDebug);
+    if (!ec) self->closeNow(self->peer_.reject_reason, log::Level::kDebug);
   });
 }
 
 void RobotSession::acceptHello(const v1::Hello& hello) {
   handshake_timer_.cancel();
-  accepted_ = true;
-  robot_id_ = hello.robot_id();
-  registry_.onConnected(robot_id_, address_, serial_, hello, monoNowNs());
+  peer_.accepted = true;
+  peer_.robot_id = hello.robot_id();
+  registry_.onConnected(peer_.robot_id, address_, serial_, hello, monoNowNs());
   std::string caps;
   for (const auto& c : hello.capabilities()) caps += (caps.empty() ? "" : ",") + c;
-  log::info(log::tag::kLink, robot_id_, " connected from ", address_, " (software '", hello.software_version(),
+  log::info(log::tag::kLink, peer_.robot_id, " connected from ", address_, " (software '", hello.software_version(),
             "', capabilities [", caps, "])");
-  server_.attach(robot_id_, shared_from_this());
+  server_.attach(peer_.robot_id, shared_from_this());
   if (closed_) return;
   v1::Envelope env;
   auto* r = env.mutable_hello_reply();
@@ -275,15 +275,15 @@ void RobotSession::acceptHello(const v1::Hello& hello) {
   heartbeat_timer_.expires_after(std::chrono::nanoseconds(0));
   armHeartbeat();
   armWatchdog();
-  last_telemetry_ = Clock::now();
+  live_.last_telemetry = Clock::now();
   if (config_.telemetry_stale_s > 0) armStaleCheck();
 }
 
 void RobotSession::armWatchdog() {
-  watchdog_timer_.expires_at(last_rx_ + seconds(config_.session_timeout_s));
+  watchdog_timer_.expires_at(live_.last_rx + seconds(config_.session_timeout_s));
   watchdog_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
     if (ec || self->closed_) return;
-    if (Clock::now() - self->last_rx_ >= seconds(self->config_.session_timeout_s)) {
+    if (Clock::now() - self->live_.last_rx >= seconds(self->config_.session_timeout_s)) {
       self->closeNow("nothing received for " + fmtShort(self->config_.session_timeout_s) +
                          " s (session timeout: robot gone or link half-open)",
                      log::Level::kWarn);
@@ -302,12 +302,12 @@ void RobotSession::armStaleCheck() {
   stale_timer_.expires_after(std::chrono::milliseconds(20));
   stale_timer_.async_wait([self = shared_from_this()](const error_code& ec) {
     if (ec || self->closed_) return;
-    const auto gap = Clock::now() - self->last_telemetry_;
-    if (!self->stale_stopped_ && (self->robot_moving_ || self->teleop_active_) &&
+    const auto gap = Clock::now() - self->live_.last_telemetry;
+    if (!self->live_.stale_stopped && (self->live_.robot_moving || self->teleop_.active) &&
         gap >= seconds(self->config_.telemetry_stale_s)) {
-      self->stale_stopped_ = true;
-      self->teleop_active_ = false;
-      ++self->teleop_generation_;
+      self->live_.stale_stopped = true;
+      self->teleop_.active = false;
+      ++self->teleop_.generation;
       self->teleop_timer_.cancel();
       const std::string why = "no telemetry for " + fmtShort(std::chrono::duration<double>(gap).count(), 2) +
                               " s while moving: EStop sent (the operator cannot see the robot; resume once it is "
@@ -320,7 +320,7 @@ void RobotSession::armStaleCheck() {
       v1::Event ev;  // shown on every console like the robot's own events
       ev.set_kind(v1::Event::FAULT_RAISED);
       ev.set_text("server: " + why);
-      self->registry_.onEvent(self->robot_id_, self->serial_, ev, monoNowNs());
+      self->registry_.onEvent(self->peer_.robot_id, self->serial_, ev, monoNowNs());
     }
     self->armStaleCheck();
   });
@@ -343,10 +343,10 @@ void RobotSession::armHeartbeat() {
 
 void RobotSession::armTeleop(uint64_t generation) {
   teleop_timer_.async_wait([self = shared_from_this(), generation](const error_code& ec) {
-    if (ec || self->closed_ || !self->teleop_active_ || generation != self->teleop_generation_) return;
+    if (ec || self->closed_ || !self->teleop_.active || generation != self->teleop_.generation) return;
     if (!self->server_.consoleResponsive()) {
       // The robot's own 300 ms deadman takes it from here.
-      self->teleop_active_ = false;
+      self->teleop_.active = false;
       log::warn(log::tag::kLink, self->who(), ": console unresponsive: teleop set-point cleared, re-send stopped");
       return;
     }
@@ -364,34 +364,34 @@ void RobotSession::sendTeleopNow(uint64_t id) {
   v1::Envelope env;
   auto* c = env.mutable_command();
   c->set_id(id);
-  c->mutable_teleop()->set_v_m_s(teleop_v_m_s_);
-  c->mutable_teleop()->set_w_rad_s(teleop_w_rad_s_);
+  c->mutable_teleop()->set_v_m_s(teleop_.v_m_s);
+  c->mutable_teleop()->set_w_rad_s(teleop_.w_rad_s);
   enqueue(env);
 }
 
 void RobotSession::enqueue(v1::Envelope& env) {
   if (closed_) return;
-  env.set_seq(++tx_seq_);
+  env.set_seq(++tx_.seq);
   env.set_send_time_us(monoNowUs());
   std::string frame;
   if (!net::appendDelimited(env, frame)) {
     log::error(log::tag::kLink, who(), ": cannot serialise an outgoing ", bodyName(env.body_case()));
     return;
   }
-  if (queued_bytes_ + frame.size() > kMaxQueuedBytes) {
+  if (tx_.bytes + frame.size() > kMaxQueuedBytes) {
     closeNow("more than " + std::to_string(kMaxQueuedBytes) + " bytes waiting to be sent: the robot is not reading",
              log::Level::kWarn);
     return;
   }
-  queued_bytes_ += frame.size();
-  if (accepted_ && env.has_command()) server_.observe(robot_id_, address_, env, false, env.send_time_us());
-  const bool idle = tx_queue_.empty();
-  tx_queue_.push_back(std::move(frame));
+  tx_.bytes += frame.size();
+  if (peer_.accepted && env.has_command()) server_.observe(peer_.robot_id, address_, env, false, env.send_time_us());
+  const bool idle = tx_.queue.empty();
+  tx_.queue.push_back(std::move(frame));
   if (idle) doWrite();
 }
 
 void RobotSession::doWrite() {
-  stream_.asyncWrite(asio::buffer(tx_queue_.front()),
+  stream_.asyncWrite(asio::buffer(tx_.queue.front()),
                     [self = shared_from_this()](const error_code& ec, std::size_t) { self->onWrite(ec); });
 }
 
@@ -401,11 +401,11 @@ void RobotSession::onWrite(const error_code& ec) {
     closeNow("write error: " + ec.message(), log::Level::kWarn);
     return;
   }
-  queued_bytes_ -= tx_queue_.front().size();
-  tx_queue_.pop_front();
-  if (!tx_queue_.empty()) {
+  tx_.bytes -= tx_.queue.front().size();
+  tx_.queue.pop_front();
+  if (!tx_.queue.empty()) {
     doWrite();
-  } else if (rejecting_) {
+  } else if (peer_.rejecting) {
     // The reply is out: half-close so the robot reads it and sees EOF; its close ends the linger.
     error_code ignored;
     stream_.socket().shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
@@ -415,7 +415,7 @@ void RobotSession::onWrite(const error_code& ec) {
 void RobotSession::closeNow(const std::string& reason, log::Level level) {
   if (closed_) return;
   closed_ = true;
-  teleop_active_ = false;
+  teleop_.active = false;
   log::logf(level, log::tag::kLink, who(), ": closed: ", reason);
   handshake_timer_.cancel();
   watchdog_timer_.cancel();
@@ -423,8 +423,8 @@ void RobotSession::closeNow(const std::string& reason, log::Level level) {
   teleop_timer_.cancel();
   stale_timer_.cancel();
   stream_.close();
-  if (accepted_) registry_.onDisconnected(robot_id_, serial_, reason, monoNowNs());
-  server_.detach(shared_from_this(), robot_id_);
+  if (peer_.accepted) registry_.onDisconnected(peer_.robot_id, serial_, reason, monoNowNs());
+  server_.detach(shared_from_this(), peer_.robot_id);
 }
 
 }  // namespace inspect::server

@@ -56,7 +56,7 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   /// Peer "ip:port" (fixed at construction).
   const std::string& address() const { return address_; }
   /// The common name of the robot's verified certificate ("" before the TLS handshake or in plaintext).
-  const std::string& certificateName() const { return cert_name_; }
+  const std::string& certificateName() const { return peer_.cert_name; }
 
  private:
   void doRead();
@@ -93,25 +93,34 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
 
   net::DelimitedDecoder decoder_;
   std::array<char, 16 * 1024> rx_buf_{};
-  std::deque<std::string> tx_queue_;
-  std::size_t queued_bytes_ = 0;
-  uint64_t tx_seq_ = 0;
+  struct Outbox {
+    std::deque<std::string> queue;
+    std::size_t bytes = 0;  // queued, not yet written
+    uint64_t seq = 0;       // Envelope.seq of the last message queued
+  } tx_;
 
-  std::string cert_name_;        // CN of the robot's certificate, after the TLS handshake
-  std::string robot_id_;         // set by an accepted Hello
-  bool accepted_ = false;
-  bool rejecting_ = false;       // HelloReply{accepted=false} queued; close once sent
-  std::string reject_reason_;
+  struct Peer {
+    std::string cert_name;      // CN of the robot's certificate, after the TLS handshake
+    std::string robot_id;       // set by an accepted Hello
+    bool accepted = false;
+    bool rejecting = false;     // HelloReply{accepted=false} queued; close once sent
+    std::string reject_reason;
+  } peer_;
   bool closed_ = false;
-  Clock::time_point last_rx_;
-  Clock::time_point last_telemetry_;
-  bool robot_moving_ = false;    // its last telemetry: a moving mode or a non-zero command
-  bool stale_stopped_ = false;   // an EStop went out for the current telemetry gap
 
-  bool teleop_active_ = false;
-  double teleop_v_m_s_ = 0;
-  double teleop_w_rad_s_ = 0;
-  uint64_t teleop_generation_ = 0;  // bumps on every change, so stale timer chains end
+  struct Liveness {
+    Clock::time_point last_rx;
+    Clock::time_point last_telemetry;
+    bool robot_moving = false;   // its last telemetry: a moving mode or a non-zero command
+    bool stale_stopped = false;  // an EStop went out for the current telemetry gap
+  } live_;
+
+  struct Setpoint {  // the teleop set-point being re-sent
+    bool active = false;
+    double v_m_s = 0;
+    double w_rad_s = 0;
+    uint64_t generation = 0;  // bumps on every change, so stale timer chains end
+  } teleop_;
 };
 
 }  // namespace inspect::server
