@@ -1,21 +1,10 @@
 #pragma once
 // The fake robot, scripted: one test drives it message by message (the server's
-// link, TLS and console tests). A blocking POSIX socket with TLS on top
-// (OpenSSL directly, with the certificate of the robot id it says Hello with,
-// from tests/support/test_certs.hpp), the shared delimited framing and an optional
-// background pump (heartbeats, telemetry, automatic Acks). Every wait is
-// bounded in time.
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <sys/time.h>
-#include <unistd.h>
-
-#include <openssl/err.h>
-#include <openssl/ssl.h>
-
+// link, TLS and console tests). On the fake robot's wire (tls_socket.hpp:
+// blocking, TLS by OpenSSL directly) with the certificate of the robot id it
+// says Hello with (tests/support/test_certs.hpp), the shared delimited framing
+// and an optional background pump (heartbeats, telemetry, automatic Acks).
+// Every wait is bounded in time.
 #include <atomic>
 #include <csignal>
 #include <chrono>
@@ -32,6 +21,7 @@
 #include "shared/net/link_version.hpp"
 #include "shared/net/robot_id.hpp"
 #include "tests/support/fake_robot/robot_messages.hpp"
+#include "tests/support/fake_robot/tls_socket.hpp"
 #include "tests/support/test_certs.hpp"
 
 namespace inspect::test {
@@ -64,22 +54,7 @@ class ScriptedRobot {
 
   /// TCP connect; the TLS handshake follows with the first send (with the
   /// certificate of the Hello's robot id, else of `cert_id_` = "robot1").
-  bool connect(uint16_t port) {
-    fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    if (fd_ < 0) return false;
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) return false;
-    int one = 1;
-    ::setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    // Bounds every blocking read/write (the TLS handshake included).
-    timeval tv{2, 0};
-    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    ::setsockopt(fd_, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
-    return true;
-  }
+  bool connect(uint16_t port) { return sock_.connect(port, 2.0); }
 
   /// The TLS handshake now, presenting the certificate made for `cert_id`; false
   /// (with tlsError()) if it failed. Called by the first send when not done yet.
@@ -92,16 +67,11 @@ class ScriptedRobot {
   std::string cert_id_ = "robot1";
 
   /// Half-close: the server reads EOF (no reset), the robot can still read.
-  void shutdownWrite() { ::shutdown(fd_, SHUT_WR); }
+  void shutdownWrite() { sock_.shutdownWrite(); }
 
   void close() {
     std::lock_guard lk(tx_mu_);
-    if (ssl_) SSL_free(ssl_);
-    ssl_ = nullptr;
-    if (ctx_) SSL_CTX_free(ctx_);
-    ctx_ = nullptr;
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = -1;
+    sock_.close();
   }
 
   /// Bytes on the link (inside TLS unless plaintext), after the handshake.
@@ -183,52 +153,25 @@ class ScriptedRobot {
  private:
   bool sendRawAs(const std::string& bytes, const std::string& cert_id) {
     std::lock_guard lk(tx_mu_);
-    if (fd_ < 0 || !handshakeLocked(cert_id)) return false;
-    std::size_t off = 0;
-    while (off < bytes.size()) {
-      if (ssl_) {
-        const int n = SSL_write(ssl_, bytes.data() + off, static_cast<int>(bytes.size() - off));
-        if (n <= 0) return false;
-        off += static_cast<std::size_t>(n);
-      } else {
-        const auto n = ::send(fd_, bytes.data() + off, bytes.size() - off, MSG_NOSIGNAL);
-        if (n <= 0) return false;
-        off += static_cast<std::size_t>(n);
-      }
-    }
-    return true;
+    if (sock_.fd() < 0 || !handshakeLocked(cert_id)) return false;
+    return sock_.write(bytes);
   }
 
   bool handshakeLocked(const std::string& cert_id) {
-    if (mode_ == Mode::kPlaintext || ssl_) return true;
-    if (fd_ < 0 || !tls_error_.empty()) return false;
+    if (mode_ == Mode::kPlaintext || sock_.tls()) return true;
+    if (sock_.fd() < 0 || !tls_error_.empty()) return false;
     const std::string dir = certs_dir_.empty() ? testCertsDir({cert_id}) : certs_dir_;
-    const std::string ca = dir + "/ca.pem", cert = dir + "/" + cert_id + ".pem", key = dir + "/" + cert_id + ".key";
-    ctx_ = SSL_CTX_new(TLS_client_method());
-    SSL_CTX_set_verify(ctx_, SSL_VERIFY_PEER, nullptr);
-    if (SSL_CTX_load_verify_locations(ctx_, ca.c_str(), nullptr) != 1 ||
-        (mode_ == Mode::kTls && (SSL_CTX_use_certificate_chain_file(ctx_, cert.c_str()) != 1 ||
-                                 SSL_CTX_use_PrivateKey_file(ctx_, key.c_str(), SSL_FILETYPE_PEM) != 1))) {
-      tls_error_ = "cannot load " + cert + " / " + key + " / " + ca;
-      return false;
-    }
-    ssl_ = SSL_new(ctx_);
-    SSL_set_fd(ssl_, fd_);
-    if (SSL_connect(ssl_) != 1) {
-      char buf[256];
-      ERR_error_string_n(ERR_get_error(), buf, sizeof buf);
-      tls_error_ = std::string("TLS handshake failed: ") + buf;
-      ERR_clear_error();
-      SSL_free(ssl_);
-      ssl_ = nullptr;
-      peer_closed_ = true;
-      return false;
-    }
-    return true;
+    const bool with_cert = mode_ == Mode::kTls;
+    if (sock_.handshake(dir + "/ca.pem", with_cert ? dir + "/" + cert_id + ".pem" : "",
+                        with_cert ? dir + "/" + cert_id + ".key" : ""))
+      return true;
+    tls_error_ = sock_.error();
+    peer_closed_ = peer_closed_ || sock_.closed();
+    return false;
   }
 
   bool readSome(Clock::time_point deadline) {
-    if (fd_ < 0 || peer_closed_) return false;
+    if (sock_.fd() < 0 || peer_closed_) return false;
     if (mode_ != Mode::kPlaintext) {
       std::lock_guard lk(tx_mu_);
       if (!handshakeLocked(cert_id_)) return false;
@@ -236,34 +179,19 @@ class ScriptedRobot {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
     if (left <= 0) return false;
     char buf[8192];
-    if (ssl_) {
-      std::unique_lock lk(tx_mu_);
-      if (SSL_pending(ssl_) == 0) {
-        lk.unlock();
-        pollfd p{fd_, POLLIN, 0};
-        if (::poll(&p, 1, static_cast<int>(left)) <= 0) return false;
-        lk.lock();
-      }
-      if (!ssl_) return false;
-      const int n = SSL_read(ssl_, buf, sizeof buf);
-      if (n <= 0) {
-        const int err = SSL_get_error(ssl_, n);
-        ERR_clear_error();
-        if (err == SSL_ERROR_WANT_READ || err == SSL_ERROR_WANT_WRITE) return true;  // a TLS record without data
-        peer_closed_ = true;
-        return false;
-      }
-      decoder_.append(buf, static_cast<std::size_t>(n));
-      return true;
+    std::unique_lock lk(tx_mu_);
+    if (!sock_.pending()) {
+      lk.unlock();  // a sender may write meanwhile
+      if (!sock_.waitReadable(static_cast<int>(left))) return false;
+      lk.lock();
     }
-    pollfd p{fd_, POLLIN, 0};
-    if (::poll(&p, 1, static_cast<int>(left)) <= 0) return false;
-    const auto n = ::recv(fd_, buf, sizeof buf, 0);
-    if (n <= 0) {
+    std::size_t got = 0;
+    const auto r = sock_.read(buf, sizeof buf, got);
+    if (r == TlsSocket::Read::kClosed) {
       peer_closed_ = true;
       return false;
     }
-    decoder_.append(buf, static_cast<std::size_t>(n));
+    decoder_.append(buf, got);
     return true;
   }
 
@@ -307,10 +235,8 @@ class ScriptedRobot {
 
   Mode mode_ = Mode::kTls;
   std::string certs_dir_;
-  SSL_CTX* ctx_ = nullptr;
-  SSL* ssl_ = nullptr;
+  TlsSocket sock_;
   std::string tls_error_;
-  int fd_ = -1;
   net::DelimitedDecoder decoder_;
   std::atomic<bool> peer_closed_{false};
   std::atomic<uint64_t> tx_seq_{0};
