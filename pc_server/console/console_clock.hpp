@@ -3,7 +3,7 @@
 // within` and Acks; the registry's snapshot ages) and the way it waits.
 // pc_server runs it on CLOCK_MONOTONIC with sleeps that a stop request
 // interrupts; the console's tests run it on a clock they advance themselves
-// (tests/pc_server/manual_clock.hpp), so that `wait 10` takes no time and an
+// (tests/pc_server/console/manual_clock.hpp), so that `wait 10` takes no time and an
 // expect's timeout is exact, on any machine. Acks are waited for on the
 // registry's WakeSignal: the console wakes when one arrives, not by polling.
 #include <algorithm>

@@ -11,7 +11,7 @@
 #include "pc_server/app/server_config.hpp"
 #include "robot_client/client_config.hpp"
 #include "robot_client/server_link.hpp"
-#include "server_fixture.hpp"
+#include "tests/pc_server/server_fixture.hpp"
 
 namespace inspect::test {
 namespace {

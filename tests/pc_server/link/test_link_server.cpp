@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "server_fixture.hpp"
+#include "tests/pc_server/server_fixture.hpp"
 
 using namespace inspect;
 using namespace inspect::test;

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "pc_server/console/console.hpp"
-#include "server_fixture.hpp"
+#include "tests/pc_server/server_fixture.hpp"
 
 namespace inspect::test {
 namespace {

@@ -21,7 +21,7 @@
 #include "pc_server/console/route_file.hpp"
 #include "pc_server/console/status_line.hpp"
 #include "shared/util/clock.hpp"
-#include "tests/pc_server/manual_clock.hpp"
+#include "tests/pc_server/console/manual_clock.hpp"
 #include "tests/support/paths.hpp"
 
 using namespace inspect;
