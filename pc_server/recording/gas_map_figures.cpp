@@ -10,6 +10,7 @@
 #include "pc_server/console/text_util.hpp"
 #include "pc_server/recording/run_stats.hpp"
 #include "shared/util/gnuplot.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::server::report {
 namespace fs = std::filesystem;
@@ -37,11 +38,7 @@ unsigned mapColor(double frac) {
   return kMapStops[0].second;
 }
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+std::string num(double v) { return util::significant(v, 6); }
 
 // Everything one gas map shows.
 struct GasMapFigure {

@@ -5,14 +5,11 @@
 #include <tuple>
 
 #include "pc_server/console/text_util.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::server::report {
 
-std::string gasValue(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
+std::string gasValue(double v) { return util::significant(v, 4); }
 
 
 // Channel descriptions and NaN-free figures for every gas slot seen in the telemetry.

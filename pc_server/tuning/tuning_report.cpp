@@ -15,6 +15,7 @@
 #include "shared/config/gains_file.hpp"
 #include "shared/util/file_util.hpp"
 #include "shared/util/gnuplot.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::tuning {
 
@@ -42,11 +43,7 @@ std::string fmtOrNotConverged(double v, int decimals) {
   return b;
 }
 
-std::string fmtG(double v) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
+std::string fmtG(double v) { return util::significant(v, 6); }
 
 Json numberOrNull(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 

@@ -9,6 +9,7 @@
 #include "shared/config/config_node.hpp"
 #include "shared/fuzzy/fis_error.hpp"
 #include "shared/fuzzy/fis_reader.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::behavior {
 namespace {
@@ -18,11 +19,7 @@ constexpr std::array<std::size_t, 3> kTermCounts{4, 2, 4};
 // Points at which the stop zone [0, sensitive] is sampled when the strategy is built.
 constexpr int kStopZoneSamples = 400;
 
-std::string num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+std::string num(double v) { return util::significant(v, 6); }
 
 [[noreturn]] void fisFail(const fuzzy::Fis& fis, const std::string& why) {
   throw fuzzy::FisError("fis '" + fis.name + "': speed strategy: " + why);

@@ -1,4 +1,5 @@
 #include "shared/config/config_node.hpp"
+#include "shared/util/number_text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,12 +9,7 @@
 namespace inspect::config {
 
 namespace {
-std::string fmtNum(double v) {
-  std::ostringstream os;
-  os.precision(12);  // ranges like [1024, 67108864] print exactly
-  os << v;
-  return os.str();
-}
+std::string fmtNum(double v) { return util::significant(v, 12); }  // ranges like [1024, 67108864] print exactly
 }  // namespace
 
 ConfigNode ConfigNode::loadFile(const std::string& path) {

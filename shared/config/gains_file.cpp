@@ -12,6 +12,7 @@
 #include "shared/fuzzy/fis_reader.hpp"
 #include "shared/fuzzy/fis_writer.hpp"
 #include "shared/util/file_util.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::config {
 
@@ -23,9 +24,7 @@ namespace fs = std::filesystem;
 std::string num(double v) {
   if (std::isnan(v)) return ".nan";
   if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
-  char buf[64];
-  const auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return ec == std::errc() ? std::string(buf, p) : ".nan";
+  return util::shortest(v);
 }
 
 // What each key is, for the file's readers (same order as control::kGainNames).

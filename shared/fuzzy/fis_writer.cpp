@@ -5,18 +5,14 @@
 #include <sstream>
 
 #include "shared/fuzzy/fis_error.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::fuzzy {
 
 namespace {
 
 // Shortest text that reads back to the same double.
-std::string num(double v) {
-  char buf[64];
-  auto [p, ec] = std::to_chars(buf, buf + sizeof(buf), v);
-  if (ec != std::errc()) return "nan";
-  return std::string(buf, p);
-}
+std::string num(double v) { return util::shortest(v); }
 
 void writeVariable(std::ostream& os, const char* kind, std::size_t index, const Variable& v) {
   os << '[' << kind << index + 1 << "]\n";

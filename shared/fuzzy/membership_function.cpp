@@ -1,4 +1,5 @@
 #include "shared/fuzzy/membership_function.hpp"
+#include "shared/util/number_text.hpp"
 
 #include <array>
 #include <cmath>
@@ -62,13 +63,7 @@ double zShape(double a, double b, double x) noexcept {
   return 2.0 * t * t;
 }
 
-std::string fmt(double v) {
-  std::string s = std::to_string(v);
-  // Trim the trailing zeros std::to_string leaves.
-  while (s.size() > 1 && s.back() == '0') s.pop_back();
-  if (!s.empty() && s.back() == '.') s.pop_back();
-  return s;
-}
+std::string fmt(double v) { return util::fmtShort(v, 6); }
 
 }  // namespace
 

@@ -1,4 +1,5 @@
 #include "shared/gas/leak_estimator.hpp"
+#include "shared/util/number_text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -218,11 +219,7 @@ double noiseSd(const std::vector<GasSample>& s) {
 }
 
 // A number for a message: 3 significant digits.
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string num(double v) { return util::significant(v, 3); }
 
 // Which candidate positions may hold the source: inside the bounds, within
 // reach of the path, and (with walls) in line of sight of one of the nearest

@@ -1,4 +1,5 @@
 #include "shared/util/cli_args.hpp"
+#include "shared/util/number_text.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -11,9 +12,7 @@ namespace {
 std::string bound(double v) {
   if (v >= std::numeric_limits<double>::max()) return "inf";
   if (v <= -std::numeric_limits<double>::max()) return "-inf";
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
+  return util::significant(v, 6);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "shared/util/number_text.hpp"
 
+#include <charconv>
 #include <cstdio>
 #include <iomanip>
 #include <sstream>
@@ -33,6 +34,12 @@ std::string significant(double v, int digits) {
   std::ostringstream os;
   os << std::setprecision(digits) << v;
   return os.str();
+}
+
+std::string shortest(double v) {
+  char buf[64];
+  const auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, p) : "nan";
 }
 
 std::string fmtPoint(double x_m, double y_m) { return "(" + fmtFixed(x_m) + ", " + fmtFixed(y_m) + ")"; }

@@ -13,6 +13,8 @@ std::string fmtSigned(double v, int decimals = 2);
 std::string fmtShort(double v, int decimals = 3);
 /// `v` with `digits` significant digits, as an ostream writes it ("0.2", "1.5e-05").
 std::string significant(double v, int digits);
+/// The shortest text that reads back as exactly `v` ("0.1", "1e-05", "nan"): for files written to be read again.
+std::string shortest(double v);
 /// A point in metres for messages: "(1.25, -0.50)".
 std::string fmtPoint(double x_m, double y_m);
 
