@@ -94,10 +94,10 @@ int main(int argc, char** argv) {
       } else if (a.is("--version")) {
         std::printf("robot_client %s\n", INSPECT_VERSION);
         return 0;
-      } else if (a.is("--config")) config_path = a.path();
-      else if (a.is("--robot-config")) robot_path = a.path();
-      else if (a.is("--control-config")) control_path = a.path();
-      else if (a.is("--behavior-config")) behavior_path = a.path();
+      } else if (a.is("--config")) config_path = a.text();  // "": built-in defaults
+      else if (a.is("--robot-config")) robot_path = a.text();
+      else if (a.is("--control-config")) control_path = a.text();
+      else if (a.is("--behavior-config")) behavior_path = a.text();  // "": people awareness off
       else if (a.is("--serial")) serial_dev = a.path();
       else if (a.is("--server")) server = a.path();
       else if (a.is("--id")) id = a.path();

@@ -82,7 +82,7 @@ class ServerLink {
   uint64_t next_seq_ = 1;
   struct Counts {
     uint64_t connects = 0;
-    uint64_t dropped = 0;  // envelopes not queued: link down or queue full
+    uint64_t dropped = 0;  // envelopes not queued because the send queue was full (none are counted while the link is down)
   } counts_;
   uint64_t generation_ = 0;
   int64_t last_rx_ns_ = 0;

@@ -312,10 +312,12 @@ std::vector<int> parseThreads(cli::ArgReader& a) {
   return out;
 }
 
-void parseArgs(int argc, char** argv, Options& o, bool& help) {
+void parseArgs(int argc, char** argv, Options& o) {
   cli::readOrExit("bench_video", argc, argv, [&](cli::ArgReader& a) {
-    if (a.isHelp()) help = true;
-    else if (a.is("--seconds")) o.seconds = a.numberAbove(0, 3600);
+    if (a.isHelp()) {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (a.is("--seconds")) o.seconds = a.numberAbove(0, 3600);
     else if (a.is("--warmup")) o.warmup = a.number(0, 60);
     else if (a.is("--fps")) o.fps = a.numberAbove(0, 120);
     else if (a.is("--bitrate-kbps")) o.bitrate_kbps = static_cast<int>(a.integer(50, 50000));
@@ -335,12 +337,7 @@ void parseArgs(int argc, char** argv, Options& o, bool& help) {
 int main(int argc, char** argv) {
   using namespace inspect::bench_video;
   Options o;
-  bool help = false;
-  parseArgs(argc, argv, o, help);
-  if (help) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
+  parseArgs(argc, argv, o);
   try {
     if (o.role == "receiver") return receiverRole(o);
     if (o.role == "sender") return senderRole(o);

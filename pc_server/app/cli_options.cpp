@@ -7,7 +7,9 @@ namespace inspect::server {
 CliOptions parseCli(const std::vector<std::string>& args) {
   CliOptions o;
   cli::ArgReader a(args);
+  int flags = 0;
   while (a.next()) {
+    ++flags;
     if (a.isHelp()) o.help = true;
     else if (a.is("--config")) o.config_path = a.path();
     else if (a.is("--bind")) {
@@ -30,7 +32,7 @@ CliOptions parseCli(const std::vector<std::string>& args) {
     else if (a.is("--no-console")) o.no_console = true;
     else a.unknown();
   }
-  if (o.attach && args.size() != 2)
+  if (o.attach && flags != 1)
     throw cli::UsageError("--attach PATH takes no other flags (it only connects to a running server's operator socket)");
   if (o.plaintext && o.certs_dir) throw cli::UsageError("--plaintext cannot be combined with --certs");
   if (o.no_console && (o.script_path || o.interactive))

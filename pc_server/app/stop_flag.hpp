@@ -5,6 +5,9 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <vector>
+
+#include "pc_server/link/wake_signal.hpp"
 
 namespace inspect::server {
 
@@ -34,6 +37,9 @@ class StopFlag {
     t->store(true);
     return true;
   }
+  /// Waits on `signal` (WakeSignal::waitChange from generation `seen`, at
+  /// most `timeout`) that request() also ends: false when the stop was requested.
+  bool waitChange(WakeSignal& signal, uint64_t seen, std::chrono::steady_clock::duration timeout);
   /// A descriptor that becomes readable once the stop is requested (for poll()).
   int wakeFd() const { return pipe_[0]; }
 
@@ -42,6 +48,7 @@ class StopFlag {
   std::atomic<std::atomic<bool>*> interrupt_target_{nullptr};
   std::mutex mu_;
   std::condition_variable cv_;
+  std::vector<WakeSignal*> waiting_;  // signals being waited on in waitChange (mu_)
   int pipe_[2] = {-1, -1};
 };
 

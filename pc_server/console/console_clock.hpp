@@ -6,7 +6,6 @@
 // (tests/pc_server/console/manual_clock.hpp), so that `wait 10` takes no time and an
 // expect's timeout is exact, on any machine. Acks are waited for on the
 // registry's WakeSignal: the console wakes when one arrives, not by polling.
-#include <algorithm>
 #include <cstdint>
 
 #include "pc_server/app/stop_flag.hpp"
@@ -34,15 +33,7 @@ class SteadyConsoleClock final : public ConsoleClock {
   int64_t nowNs() override { return monoNowNs(); }
   bool sleep(double seconds) override { return stop_.sleepFor(steadyDuration(seconds)); }
   bool waitSignal(double seconds, WakeSignal& signal, uint64_t seen) override {
-    // The stop is seen within kStopCheck_s (it has no way into the signal).
-    constexpr double kStopCheck_s = 0.05;
-    const int64_t deadline = monoNowNs() + static_cast<int64_t>(seconds * 1e9);
-    for (;;) {
-      if (stop_.requested()) return false;
-      const double left_s = static_cast<double>(deadline - monoNowNs()) * 1e-9;
-      if (left_s <= 0 || signal.waitChange(seen, steadyDuration(std::min(left_s, kStopCheck_s)))) break;
-    }
-    return !stop_.requested();
+    return stop_.waitChange(signal, seen, steadyDuration(seconds));  // a stop request ends it at once
   }
 
  private:

@@ -32,7 +32,7 @@ struct LeakOptions {
   double min_duration_s = 5.0;          // less data than this: not estimated
   double min_path_m = 1.0;              // a shorter path cannot locate anything
   double min_radius_m = 0.5;            // floor of radius95 (airflow skew, odometry drift, inlet offset)
-  std::vector<geometry::Segment> walls;  // walls and obstacle edges (same frame as the samples);       // a candidate must be in line of sight of the path
+  std::vector<geometry::Segment> walls;  // walls and obstacle edges (same frame as the samples): a candidate must be in line of sight of the path
   bool reflect_walls = false;           // walls reflect the plume: image sources (method of images)
   double image_max_m = 1.5;             // only walls this close to a candidate make an image
   // With walls (a site map): sources are searched only within this distance

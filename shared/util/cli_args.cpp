@@ -83,6 +83,16 @@ int64_t ArgReader::integer(int64_t min, int64_t max) {
   return n;
 }
 
+uint64_t ArgReader::unsignedInteger(uint64_t max) {
+  const std::string v = text();
+  uint64_t n = 0;
+  const char* end = v.data() + v.size();
+  const auto [p, ec] = std::from_chars(v.data(), end, n);
+  if (v.empty() || ec != std::errc() || p != end || n > max)
+    fail("'" + v + "' is not a whole number in [0, " + std::to_string(max) + "]");
+  return n;
+}
+
 uint16_t ArgReader::port() {
   const std::string v = text();
   int64_t n = 0;

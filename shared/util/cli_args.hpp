@@ -65,6 +65,8 @@ class ArgReader {
   double numberAbove(double min, double max = std::numeric_limits<double>::max());
   /// A whole number in [min, max] ("--seed: '-3' is not a whole number in [0, 4294967295]").
   int64_t integer(int64_t min, int64_t max);
+  /// A whole number in [0, max], up to 2^64 - 1 (seeds).
+  uint64_t unsignedInteger(uint64_t max = std::numeric_limits<uint64_t>::max());
   /// A port number 0-65535.
   uint16_t port();
   /// One of `choices` ("--plant: 'x' is not one of nominal, worn").

@@ -1,6 +1,5 @@
 #include "sim/mcu_sim/sim_options.hpp"
 
-#include <limits>
 
 namespace inspect::sim {
 
@@ -37,7 +36,7 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     else if (a.is("--people-wait-motion")) o.people_wait_motion = true;
     else if (a.is("--rate")) o.rate = a.number(0.1, 100.0);
     else if (a.is("--duration")) o.duration_s = a.numberAbove(0.0, 1e6);
-    else if (a.is("--seed")) o.seed = static_cast<uint64_t>(a.integer(0, std::numeric_limits<int64_t>::max()));
+    else if (a.is("--seed")) o.seed = a.unsignedInteger();
     else a.unknown();
   }
   if (!o.help && (!have_world || o.world_path.empty())) throw cli::UsageError("--world: required");

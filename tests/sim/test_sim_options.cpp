@@ -39,6 +39,7 @@ TEST(SimOptions, AllFlags) {
   EXPECT_DOUBLE_EQ(o.rate, 5.0);
   EXPECT_DOUBLE_EQ(*o.duration_s, 3.0);
   EXPECT_EQ(o.seed, 77u);
+  EXPECT_EQ(parseSimOptions({"--world", "w", "--seed", "18446744073709551615"}).seed, 18446744073709551615ull);
 }
 
 TEST(SimOptions, HelpNeedsNoWorld) { EXPECT_TRUE(parseSimOptions({"--help"}).help); }

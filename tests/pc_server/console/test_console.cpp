@@ -269,6 +269,19 @@ TEST_F(ConsoleTest, AnAckWakesTheConsoleWhenItArrives) {
   EXPECT_EQ(clock_.sleeps(), 6);  // five 50 ms waits, then the one the Ack ended
 }
 
+TEST(WakeSignal, AStopRequestEndsTheWait) {
+  // Without the stop's wake-up this wait would last an hour (the test's timeout fails it first).
+  StopFlag stop;
+  WakeSignal s;
+  std::thread t([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    stop.request();
+  });
+  EXPECT_FALSE(stop.waitChange(s, s.generation(), std::chrono::hours(1)));
+  t.join();
+  EXPECT_FALSE(stop.waitChange(s, s.generation(), std::chrono::hours(1)));  // already stopped: at once
+}
+
 TEST(WakeSignal, NoLostWakeUp) {
   WakeSignal s;
   const uint64_t seen = s.generation();

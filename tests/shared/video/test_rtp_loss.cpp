@@ -1,5 +1,5 @@
 // The RTP layer over real UDP sockets on loopback through the test-only relay
-// (tests/tools/udp_relay) with loss, reordering and duplication: the receiver
+// (tests/support/udp_relay.cpp) with loss, reordering and duplication: the receiver
 // never hangs, never passes a damaged frame on, and recovers at the next
 // keyframe. Prints, per condition, frames delivered, keyframe requests per
 // minute and frames until a clean picture after a loss.

@@ -1,6 +1,6 @@
 // The whole camera path with the real codec on loopback: VideoSender
 // (synthetic source, libx264, RTP over UDP) -> optionally the test-only relay
-// (tests/tools/udp_relay) with loss, reordering and bursts -> VideoReceiver
+// (tests/support/udp_relay.cpp) with loss, reordering and bursts -> VideoReceiver
 // (reorder, reassemble, decode). Every decoded picture's time code is read
 // back: a picture whose code does not read is a damaged picture passed on.
 // Prints, per condition, frames sent / decoded / skipped, keyframe requests
