@@ -3,7 +3,7 @@
 // a world file, in the robot's odometry frame.
 #include <vector>
 
-#include "shared/behavior/human_tracker.hpp"
+#include "shared/geometry/segment.hpp"
 #include "shared/world/world.hpp"
 
 namespace inspect::world {
