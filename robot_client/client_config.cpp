@@ -54,7 +54,7 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   auto& vp = c.video;
   vp.enabled = v.boolean("enabled", vp.enabled);
   vp.source = v.string("source", vp.source);
-  if (vp.source.empty()) v.fail("source", "must not be empty (\"synthetic\", \"v4l2:/dev/videoN\" or \"file:PATH\")");
+  if (vp.source.empty()) v.fail("source", "must not be empty (\"synthetic\", \"v4l2:/dev/videoN\", \"file:PATH\" or \"sim:PATH\")");
   vp.width = static_cast<int>(v.integer("width", vp.width, 64, 4096));
   vp.height = static_cast<int>(v.integer("height", vp.height, 64, 4096));
   if (vp.width % 2 || vp.height % 2) v.fail("width", "width and height must be even (4:2:0 video)");

@@ -10,7 +10,7 @@ namespace inspect::client {
 /// Camera stream (docs/video.md); becomes video::SenderSettings.
 struct VideoParams {
   bool enabled = true;
-  std::string source = "synthetic";  // "synthetic", "v4l2:/dev/videoN", "file:PATH"
+  std::string source = "synthetic";  // "synthetic", "v4l2:/dev/videoN", "file:PATH", "sim:PATH"
   int width = 640;
   int height = 480;
   double fps = 30.0;

@@ -53,7 +53,8 @@ options:
                        (isolated test benches only; the server needs --plaintext too)
   --cmd-log FILE       write every wheel command sent to the MCU (CSV; for tests)
   --video-source URI   camera stream source (overrides video.source): synthetic,
-                       v4l2:/dev/videoN or file:PATH
+                       v4l2:/dev/videoN, file:PATH or sim:PATH (the simulated
+                       camera of mcu_sim --camera PATH)
   --video-port PORT    UDP port of the server's video receiver (overrides video.port)
   --no-video           do not stream video (overrides video.enabled)
   --version            print the version and exit

@@ -4,21 +4,32 @@
 # pc_server on loopback running scripts/demo/gas_inspection.console (a
 # recorded gas inspection round, alarms, report), then prints what happened.
 #
-#   scripts/run_demo.sh [--interactive|--batch] [--port N] [--tuning] [--out DIR]
+#   scripts/run_demo.sh [--interactive|--batch] [--port N] [--foxglove-port N] [--tuning] [--out DIR]
 #
 # --tuning runs the fuzzy-PID tuning job instead (scripts/demo/tuning.console
 # on config/worlds/tuning_floor.yaml, whose robot has worn, slower motors):
 # identification wheel test, identify, circle with the paper's gains, tune,
 # push the tuned gains, circle again (docs/tuning.md).
 #
+# The robot's camera is mcu_sim's (--camera): the simulated world as the PTZ
+# camera on the robot sees it, handed to robot_client (--video-source sim:...)
+# through a frame slot in /dev/shm (docs/video.md), so the operator's video
+# and the recorded runs/<id>/video.mp4 show the world the robot is in.
+#
+# Watch it live in Foxglove or Lichtblick: the demo prints the bridge's URL
+# with its token (ws://127.0.0.1:8765/?token=..., loopback, no TLS;
+# docs/foxglove.md); import config/foxglove/inspect_live.json as the layout.
+#
 # --interactive (default when stdin is a terminal) leaves you in the console
 # after the script; --batch exits when the script ends. --port 0 picks a free
-# port (the default is 7600). --out DIR keeps the logs, ground truth, runs and
+# port for the robot link and the Foxglove bridge (the defaults are 7600 and
+# 8765; --foxglove-port N sets the bridge's alone). --out DIR keeps the logs, ground truth, runs and
 # video there (default: a new folder under $TMPDIR); the demo's test reads them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${BUILD_DIR:-build}/bin
 PORT=7600
+FOX_PORT=
 MODE=auto
 JOB=gas
 OUT=
@@ -27,22 +38,27 @@ while [ $# -gt 0 ]; do
     --interactive) MODE=interactive ;;
     --batch) MODE=batch ;;
     --port) PORT=$2; shift ;;
+    --foxglove-port) FOX_PORT=$2; shift ;;
     --tuning) JOB=tuning ;;
     --out) OUT=${2:?--out needs a folder}; shift ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
     *) echo "run_demo: unknown option $1" >&2; exit 2 ;;
   esac
   shift
 done
+if [ -z "$FOX_PORT" ]; then if [ "$PORT" = 0 ]; then FOX_PORT=0; else FOX_PORT=8765; fi; fi
 if [ "$MODE" = auto ]; then
   if [ -t 0 ] && [ -t 1 ]; then MODE=interactive; else MODE=batch; fi
 fi
 
 if [ -n "${OUT:-}" ]; then mkdir -p "$OUT"; else OUT=$(mktemp -d "${TMPDIR:-/tmp}/inspect-demo-XXXXXX"); fi
+# The camera's frame slot: in memory when /dev/shm is there (mcu_sim removes it at its end).
+if [ -d /dev/shm ] && [ -w /dev/shm ]; then CAM=/dev/shm/inspect-demo-$$.camera; else CAM=$OUT/camera.slot; fi
 PIDS=()
 cleanup() {
   for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
+  rm -f "$CAM"
 }
 trap cleanup EXIT
 
@@ -54,7 +70,7 @@ if [ "$JOB" = tuning ]; then
 else
   WORLD=config/worlds/gas_lab.yaml; SCRIPT=scripts/demo/gas_inspection.console; SIM_ARGS=(--people-wait-motion)
 fi
-"$BIN/mcu_sim" --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" \
+"$BIN/mcu_sim" --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
   --pty-link "$OUT/mcu" --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
 SIM=$!
 PIDS+=("$SIM")
@@ -67,7 +83,7 @@ head -n 1 "$OUT/mcu_sim.out"
   for _ in $(seq 200); do [ -s "$OUT/port" ] && [ -s "$OUT/video_port" ] && break; sleep 0.05; done
   exec "$BIN/robot_client" --config config/client.yaml --robot-config config/robot.yaml \
     --serial "$OUT/mcu" --server "127.0.0.1:$(cat "$OUT/port")" --video-port "$(cat "$OUT/video_port")" \
-    --map "$WORLD" --id robot1 2>"$OUT/robot_client.err"
+    --map "$WORLD" --id robot1 --video-source "sim:$CAM" 2>"$OUT/robot_client.err"
 ) &
 CLIENT=$!
 PIDS+=("$CLIENT")
@@ -75,10 +91,20 @@ PIDS+=("$CLIENT")
 # Video on an ephemeral UDP port (5600 may be taken); SDP and snapshots in $OUT/video.
 ARGS=(--config config/server.yaml --bind 127.0.0.1 --port "$PORT" --port-file "$OUT/port"
       --video-port 0 --video-port-file "$OUT/video_port" --video-dir "$OUT/video" --runs-dir "$OUT/runs"
-      --operator-socket "$OUT/operator.sock" --script "$SCRIPT")
+      --operator-socket "$OUT/operator.sock" --script "$SCRIPT"
+      --foxglove-port "$FOX_PORT" --foxglove-port-file "$OUT/foxglove_port" --foxglove-token-file "$OUT/foxglove.token")
+# The Foxglove URL once the bridge listens (its token is made at start, mode 0600).
+(
+  for _ in $(seq 200); do [ -s "$OUT/foxglove_port" ] && [ -s "$OUT/foxglove.token" ] && break; sleep 0.05; done
+  [ -s "$OUT/foxglove_port" ] || exit 0
+  echo "demo: live in Foxglove / Lichtblick (open connection -> Foxglove WebSocket; layout config/foxglove/inspect_live.json):"
+  echo "        ws://127.0.0.1:$(cat "$OUT/foxglove_port")/?token=$(head -n 1 "$OUT/foxglove.token")"
+) &
+PIDS+=("$!")
 echo "demo: link: mutual TLS with certs/ (scripts/make_certs.sh); a second operator (observer; 'help control'):"
 echo "        $BIN/pc_server --attach $OUT/operator.sock"
-echo "demo: camera: $OUT/video/robot1.sdp (play it while the console runs:"
+echo "demo: camera: the simulated world seen by the robot's camera (mcu_sim --camera $CAM), streamed as"
+echo "      $OUT/video/robot1.sdp (play it while the console runs:"
 echo "        ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay $OUT/video/robot1.sdp)"
 echo "      snapshots: $OUT/video/robot1_latest.png (refreshed every 5 s), 'snapshot' at the console" 
 status=0
@@ -97,7 +123,7 @@ wait "$SIM" 2>/dev/null || true
 
 echo
 echo "=== what the robot did"
-grep -E '^mcu_sim: (final pose|serial)' "$OUT/mcu_sim.out" || true
+grep -E '^mcu_sim: (final pose|serial|camera .* frames=)' "$OUT/mcu_sim.out" || true
 awk -F, '$1=="T"{ if(!n){x0=$4;y0=$5;t0=$6;n=1} x=$4;y=$5;t=$6 }
   END{ if(!n) exit; dx=x-x0; dy=y-y0; c=cos(t0); s=sin(t0);
        d=t-t0; while(d>3.14159265)d-=6.2831853; while(d<-3.14159265)d+=6.2831853;

@@ -23,6 +23,11 @@ CliOptions parseCli(const std::vector<std::string>& args) {
     else if (a.is("--runs-dir")) o.runs_dir = a.path();
     else if (a.is("--no-record")) o.no_record = true;
     else if (a.is("--certs")) o.certs_dir = a.path();
+    else if (a.is("--no-foxglove")) o.no_foxglove = true;
+    else if (a.is("--foxglove-port")) o.foxglove_port = a.port();
+    else if (a.is("--foxglove-port-file")) o.foxglove_port_file = a.path();
+    else if (a.is("--foxglove-token-file")) o.foxglove_token_file = a.path();
+    else if (a.is("--site-map")) o.site_map = a.path();
     else if (a.is("--operator-socket")) o.operator_socket = a.path();
     else if (a.is("--attach")) o.attach = a.path();
     else if (a.is("--plaintext")) o.plaintext = true;
@@ -58,6 +63,11 @@ std::string usageText() {
          "                    make them with scripts/make_certs.sh)\n"
          "  --plaintext       no TLS: the robot link is neither encrypted nor authenticated (test benches only;\n"
          "                    warns at start and for every robot; robots must use --plaintext too)\n"
+         "  --no-foxglove     no Foxglove WebSocket bridge (overrides foxglove.enabled; docs/foxglove.md)\n"
+         "  --foxglove-port N the bridge's TCP port, 0 = ephemeral (overrides foxglove.port; default 8765)\n"
+         "  --foxglove-port-file FILE  write the bridge's port to FILE once listening\n"
+         "  --foxglove-token-file FILE  the bridge's token (read, or created with a new random token; mode 0600)\n"
+         "  --site-map FILE   world file drawn in every robot's 3-D scene (overrides site_map; a route's map wins)\n"
          "  --operator-socket PATH  more operator consoles: `pc_server --attach PATH` connects one (Unix socket,\n"
          "                    mode 0660; overrides operator_socket; each is a session, see 'help control')\n"
          "  --attach PATH     be an operator console of the server listening on PATH, then exit\n"

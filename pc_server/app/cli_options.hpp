@@ -27,6 +27,11 @@ struct CliOptions {
   bool no_record = false;
   std::optional<std::string> certs_dir;  // --certs DIR: DIR/ca.pem, DIR/server.pem, DIR/server.key
   bool plaintext = false;
+  bool no_foxglove = false;
+  std::optional<uint16_t> foxglove_port;
+  std::optional<std::string> foxglove_port_file;
+  std::optional<std::string> foxglove_token_file;
+  std::optional<std::string> site_map;
   std::optional<std::string> operator_socket;  // more operator consoles on this Unix socket
   std::optional<std::string> attach;           // --attach PATH: be a console of a running server
   bool interactive = false;

@@ -20,6 +20,10 @@
 #include <boost/asio/signal_set.hpp>
 
 #include "pc_server/console/console.hpp"
+#include "pc_server/foxglove/foxglove_bridge.hpp"
+#include "pc_server/foxglove/token_file.hpp"
+#include "pc_server/scene/site_maps.hpp"
+#include "shared/config/robot_config.hpp"
 #include "pc_server/console/console_runner.hpp"
 #include "pc_server/link/link_server.hpp"
 #include "pc_server/operator/operator_socket.hpp"
@@ -83,6 +87,13 @@ ServerConfig resolveConfig(const CliOptions& options) {
   }
   c.tls.plaintext = options.plaintext;
   if (options.operator_socket) c.operator_socket = *options.operator_socket;
+  if (options.no_foxglove) c.foxglove.enabled = false;
+  if (options.foxglove_port) c.foxglove.port = *options.foxglove_port;
+  if (options.foxglove_token_file) {
+    c.foxglove.token_file = *options.foxglove_token_file;
+    c.foxglove.auth = "token";
+  }
+  if (options.site_map) c.site_map = *options.site_map;
   return c;
 }
 
@@ -105,11 +116,33 @@ int runServer(const CliOptions& options) {
   // A console writing to a closed pipe must not kill the server.
   std::signal(SIGPIPE, SIG_IGN);
 
+  // The robot and control configs beside the server's (config/robot.yaml,
+  // config/control.yaml): the tuning host reads them, the 3-D scene draws the robot's body and sensors.
+  const std::filesystem::path cfg_dir =
+      options.config_path ? std::filesystem::path(*options.config_path).parent_path() : std::filesystem::path("config");
+  const auto beside = [&](const char* name) { return (cfg_dir.empty() ? std::filesystem::path(".") : cfg_dir) / name; };
+  scene::Geometry geometry;
+  if (std::filesystem::exists(beside("robot.yaml"))) {
+    try {
+      geometry = scene::geometryOf(config::loadRobotConfigFile(beside("robot.yaml").string()));
+    } catch (const std::exception& e) {
+      log::warn(log::tag::kServer, "the 3-D scene draws the default robot: ", e.what());
+    }
+  }
+  scene::SiteMaps site_maps;
+  site_maps.setDefault(config.site_map);
+
   asio::io_context ioc;
   RobotRegistry registry;
   LinkServer link(ioc, config, registry);
   link.setLogEvents(mode == ConsoleMode::kNone);
   if (mode != ConsoleMode::kNone) link.setConsoleWatchdog(kConsoleWatchdog);
+  // The Foxglove bridge (made once the recorder and the video exist) sees every envelope.
+  std::atomic<foxglove::FoxgloveBridge*> bridge_ptr{nullptr};
+  link.addEnvelopeObserver([&bridge_ptr](const std::string& id, const std::string&, const v1::Envelope& env,
+                                         bool inbound, uint64_t time_us) {
+    if (auto* b = bridge_ptr.load()) b->onEnvelope(id, env, inbound, time_us);
+  });
   const auto endpoint = link.listen();
   if (config.tls.plaintext) {
     log::warn(log::tag::kServer, net::kPlaintextWarning);
@@ -144,6 +177,7 @@ int runServer(const CliOptions& options) {
       if (!snap) return std::nullopt;
       return snap->hello;
     });
+    recorder->setScene(&site_maps, geometry);
     std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog.sqlite)";
     if (!recorder->startupReport().empty()) std::cout << "; " << recorder->startupReport();
     std::cout << std::endl;
@@ -157,8 +191,6 @@ int runServer(const CliOptions& options) {
       if (inbound && env.has_telemetry()) hub->onTelemetry(id, address, env, time_us);
     });
     if (recorder) {
-      video->setAccessUnitHook([rec = recorder.get()](const std::string& robot, const video::Frame& f,
-                                                      uint64_t capture_us) { rec->onAccessUnit(robot, f, capture_us); });
       recorder->setVideoFigures([hub = video.get()](const std::string& robot) -> std::optional<VideoFigures> {
         const auto st = hub->stats(robot);
         if (!st) return std::nullopt;
@@ -166,10 +198,62 @@ int runServer(const CliOptions& options) {
                             static_cast<int64_t>(st->lost_packets)};
       });
     }
+    // Every intact access unit goes to the run's recording and to the Foxglove clients, as received.
+    video->setAccessUnitHook([rec = recorder.get(), &bridge_ptr](const std::string& robot, const video::Frame& f,
+                                                                 uint64_t capture_us) {
+      if (rec) rec->onAccessUnit(robot, f, capture_us);
+      if (auto* b = bridge_ptr.load()) b->onAccessUnit(robot, f, capture_us);
+    });
     video->start();
     std::cout << "pc_server: video on UDP port " << video->port() << ", SDP files in " << config.video.dir << "/"
               << std::endl;
     if (options.video_port_file) writePortFile(*options.video_port_file, video->port(), "--video-port-file");
+  }
+
+  Console::Options copt;
+  // Every console (this one, those attached to the operator socket and each
+  // Foxglove client) is one session; one session at a time controls a robot (docs/console.md).
+  ControlArbiter control;
+  const auto configure = [&](Console& c) {
+    c.setVideo(video.get());
+    c.setRecorder(recorder.get());
+    c.setSiteMaps(&site_maps);
+    if (auto* b = bridge_ptr.load()) c.setFoxgloveReport([b] { return b->report(); });
+    c.setTuningPaths(beside("robot.yaml").string(), beside("control.yaml").string(),
+                     (recorder ? recorder->config().dir : config.recording.dir) + "/tuning");
+  };
+  std::unique_ptr<foxglove::FoxgloveBridge> bridge;
+  if (config.foxglove.enabled) {
+    const auto& fc = config.foxglove;
+    foxglove::FoxgloveBridge::Options fo;
+    fo.server.bind = fc.bind;
+    fo.server.port = fc.port;
+    fo.server.name = config.server_id;
+    if (fc.auth == "token") fo.server.token = foxglove::loadOrCreateToken(fc.token_file);
+    fo.server.allowed_origins = fc.allowed_origins;
+    fo.server.max_clients = fc.max_clients;
+    if (fc.tls) {
+      try {
+        fo.server.tls = net::makeTlsContext({"", config.tls.cert, config.tls.key}, net::TlsRole::kWebServer);
+      } catch (const net::TlsError& e) {
+        throw StartupError(std::string("foxglove.tls: ") + e.what());
+      }
+    }
+    fo.scene_hz = fc.scene_hz;
+    fo.grid_hz = fc.grid_hz;
+    fo.teleop_timeout_s = fc.teleop_timeout_s;
+    fo.max_v_m_s = copt.max_v_m_s;
+    fo.max_w_rad_s = copt.max_w_rad_s;
+    bridge = std::make_unique<foxglove::FoxgloveBridge>(ioc, fo, registry, link, control, site_maps, geometry, copt,
+                                                        configure);
+    bridge_ptr = bridge.get();
+    const auto ep = bridge->start();
+    const std::string url = std::string(fc.tls ? "wss" : "ws") + "://" + (fc.bind == "0.0.0.0" ? "<this-host>" : fc.bind) +
+                            ":" + std::to_string(ep.port()) + "/";
+    std::cout << "pc_server: Foxglove WebSocket on " << url
+              << (fc.auth == "token" ? "?token=<the token in " + fc.token_file + ">" : std::string(" (no token: loopback only)"))
+              << std::endl;
+    if (options.foxglove_port_file) writePortFile(*options.foxglove_port_file, ep.port(), "--foxglove-port-file");
   }
 
   StopFlag stop;
@@ -207,21 +291,6 @@ int runServer(const CliOptions& options) {
 
   int status = 0;
   {
-    Console::Options copt;
-    // Every console (this one and those attached to the operator socket) is one
-    // session; one session at a time controls a robot (docs/console.md).
-    ControlArbiter control;
-    const auto configure = [&](Console& c) {
-      c.setVideo(video.get());
-      c.setRecorder(recorder.get());
-      // The tuning host reads the robot and control configs beside the server's
-      // (config/robot.yaml, config/control.yaml) and writes sessions under the runs.
-      const std::filesystem::path cfg_dir =
-          options.config_path ? std::filesystem::path(*options.config_path).parent_path() : std::filesystem::path("config");
-      const auto beside = [&](const char* name) { return (cfg_dir.empty() ? std::filesystem::path(".") : cfg_dir) / name; };
-      c.setTuningPaths(beside("robot.yaml").string(), beside("control.yaml").string(),
-                       (recorder ? recorder->config().dir : config.recording.dir) + "/tuning");
-    };
     Console console(registry, link, std::cout, stop, copt);
     configure(console);
     console.setSession(&control, control.openSession(localUserName() + "@console"));
@@ -251,6 +320,7 @@ int runServer(const CliOptions& options) {
     if (operators) operators->stop();
   }
   std::cout.flush();
+  if (bridge) bridge->stop();
 
   log::info(log::tag::kServer, "stopping: closing robot sessions");
   link.stop();

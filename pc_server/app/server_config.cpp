@@ -56,6 +56,25 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
     r.fail("compression", "'" + rc.compression + "' is not one of zstd, none");
   rc.max_fragment_s = r.number("max_fragment_s", rc.max_fragment_s, 0.1, 60);
   c.operator_socket = root.string("operator_socket", c.operator_socket);
+  c.site_map = root.string("site_map", c.site_map);
+  const auto f = root.optChild("foxglove");
+  auto& fc = c.foxglove;
+  fc.enabled = f.boolean("enabled", fc.enabled);
+  fc.bind = f.string("bind", fc.bind);
+  if (!validBindAddress(fc.bind)) f.fail("bind", "'" + fc.bind + "' is not a numeric IP address (e.g. 127.0.0.1, 0.0.0.0)");
+  fc.port = static_cast<uint16_t>(f.integer("port", fc.port, 0, 65535));
+  fc.auth = f.string("auth", fc.auth);
+  if (fc.auth != "token" && fc.auth != "none") f.fail("auth", "'" + fc.auth + "' is not one of token, none");
+  if (fc.auth == "none" && fc.bind != "127.0.0.1" && fc.bind != "::1")
+    f.fail("auth", "none is only allowed with bind 127.0.0.1 or ::1 (other hosts must present the token)");
+  fc.token_file = f.string("token_file", fc.token_file);
+  if (fc.auth == "token" && fc.token_file.empty()) f.fail("token_file", "must not be empty with auth: token");
+  fc.tls = f.boolean("tls", fc.tls);
+  fc.allowed_origins = f.strings("allowed_origins");
+  fc.scene_hz = f.number("scene_hz", fc.scene_hz, 1, 30);
+  fc.grid_hz = f.number("grid_hz", fc.grid_hz, 0.1, 10);
+  fc.teleop_timeout_s = f.number("teleop_timeout_s", fc.teleop_timeout_s, 0.1, 2);
+  fc.max_clients = static_cast<int>(f.integer("max_clients", fc.max_clients, 1, 256));
   const auto t = root.optChild("tls");
   for (const char* key : {"ca", "cert", "key"}) {
     std::string& field = key[0] == 'c' ? (key[1] == 'a' ? c.tls.ca : c.tls.cert) : c.tls.key;

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "shared/config/config_node.hpp"
 
@@ -38,6 +39,21 @@ struct TlsServerConfig {
   std::string key = "certs/server.key";
 };
 
+/// The Foxglove WebSocket bridge (docs/foxglove.md).
+struct FoxgloveServerConfig {
+  bool enabled = true;
+  std::string bind = "127.0.0.1";          // this machine only; another address lets other hosts in (with the token)
+  uint16_t port = 8765;                    // the protocol's usual port; 0 = any free port (tests)
+  std::string auth = "token";              // token | none (none only with a loopback bind)
+  std::string token_file = "foxglove.token";  // read if it exists, else a new random token is written (mode 0600)
+  bool tls = false;                        // wss:// with the server's certificate (tls.cert, tls.key)
+  std::vector<std::string> allowed_origins;  // browsers' Origin header must be one of these; empty = any
+  double scene_hz = 10;                    // SceneUpdate rate per robot, Hz
+  double grid_hz = 1;                      // gas grids per robot and channel, Hz
+  double teleop_timeout_s = 0.5;           // a teleop set-point not refreshed this long stops the robot
+  int max_clients = 32;
+};
+
 /// Link and console settings; defaults are those documented in config/server.yaml.
 struct ServerConfig {
   std::string bind_address = "0.0.0.0";  // all interfaces: robots connect from the network
@@ -54,6 +70,8 @@ struct ServerConfig {
   RecordingServerConfig recording;
   TlsServerConfig tls;
   std::string operator_socket;           // Unix socket for more operator consoles; "" = none
+  FoxgloveServerConfig foxglove;
+  std::string site_map;                  // world file drawn in every robot's 3-D scene ("" = none; routes' maps win)
 };
 
 /// True for a numeric IPv4/IPv6 address.

@@ -25,6 +25,9 @@ namespace inspect::server {
 
 class VideoHub;
 class Recorder;
+namespace scene {
+class SiteMaps;
+}
 
 class Console {
  public:
@@ -91,6 +94,10 @@ class Console {
   /// Enables snapshot and the video figures (null: the server has no video).
   void setVideo(VideoHub* hub) { video_ = hub; }
   VideoHub* video() const { return video_; }
+  /// Enables `foxglove` (the bridge's report; empty function: no bridge).
+  void setFoxgloveReport(std::function<std::string()> report) { foxglove_report_ = std::move(report); }
+  /// Where `inspect` and `route` note the site map of the route they send (null: nowhere).
+  void setSiteMaps(scene::SiteMaps* maps) { site_maps_ = maps; }
   /// Enables record/runs/run (null: the server records nothing).
   void setRecorder(Recorder* r) { recorder_ = r; }
   Recorder* recorder() const { return recorder_; }
@@ -132,6 +139,7 @@ class Console {
   bool cmdVideo(const Args& args, const std::string& rest, int line_no);
   bool cmdPtz(const Args& args, const std::string& rest, int line_no);
   bool cmdSnapshot(const Args& args, const std::string& rest, int line_no);
+  bool cmdFoxglove(const Args& args, const std::string& rest, int line_no);
   bool cmdRecord(const Args& args, const std::string& rest, int line_no);
   bool cmdRuns(const Args& args, const std::string& rest, int line_no);
   bool cmdRun(const Args& args, const std::string& rest, int line_no);
@@ -189,6 +197,8 @@ class Console {
   TeleopHandler teleop_handler_;
   VideoHub* video_ = nullptr;
   Recorder* recorder_ = nullptr;
+  std::function<std::string()> foxglove_report_;
+  scene::SiteMaps* site_maps_ = nullptr;
   bool alarm_style_ = false;
   std::string selected_;
   uint64_t event_cursor_ = 0;

@@ -174,6 +174,12 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  Default file: <video.dir>/<robot>_<n>.png. Without a display the server also keeps\n"
        "  <video.dir>/<robot>_latest.png fresh (video.snapshot_period_s).\n",
        &Console::cmdSnapshot},
+      {"foxglove", "foxglove", "the Foxglove bridge: clients, subscriptions, send queues, drops",
+       "  One line per connected Foxglove/Lichtblick client (its operator session, how long it has\n"
+       "  been connected, subscriptions, queued messages and bytes, messages sent, data and video\n"
+       "  messages dropped for a slow reader, its messages refused), then the topics it subscribed\n"
+       "  to and publishes on. docs/foxglove.md.\n",
+       &Console::cmdFoxglove},
       {"record", "record start [name] | record stop", "record a run of the selected robot",
        "  A run is written to <recording.dir>/<run-id>/: run.mcap (telemetry, commands, acks, events,\n"
        "  camera frames; Foxglove opens it) and video.mp4, and listed in catalog.sqlite with its\n"

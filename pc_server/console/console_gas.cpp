@@ -2,7 +2,9 @@
 #include <cmath>
 
 #include "pc_server/console/console.hpp"
+
 #include "pc_server/recording/recorder.hpp"
+#include "pc_server/scene/site_maps.hpp"
 #include "pc_server/console/route_file.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "shared/config/config_node.hpp"
@@ -55,6 +57,7 @@ bool Console::cmdInspect(const Args& args, const std::string&, int) {
   }
   const auto robot = connectedRobot("inspect");
   if (!robot) return false;
+  if (site_maps_ && !r.map.empty()) site_maps_->set(*robot, r.map);
   if (recorder_) {
     if (!r.map.empty()) recorder_->setRunMap(*robot, r.map);
   } else {

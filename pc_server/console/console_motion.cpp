@@ -8,6 +8,7 @@
 #include "pc_server/console/route_file.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "pc_server/recording/recorder.hpp"
+#include "pc_server/scene/site_maps.hpp"
 #include "pc_server/video/video_hub.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/util/clock.hpp"
@@ -147,6 +148,7 @@ bool Console::cmdRoute(const Args& args, const std::string&, int) {
     return sendAndReport("route", std::move(c), true);
   }
   *c.mutable_go_to() = goToOf(r);
+  if (site_maps_ && !r.map.empty() && !selected_.empty()) site_maps_->set(selected_, r.map);
   out_ << "route '" << r.name << "': " << r.points.size() << " points"
        << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string()) << "\n";
   return sendAndReport("route", std::move(c), true);
@@ -268,6 +270,13 @@ bool Console::cmdPtz(const Args& args, const std::string&, int) {
   p->set_pan_rad(*pan * M_PI / 180.0);
   p->set_tilt_rad(*tilt * M_PI / 180.0);
   return sendAndReport("ptz", std::move(c));
+}
+
+bool Console::cmdFoxglove(const Args& args, const std::string&, int) {
+  if (!args.empty()) return fail("foxglove", "takes no arguments");
+  if (!foxglove_report_) return fail("foxglove", "the server has no Foxglove bridge (foxglove.enabled: false or --no-foxglove)");
+  out_ << foxglove_report_();
+  return true;
 }
 
 bool Console::cmdSnapshot(const Args& args, const std::string&, int) {

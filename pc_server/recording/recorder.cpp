@@ -19,18 +19,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-uint64_t wallNowNs() {
-  return static_cast<uint64_t>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-          .count());
-}
-
-/// A time on this process's monotonic clock (µs) as wall-clock ns.
-uint64_t monoUsToWallNs(uint64_t mono_us) {
-  const int64_t age_ns = (static_cast<int64_t>(monoNowUs()) - static_cast<int64_t>(mono_us)) * 1000;
-  return wallNowNs() - static_cast<uint64_t>(std::max<int64_t>(age_ns, 0));
-}
-
 int64_t fileBytes(const std::string& path) {
   std::error_code ec;
   const auto n = fs::file_size(path, ec);
@@ -67,6 +55,11 @@ struct Recorder::Run {
   catalog::RunInfo info;
   record::McapWriter mcap;
   uint16_t ch_telemetry = 0, ch_command = 0, ch_ack = 0, ch_event = 0, ch_server = 0, ch_camera = 0, ch_info = 0;
+  // The 3-D scene (the live bridge's, so that the run replays the same view).
+  std::unique_ptr<scene::RobotScene> scene;
+  uint16_t ch_tf = 0, ch_scene = 0, ch_log = 0;
+  std::map<std::string, uint16_t> ch_grid;
+  uint64_t last_tf_ns = 0, last_scene_ns = 0, last_grid_ns = 0, map_version = 0;
   std::unique_ptr<video::Mp4Writer> mp4;
   std::string mp4_error;
   RunStats stats;
@@ -209,8 +202,12 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
     run->ch_ack = run->mcap.addProtobufChannel(v1::Ack::descriptor(), "/ack");
     run->ch_event = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/event");
     run->ch_server = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/server_event");
-    run->ch_camera = run->mcap.addProtobufChannel(foxglove::CompressedVideo::descriptor(), "/camera");
+    run->ch_camera = run->mcap.addProtobufChannel(::foxglove::CompressedVideo::descriptor(), "/camera");
     run->ch_info = run->mcap.addProtobufChannel(v1::Hello::descriptor(), "/robot_info");
+    run->ch_tf = run->mcap.addProtobufChannel(::foxglove::FrameTransforms::descriptor(), "/tf");
+    run->ch_scene = run->mcap.addProtobufChannel(::foxglove::SceneUpdate::descriptor(), "/scene");
+    run->ch_log = run->mcap.addProtobufChannel(::foxglove::Log::descriptor(), "/log");
+    run->scene = std::make_unique<scene::RobotScene>(robot, geometry_);
     video::Mp4Settings ms;
     ms.max_fragment_s = config_.max_fragment_s;
     run->mp4 = std::make_unique<video::Mp4Writer>(run->info.dir + "/video.mp4", ms);
@@ -235,6 +232,7 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
       const uint64_t now = wallNowNs();
       run->mcap.write(run->ch_info, now, now, *h);
       hello_[robot] = *h;
+      run->scene->onHello(*h);
     }
   }
   runs_[robot] = std::move(run);
@@ -356,11 +354,18 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
           r.gains_known = true;
         }
         r.mcap.write(r.ch_telemetry, log_ns, publish_ns, env.telemetry());
+        r.scene->onTelemetry(env.telemetry(), log_ns);
+        writeScene(r, robot, log_ns, true);
         break;
-      case v1::Envelope::kCommand: r.mcap.write(r.ch_command, log_ns, publish_ns, env.command()); break;
+      case v1::Envelope::kCommand:
+        r.mcap.write(r.ch_command, log_ns, publish_ns, env.command());
+        r.scene->onCommand(env.command());
+        break;
       case v1::Envelope::kAck: r.mcap.write(r.ch_ack, log_ns, publish_ns, env.ack()); break;
       case v1::Envelope::kEvent:
         r.mcap.write(r.ch_event, log_ns, publish_ns, env.event());
+        r.scene->onEvent(env.event(), log_ns);
+        r.mcap.write(r.ch_log, log_ns, log_ns, scene::RobotScene::log(robot, env.event(), log_ns));
         if (env.event().kind() == v1::Event::GAINS_APPLIED && env.event().has_gains()) {
           // New gains during the run: the catalog keeps the latest set and counts the changes.
           const std::string controller = r.gains.value("controller", "");
@@ -393,12 +398,7 @@ void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame,
   Run& r = *it->second;
   ++r.video_frames;
   const uint64_t capture_wall_ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
-  foxglove::CompressedVideo v;
-  v.mutable_timestamp()->set_seconds(static_cast<int64_t>(capture_wall_ns / 1'000'000'000));
-  v.mutable_timestamp()->set_nanos(static_cast<int32_t>(capture_wall_ns % 1'000'000'000));
-  v.set_frame_id("camera");
-  v.set_data(frame.annexb.data(), frame.annexb.size());
-  v.set_format("h264");
+  const auto v = scene::RobotScene::cameraFrame(robot, frame, capture_wall_ns);
   try {
     r.mcap.write(r.ch_camera, wallNowNs(), capture_wall_ns, v);
     if (r.mp4) r.mp4->write(frame.annexb.data(), frame.annexb.size(), frame.keyframe, capture_us ? capture_us : monoNowUs());
@@ -406,6 +406,41 @@ void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame,
     if (r.mp4_error.empty()) log::error(log::tag::kRecord, robot, ": run ", r.info.id, " video: ", e.what());
     r.mp4_error = e.what();
     r.mp4.reset();
+  }
+}
+
+void Recorder::setScene(scene::SiteMaps* maps, const scene::Geometry& geometry) {
+  std::lock_guard lk(mu_);
+  site_maps_ = maps;
+  geometry_ = geometry;
+}
+
+void Recorder::writeScene(Run& r, const std::string& robot, uint64_t ns, bool telemetry) {
+  // The live view's rates, thinned: transforms at 10 Hz (the 3-D panel
+  // interpolates), the scene at 5 Hz, the gas grids at 1 Hz.
+  constexpr uint64_t kTfNs = 100'000'000, kSceneNs = 200'000'000, kGridNs = 1'000'000'000;
+  if (telemetry && ns - r.last_tf_ns >= kTfNs) {
+    r.last_tf_ns = ns;
+    r.mcap.write(r.ch_tf, ns, ns, r.scene->transforms(ns));
+  }
+  if (ns - r.last_scene_ns >= kSceneNs) {
+    r.last_scene_ns = ns;
+    if (site_maps_) {
+      const auto m = site_maps_->get(robot);
+      if (m.version != r.map_version) {
+        r.map_version = m.version;
+        r.scene->setMap(m.map ? std::optional<scene::SiteMap>(*m.map) : std::nullopt);
+      }
+    }
+    r.mcap.write(r.ch_scene, ns, ns, r.scene->scene(ns));
+  }
+  if (ns - r.last_grid_ns >= kGridNs) {
+    r.last_grid_ns = ns;
+    for (const auto& name : r.scene->gridChannels()) {
+      auto& ch = r.ch_grid[name];
+      if (ch == 0) ch = r.mcap.addProtobufChannel(::foxglove::Grid::descriptor(), "/gas/" + name);
+      if (const auto g = r.scene->grid(name, ns)) r.mcap.write(ch, ns, ns, *g);
+    }
   }
 }
 

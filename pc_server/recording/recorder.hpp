@@ -19,6 +19,8 @@
 
 #include "inspect/v1/link.pb.h"
 #include "pc_server/recording/run_stats.hpp"
+#include "pc_server/scene/robot_scene.hpp"
+#include "pc_server/scene/site_maps.hpp"
 #include "pc_server/app/server_config.hpp"
 #include "shared/catalog/catalog.hpp"
 #include "shared/video/rtp_h264.hpp"
@@ -70,6 +72,10 @@ class Recorder {
   /// when none is running (`inspect` with a route that names a map); listed
   /// as the run's "map" file, which reports draw. "" forgets a pending one.
   void setRunMap(const std::string& robot, const std::string& map_path);
+  /// Every run also records the robot's 3-D scene (docs/mcap.md: /tf, /scene,
+  /// /gas/<channel>, /log), drawn with this geometry on the map `maps` gives
+  /// (null: no map). Set before the first run.
+  void setScene(scene::SiteMaps* maps, const scene::Geometry& geometry);
   /// The operator acknowledged a gas alarm: /server_event and the catalog's alarms.
   void noteAlarmAck(const std::string& robot, const v1::GasAlarm& alarm, const std::string& text);
 
@@ -92,6 +98,9 @@ class Recorder {
   std::function<std::optional<VideoFigures>(const std::string&)> video_figures_;
   std::function<std::string(const std::string&)> gains_source_;
   std::function<std::optional<v1::Hello>(const std::string&)> hello_source_;
+  void writeScene(Run& r, const std::string& robot, uint64_t ns, bool telemetry);
+  scene::SiteMaps* site_maps_ = nullptr;
+  scene::Geometry geometry_;
   std::map<std::string, std::string> pending_map_;  // robot -> map for its next run
   std::map<std::string, v1::Hello> hello_;          // robot -> Hello at its run's start
   mutable std::mutex mu_;

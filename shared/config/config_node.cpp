@@ -176,6 +176,18 @@ std::vector<double> ConfigNode::numbers(const std::string& key, int size) const 
   return out;
 }
 
+std::vector<std::string> ConfigNode::strings(const std::string& key) const {
+  YAML::Node n = get(key);
+  std::vector<std::string> out;
+  if (!n || n.IsNull()) return out;
+  if (!n.IsSequence()) fail(key, "must be a list of strings");
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsScalar()) fail(key, "element " + std::to_string(i) + " must be a string");
+    out.push_back(n[i].Scalar());
+  }
+  return out;
+}
+
 void ConfigNode::checkKnownRec(const State& s) {
   if (s.node.IsMap()) {
     for (const auto& kv : s.node) {

@@ -47,6 +47,8 @@ class ConfigNode {
   std::string oneOf(const std::string& key, const std::string& def, const std::vector<std::string>& choices) const;
   /// A list of numbers; when `size` >= 0 the list must have exactly that many.
   std::vector<double> numbers(const std::string& key, int size = -1) const;
+  /// An optional list of strings (empty when absent).
+  std::vector<std::string> strings(const std::string& key) const;
 
   /// Throws ConfigError for keys in this mapping (and nested ones read) never read.
   void checkKnown() const;

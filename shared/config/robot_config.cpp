@@ -42,6 +42,11 @@ RobotConfig loadRobotConfig(const ConfigNode& root) {
       (void)mounts[i].string("name", "");
     }
   }
+  const auto cam = root.optChild("camera");
+  c.camera.x_m = cam.number("x_m", c.camera.x_m, -5.0, 5.0);
+  c.camera.y_m = cam.number("y_m", c.camera.y_m, -5.0, 5.0);
+  c.camera.z_m = cam.number("z_m", c.camera.z_m, 0.05, 5.0);
+  c.camera.hfov_deg = cam.number("hfov_deg", c.camera.hfov_deg, 10.0, 150.0);
   c.gas = loadGasConfig(root.optChild("gas"), root.has("gas"));
   return c;
 }

@@ -59,11 +59,23 @@ struct UltrasonicConfig {
                                          {0.0, -0.25, -1.5707963267948966}}};
 };
 
+/// The PTZ camera's mount: where the pan/tilt head sits on the robot and what
+/// the lens takes in (mcu_sim renders this camera's view, sim/camera_view.hpp).
+/// Pan turns it about the vertical through the mount (CCW positive), tilt about
+/// its horizontal axis (up positive); both 0 = looking straight ahead.
+struct CameraMount {
+  double x_m = 0.20;      // ahead of the axle midpoint
+  double y_m = 0.0;       // left of the centre line
+  double z_m = 0.60;      // lens height above the floor
+  double hfov_deg = 60.0; // horizontal field of view (the vertical one follows from the picture's aspect)
+};
+
 struct RobotConfig {
   RobotGeometry geometry;
   RobotLimits limits;
   MotorModel motor;
   UltrasonicConfig ultrasonic;
+  CameraMount camera;
   GasConfig gas;  // the `gas` section (none when absent; defaultGasConfig() = config/robot.yaml's)
 };
 

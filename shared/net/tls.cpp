@@ -96,7 +96,8 @@ std::string describeCertificate(const std::string& pem_file) {
 }
 
 std::shared_ptr<ssl::context> makeTlsContext(const TlsFiles& files, TlsRole role) {
-  const bool server = role == TlsRole::kServer;
+  const bool server = role != TlsRole::kClient;
+  const bool verify_peer = role != TlsRole::kWebServer;
   auto ctx = std::make_shared<ssl::context>(server ? ssl::context::tls_server : ssl::context::tls_client);
   SSL_CTX* c = ctx->native_handle();
   SSL_CTX_set_min_proto_version(c, TLS1_2_VERSION);
@@ -109,10 +110,11 @@ std::shared_ptr<ssl::context> makeTlsContext(const TlsFiles& files, TlsRole role
                    "; make a new one with scripts/make_certs.sh");
   if (X509_cmp_current_time(X509_get0_notBefore(own.get())) >= 0)
     throw TlsError("certificate '" + files.cert + "' is not valid yet (is this machine's clock right?)");
-  readCertificate(files.ca, "CA");  // a clear message before OpenSSL's
-
-  if (SSL_CTX_load_verify_locations(c, files.ca.c_str(), nullptr) != 1)
-    throw TlsError("CA certificate '" + files.ca + "': " + opensslError());
+  if (verify_peer) {
+    readCertificate(files.ca, "CA");  // a clear message before OpenSSL's
+    if (SSL_CTX_load_verify_locations(c, files.ca.c_str(), nullptr) != 1)
+      throw TlsError("CA certificate '" + files.ca + "': " + opensslError());
+  }
   if (SSL_CTX_use_certificate_chain_file(c, files.cert.c_str()) != 1)
     throw TlsError("certificate '" + files.cert + "': " + opensslError());
   if (files.key.empty()) throw TlsError("no private key file given");
@@ -130,6 +132,10 @@ std::shared_ptr<ssl::context> makeTlsContext(const TlsFiles& files, TlsRole role
 
   // The peer must present a certificate of the CA made for the other role:
   // a robot's certificate (client auth) cannot pose as the server and back.
+  if (!verify_peer) {
+    ctx->set_verify_mode(ssl::verify_none);
+    return ctx;
+  }
   ctx->set_verify_mode(ssl::verify_peer | ssl::verify_fail_if_no_peer_cert);
   SSL_CTX_set_purpose(c, server ? X509_PURPOSE_SSL_CLIENT : X509_PURPOSE_SSL_SERVER);
   return ctx;

@@ -35,8 +35,10 @@ std::string describeCertificate(const std::string& pem_file);
 
 /// Role of a context: the server requires a client certificate for TLS
 /// Web Client Authentication; the client requires a server certificate for
-/// TLS Web Server Authentication naming the host it connects to.
-enum class TlsRole { kServer, kClient };
+/// TLS Web Server Authentication naming the host it connects to. kWebServer
+/// presents the server's certificate and asks for none (wss:// for browsers and
+/// Foxglove, which authenticate with a token instead; `files.ca` unused).
+enum class TlsRole { kServer, kClient, kWebServer };
 
 /// A TLS 1.2+ context that verifies the peer against `files.ca` and presents
 /// `files.cert`/`files.key`. Throws TlsError naming the file (missing,

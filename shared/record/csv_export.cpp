@@ -179,6 +179,14 @@ std::string fileBase(std::string_view topic) {
   return name;
 }
 
+/// The 3-D scene's channels (docs/foxglove.md) are drawings of what the other
+/// channels hold (walls, beams, rings; pixels of the gas maps): no table.
+bool drawing(const pb::Descriptor* d) {
+  if (!d) return false;
+  const std::string& n = d->full_name();
+  return n == "foxglove.SceneUpdate" || n == "foxglove.FrameTransforms" || n == "foxglove.Grid";
+}
+
 }  // namespace
 
 CsvExportResult exportCsv(const std::string& mcap_path, const std::string& out_dir, bool include_bytes) {
@@ -190,7 +198,8 @@ CsvExportResult exportCsv(const std::string& mcap_path, const std::string& out_d
   // Pass 1: the largest size of every repeated field, per channel.
   std::map<uint16_t, RepeatCounts> counts;
   reader.forEach([&](const McapMessageView& v) {
-    if (reader.descriptor(v.channel_id)) countRepeated(*reader.decode(v), "", counts[v.channel_id]);
+    const pb::Descriptor* d = reader.descriptor(v.channel_id);
+    if (d && !drawing(d)) countRepeated(*reader.decode(v), "", counts[v.channel_id]);
     return true;
   });
 
@@ -198,6 +207,7 @@ CsvExportResult exportCsv(const std::string& mcap_path, const std::string& out_d
   std::map<uint16_t, CsvFile> files;
   std::set<std::string> names;
   for (const auto& [id, ch] : reader.channels()) {
+    if (drawing(reader.descriptor(id))) continue;
     std::string base = fileBase(ch.topic);
     if (base.empty() || !names.insert(base).second) base += "_" + std::to_string(id);
     names.insert(base);

@@ -465,6 +465,21 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
     t.set_nearest_person_speed_m_s(a.person_speed_m_s);
     t.set_speed_factor(a.speed_factor);
     t.set_people_tracked(static_cast<uint32_t>(a.people));
+    // The people themselves (a cleared repeated field keeps its elements: no allocation once warm).
+    t.clear_people();
+    const auto* nearest = awareness_->tracker().nearest(estimate_.pose());
+    for (const auto& tr : awareness_->tracker().tracks()) {
+      if (!tr.isPerson()) continue;
+      auto* p = t.add_people();
+      p->set_id(static_cast<uint32_t>(tr.id));
+      p->set_x_m(tr.x[0]);
+      p->set_y_m(tr.x[1]);
+      p->set_vx_m_s(tr.x[2]);
+      p->set_vy_m_s(tr.x[3]);
+      const bool is_nearest = &tr == nearest;
+      p->set_nearest(is_nearest);
+      p->set_pattern(is_nearest ? static_cast<v1::HumanPattern>(static_cast<int>(a.pattern)) : v1::PATTERN_NONE);
+    }
   } else {
     t.set_nearest_person_m(-1.0);
     t.set_speed_factor(1.0);

@@ -7,12 +7,15 @@
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <thread>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "shared/video/frame_slot.hpp"
 #include "shared/video/timecode.hpp"
 
 namespace inspect::video {
@@ -154,6 +157,94 @@ class FileSource : public CaptureSource {
   bool loop_;
 };
 
+// The simulator's camera: the newest picture of the frame slot that mcu_sim
+// writes (--camera PATH), at most at the asked frame rate, resized to the
+// asked size. Paced by the simulator: read() waits for its next picture.
+class SimCameraSource : public FrameSource {
+ public:
+  SimCameraSource(const SourceSettings& s, const std::string& path)
+      : name_("sim:" + path), width_(s.width), height_(s.height), fps_(s.fps) {
+    if (path.empty()) throw VideoError("video source 'sim:': no path (sim:PATH, the file of mcu_sim --camera PATH)");
+    try {
+      reader_ = std::make_unique<FrameSlotReader>(path);
+    } catch (const VideoError& e) {
+      std::string why = e.what();
+      if (why.rfind(path + ": ", 0) == 0) why = why.substr(path.size() + 2);
+      if (why == "not found") why += " (is mcu_sim running with --camera " + path + "?)";
+      throw VideoError(name_ + ": " + why);
+    }
+    char fps[32];
+    std::snprintf(fps, sizeof fps, "%g", reader_->fps());
+    describe_ = name_ + " (mcu_sim pid " + std::to_string(reader_->writerPid()) + ", " +
+                sizeText(reader_->width(), reader_->height()) + " at " + fps + " fps, out " +
+                sizeText(width_, height_) + ")";
+    if (reader_->width() != width_ || reader_->height() != height_)
+      staging_.create(reader_->height(), reader_->width(), CV_8UC3);
+  }
+
+  bool read(cv::Mat& bgr, uint64_t, uint32_t) override {
+    using Clock = std::chrono::steady_clock;
+    const double slot_period_s = reader_->fps() > 0 ? 1.0 / reader_->fps() : 0.0;
+    const auto stall = std::chrono::milliseconds(
+        std::max<long>(kSimStallTimeoutMs, std::lround(3000.0 * slot_period_s)));
+    // Frames closer together than 0.7 of our period are skipped, so a
+    // simulator rendering faster than we send is sampled at our rate, and one
+    // rendering at our rate is never halved by its jitter.
+    const auto min_gap = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(fps_ > 0 ? 0.7 / fps_ : 0.0));
+    const bool direct = staging_.empty();
+    if (direct) bgr.create(height_, width_, CV_8UC3);
+    cv::Mat& dst = direct ? bgr : staging_;
+    auto deadline = Clock::now() + stall;
+    for (;;) {
+      const auto now = Clock::now();
+      if (have_last_ && now < last_return_ + min_gap) {
+        std::this_thread::sleep_until(std::min(last_return_ + min_gap, deadline));
+        continue;
+      }
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now);
+      const auto f = reader_->readNewer(last_seq_, dst.data, dst.step, std::max(left, std::chrono::milliseconds(0)));
+      if (!f) {
+        if (reader_->closed()) {
+          error_ = name_ + ": mcu_sim closed the camera (it stopped)";
+        } else {
+          char s[32];
+          std::snprintf(s, sizeof s, "%.1f", std::chrono::duration<double>(stall).count());
+          error_ = name_ + ": no new picture for " + s + " s (" +
+                   (reader_->writerAlive() ? "mcu_sim pid " + std::to_string(reader_->writerPid()) +
+                                                 " is running but not writing"
+                                           : "mcu_sim pid " + std::to_string(reader_->writerPid()) + " has exited") +
+                   ")";
+        }
+        return false;
+      }
+      last_seq_ = f->seq;
+      last_return_ = Clock::now();
+      have_last_ = true;
+      break;
+    }
+    if (!direct) {
+      const bool shrink = staging_.cols > width_ || staging_.rows > height_;
+      cv::resize(staging_, bgr, cv::Size(width_, height_), 0, 0, shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
+    }
+    return true;
+  }
+  std::string describe() const override { return describe_; }
+  std::string error() const override { return error_; }
+  bool paced() const override { return true; }
+
+ private:
+  std::string name_;
+  int width_, height_;
+  double fps_;
+  std::unique_ptr<FrameSlotReader> reader_;
+  cv::Mat staging_;  // the slot's size, when it differs from ours
+  uint64_t last_seq_ = 0;
+  std::chrono::steady_clock::time_point last_return_{};
+  bool have_last_ = false;
+  std::string describe_;
+  std::string error_;
+};
+
 }  // namespace
 
 SyntheticSource::SyntheticSource(int width, int height) : width_(width), height_(height) {
@@ -207,8 +298,9 @@ std::unique_ptr<FrameSource> openFrameSource(const SourceSettings& s) {
   if (startsWith(uri, "v4l2:")) return std::make_unique<CameraSource>(s, uri.substr(5));
   if (startsWith(uri, "/dev/video")) return std::make_unique<CameraSource>(s, uri);
   if (startsWith(uri, "file:")) return std::make_unique<FileSource>(s, uri.substr(5));
+  if (startsWith(uri, "sim:")) return std::make_unique<SimCameraSource>(s, uri.substr(4));
   if (hasVideoExtension(uri)) return std::make_unique<FileSource>(s, uri);
-  throw VideoError("video source '" + uri + "': unknown (synthetic, v4l2:/dev/videoN, /dev/videoN, file:PATH)");
+  throw VideoError("video source '" + uri + "': unknown (synthetic, v4l2:/dev/videoN, /dev/videoN, file:PATH, sim:PATH)");
 }
 
 }  // namespace inspect::video

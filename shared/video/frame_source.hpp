@@ -1,6 +1,7 @@
 #pragma once
 // Where the robot's video frames come from: a V4L2 camera through OpenCV, a
-// video file, or a synthetic scene (the default when there is no camera).
+// video file, the simulator's camera (mcu_sim --camera, through a frame slot),
+// or a synthetic scene (the default when there is no camera).
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -8,18 +9,14 @@
 
 #include <opencv2/core.hpp>
 
-namespace inspect::video {
+#include "shared/video/video_error.hpp"
 
-/// Any failure of the video layer that the caller should report (bad device,
-/// codec missing, bad settings). The message names what was wrong.
-class VideoError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+namespace inspect::video {
 
 struct SourceSettings {
   /// "synthetic", "v4l2:/dev/videoN" (or just "/dev/videoN"), "file:PATH"
-  /// (or any other path ending in a video extension).
+  /// (or any other path ending in a video extension), "sim:PATH" (the frame
+  /// slot that `mcu_sim --camera PATH` writes, frame_slot.hpp).
   std::string uri = "synthetic";
   int width = 640;
   int height = 480;
@@ -47,8 +44,18 @@ class FrameSource {
 };
 
 /// Opens the source named by `s.uri`. Throws VideoError naming the device or
-/// file and what failed (not found, cannot open, no frames).
+/// file and what failed (not found, cannot open, no frames, not a frame slot).
+///
+/// `sim:PATH` gives the newest picture of the simulator's camera (resized to
+/// the settings' size when the simulator renders another one), at most at the
+/// settings' frame rate; it is paced by the simulator. When no new picture
+/// comes for `kSimStallTimeoutMs` (or the simulator closes the slot), read()
+/// returns false and error() says so; the caller reopens it later.
 std::unique_ptr<FrameSource> openFrameSource(const SourceSettings& s);
+
+/// How long a `sim:` source waits for the simulator's next picture before it
+/// reports the simulator as stopped (also at least 3 of its frame periods).
+inline constexpr int kSimStallTimeoutMs = 1000;
 
 /// The synthetic scene alone (used by benchmarks and tests): a moving
 /// pattern (a bouncing disc and a sweeping bar over a gradient, so the encoder

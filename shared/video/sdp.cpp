@@ -2,32 +2,16 @@
 
 #include <cstdio>
 
+#include "shared/util/base64.hpp"
 #include "shared/video/rtp_h264.hpp"
 
 namespace inspect::video {
 
-std::string base64(const std::vector<uint8_t>& b) {
-  static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  std::size_t i = 0;
-  for (; i + 2 < b.size(); i += 3) {
-    const uint32_t v = (b[i] << 16) | (b[i + 1] << 8) | b[i + 2];
-    for (int k = 18; k >= 0; k -= 6) out += kAlphabet[(v >> k) & 63];
-  }
-  if (i + 1 == b.size()) {
-    const uint32_t v = b[i] << 16;
-    out += kAlphabet[(v >> 18) & 63];
-    out += kAlphabet[(v >> 12) & 63];
-    out += "==";
-  } else if (i + 2 == b.size()) {
-    const uint32_t v = (b[i] << 16) | (b[i + 1] << 8);
-    out += kAlphabet[(v >> 18) & 63];
-    out += kAlphabet[(v >> 12) & 63];
-    out += kAlphabet[(v >> 6) & 63];
-    out += '=';
-  }
-  return out;
+namespace {
+std::string b64(const std::vector<uint8_t>& b) {
+  return util::base64(std::string_view(reinterpret_cast<const char*>(b.data()), b.size()));
 }
+}  // namespace
 
 std::string makeSdp(const SdpParams& p) {
   std::string s;
@@ -42,7 +26,7 @@ std::string makeSdp(const SdpParams& p) {
   if (p.sps.size() >= 4 && !p.pps.empty()) {
     char pli[8];
     std::snprintf(pli, sizeof pli, "%02x%02x%02x", p.sps[1], p.sps[2], p.sps[3]);
-    s += std::string(";profile-level-id=") + pli + ";sprop-parameter-sets=" + base64(p.sps) + "," + base64(p.pps);
+    s += std::string(";profile-level-id=") + pli + ";sprop-parameter-sets=" + b64(p.sps) + "," + b64(p.pps);
   }
   s += "\n";
   s += "a=recvonly\n";

@@ -18,6 +18,4 @@ struct SdpParams {
 /// profile-level-id / sprop-parameter-sets when SPS/PPS are known.
 std::string makeSdp(const SdpParams& p);
 
-std::string base64(const std::vector<uint8_t>& bytes);
-
 }  // namespace inspect::video

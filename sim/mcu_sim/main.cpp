@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "shared/config/robot_config.hpp"
+#include "sim/mcu_sim/camera_feed.hpp"
 #include "sim/mcu_sim/pty_port.hpp"
 #include "sim/mcu_sim/realtime_runner.hpp"
 #include "sim/mcu_sim/sim_options.hpp"
@@ -37,10 +38,24 @@ int main(int argc, char** argv) {
     if (truth && !opt.frame_log_path.empty()) truth->openFrameLog(opt.frame_log_path);
     sim::Simulation simulation(robot, std::move(world), opt.seed, truth.get());
     simulation.setPeopleWaitForMotion(opt.people_wait_motion);
+    // The camera's slot exists before the serial device is announced, so a
+    // client started on that announcement finds both.
+    std::unique_ptr<sim::CameraFeed> camera;
+    if (!opt.camera_path.empty()) {
+      camera = std::make_unique<sim::CameraFeed>(
+          simulation.world(), robot,
+          sim::CameraFeedOptions{opt.camera_path, opt.camera_width, opt.camera_height, opt.camera_fps});
+      camera->publish(simulation);
+      camera->start();
+    }
     sim::PtyPort port(opt.pty_link);
 
     std::printf("mcu_sim: serial device %s\n", port.slavePath().c_str());
     if (!opt.pty_link.empty()) std::printf("mcu_sim: linked at %s\n", opt.pty_link.c_str());
+    if (camera)
+      std::printf("mcu_sim: camera %s (%dx%d at %g fps; robot_client --video-source sim:%s)\n",
+                  opt.camera_path.c_str(), opt.camera_width, opt.camera_height, opt.camera_fps,
+                  opt.camera_path.c_str());
     std::fflush(stdout);
 
     if (truth) {
@@ -49,13 +64,17 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(opt.seed), opt.rate, port.slavePath().c_str());
       truth->onEvent(0.0, "start", detail);
     }
-    sim::RealtimeRunner runner(simulation, port, truth.get(), {opt.rate, opt.duration_s});
+    sim::RealtimeRunner::Options run_opts{opt.rate, opt.duration_s, {}};
+    if (camera) run_opts.on_caught_up = [&camera](const sim::Simulation& s) { camera->publish(s); };
+    sim::RealtimeRunner runner(simulation, port, truth.get(), run_opts);
     const sim::RunSummary r = runner.run();
+    if (camera) camera->stop();
 
     const std::string stats = sim::formatSerialStats(r.stats);
     std::printf("mcu_sim: final pose x=%.4f y=%.4f theta=%.4f\n", r.final_pose.x_m, r.final_pose.y_m,
                 r.final_pose.theta_rad);
     std::printf("mcu_sim: %s\n", stats.c_str());
+    if (camera) std::printf("mcu_sim: %s\n", camera->summary().c_str());
     std::fflush(stdout);
     if (truth) truth->comment(stats);
     return 0;

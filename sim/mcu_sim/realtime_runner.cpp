@@ -102,6 +102,7 @@ RunSummary RealtimeRunner::run() {
     sim_.advanceTo(simNowMs(monoNowNs()));
     sim_.takeTx(tx);
     if (!tx.empty()) port_.write(tx);
+    if (opts_.on_caught_up) opts_.on_caught_up(sim_);
   };
 
   std::string reason;

@@ -4,6 +4,7 @@
 // frame's deadline as timeout, no busy-waiting. Stops on SIGINT/SIGTERM or
 // after the requested sim duration.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -49,6 +50,10 @@ class RealtimeRunner {
   struct Options {
     double rate = 1.0;                 // sim seconds per wall second
     std::optional<double> duration_s;  // sim seconds; empty: until a stop signal
+    /// Called on the runner's thread each time the simulation has caught up
+    /// with the wall clock (mcu_sim's camera takes its snapshot there); must
+    /// be quick. Empty: none.
+    std::function<void(const Simulation&)> on_caught_up;
   };
 
   /// Blocks SIGINT/SIGTERM and installs handlers that only set a flag; the

@@ -1,7 +1,23 @@
 #include "sim/mcu_sim/sim_options.hpp"
 
+#include <cstdio>
 
 namespace inspect::sim {
+
+namespace {
+
+// "640x480", each side in [64, 4096].
+void readSize(cli::ArgReader& a, int& width, int& height) {
+  const std::string v = a.path();
+  int w = 0, h = 0;
+  char tail = 0;
+  if (std::sscanf(v.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 4096 || h > 4096)
+    a.fail("'" + v + "' is not WxH with W and H in [64, 4096]");
+  width = w;
+  height = h;
+}
+
+}  // namespace
 
 std::string simUsage() {
   return "usage: mcu_sim --world FILE [options]\n"
@@ -19,12 +35,18 @@ std::string simUsage() {
          "  --people-wait-motion  pedestrians stand at their start points and their clock (start_s,\n"
          "                   pauses) starts when the robot is first commanded to move, so a scenario\n"
          "                   plays the same however long the robot takes to connect\n"
+         "  --camera PATH    render what the robot's PTZ camera sees (walls, obstacles, floor lines,\n"
+         "                   people) into the frame slot PATH (a file; /dev/shm/NAME keeps it in memory),\n"
+         "                   for robot_client --video-source sim:PATH (docs/video.md)\n"
+         "  --camera-size WxH  its picture size, each in [64, 4096] (default 640x480; needs --camera)\n"
+         "  --camera-fps N   its frame rate on the wall clock, N in [1, 120] (default 30; needs --camera)\n"
          "  --help           print this help and exit\n";
 }
 
 SimOptions parseSimOptions(const std::vector<std::string>& args) {
   SimOptions o;
   bool have_world = false;
+  bool camera_size = false, camera_fps = false;
   cli::ArgReader a(args);
   while (a.next()) {
     if (a.isHelp()) o.help = true;
@@ -37,8 +59,13 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     else if (a.is("--rate")) o.rate = a.number(0.1, 100.0);
     else if (a.is("--duration")) o.duration_s = a.numberAbove(0.0, 1e6);
     else if (a.is("--seed")) o.seed = a.unsignedInteger();
+    else if (a.is("--camera")) o.camera_path = a.path();
+    else if (a.is("--camera-size")) readSize(a, o.camera_width, o.camera_height), camera_size = true;
+    else if (a.is("--camera-fps")) o.camera_fps = a.number(1.0, 120.0), camera_fps = true;
     else a.unknown();
   }
+  if (!o.help && o.camera_path.empty() && camera_size) throw cli::UsageError("--camera-size: needs --camera");
+  if (!o.help && o.camera_path.empty() && camera_fps) throw cli::UsageError("--camera-fps: needs --camera");
   if (!o.help && (!have_world || o.world_path.empty())) throw cli::UsageError("--world: required");
   if (!o.help && !o.frame_log_path.empty() && o.truth_path.empty()) throw cli::UsageError("--frame-log: needs --truth");
   return o;

@@ -20,6 +20,10 @@ struct SimOptions {
   std::optional<double> duration_s;  // sim seconds; empty: until SIGINT/SIGTERM
   uint64_t seed = 1;
   bool people_wait_motion = false;   // pedestrians' clock starts at the robot's first wheel motion
+  std::string camera_path;           // empty: no camera; else the frame slot the camera's view is written to
+  int camera_width = 640;            // --camera-size WxH, each in [64, 4096]
+  int camera_height = 480;
+  double camera_fps = 30.0;          // [1, 120]
   bool help = false;
 };
 

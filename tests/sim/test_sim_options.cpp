@@ -42,6 +42,19 @@ TEST(SimOptions, AllFlags) {
   EXPECT_EQ(parseSimOptions({"--world", "w", "--seed", "18446744073709551615"}).seed, 18446744073709551615ull);
 }
 
+TEST(SimOptions, Camera) {
+  const auto none = parseSimOptions({"--world", "w"});
+  EXPECT_TRUE(none.camera_path.empty());
+  EXPECT_EQ(none.camera_width, 640);
+  EXPECT_EQ(none.camera_height, 480);
+  EXPECT_DOUBLE_EQ(none.camera_fps, 30.0);
+  const auto o = parseSimOptions({"--world", "w", "--camera", "/dev/shm/cam", "--camera-size=320x240", "--camera-fps", "15"});
+  EXPECT_EQ(o.camera_path, "/dev/shm/cam");
+  EXPECT_EQ(o.camera_width, 320);
+  EXPECT_EQ(o.camera_height, 240);
+  EXPECT_DOUBLE_EQ(o.camera_fps, 15.0);
+}
+
 TEST(SimOptions, HelpNeedsNoWorld) { EXPECT_TRUE(parseSimOptions({"--help"}).help); }
 
 TEST(SimOptions, ErrorsNameTheFlag) {
@@ -63,6 +76,13 @@ TEST(SimOptions, ErrorsNameTheFlag) {
       {{"--world", "w", "--truth="}, "--truth: empty value"},
       {{"--world", "w", "--people-wait-motion=1"}, "--people-wait-motion: takes no value"},
       {{"--world"}, "--world: missing value"},
+      {{"--world", "w", "--camera="}, "--camera: empty value"},
+      {{"--world", "w", "--camera-size", "640x480"}, "--camera-size: needs --camera"},
+      {{"--world", "w", "--camera-fps", "10"}, "--camera-fps: needs --camera"},
+      {{"--world", "w", "--camera", "c", "--camera-size", "640"}, "--camera-size: '640' is not WxH with W and H in [64, 4096]"},
+      {{"--world", "w", "--camera", "c", "--camera-size", "32x32"}, "--camera-size: '32x32' is not WxH"},
+      {{"--world", "w", "--camera", "c", "--camera-size", "640x480x"}, "--camera-size: '640x480x' is not WxH"},
+      {{"--world", "w", "--camera", "c", "--camera-fps", "0"}, "--camera-fps: 0 is out of range [1, 120]"},
   };
   for (const auto& c : cases) {
     const auto e = errorOf(c.args);
@@ -72,6 +92,7 @@ TEST(SimOptions, ErrorsNameTheFlag) {
 
 TEST(SimOptions, UsageListsEveryFlag) {
   const auto u = simUsage();
-  for (const char* f : {"--world", "--robot", "--pty-link", "--truth", "--rate", "--duration", "--seed", "--help"})
+  for (const char* f : {"--world", "--robot", "--pty-link", "--truth", "--rate", "--duration", "--seed", "--camera",
+                        "--camera-size", "--camera-fps", "--help"})
     EXPECT_NE(u.find(f), std::string::npos) << f;
 }

@@ -91,6 +91,14 @@ bool Stack::startServer(const std::string& script, const std::vector<std::string
   } else {
     argv.push_back("--no-video");
   }
+  if (foxglove_) {
+    for (const std::string a : {"--foxglove-port", "0", "--foxglove-port-file"}) argv.push_back(a);
+    argv.push_back(dir_ / "foxglove_port");
+    argv.push_back("--foxglove-token-file");
+    argv.push_back(dir_ / "foxglove.token");
+  } else {
+    argv.push_back("--no-foxglove");
+  }
   // Mutual TLS with the tests' certificates, as in the field (unless the test asks for --plaintext).
   if (std::find(extra.begin(), extra.end(), "--plaintext") == extra.end()) {
     argv.push_back("--certs");
@@ -104,7 +112,17 @@ bool Stack::startServer(const std::string& script, const std::vector<std::string
     if (!waitUntil([&] { return exists(dir_ / "video_port"); }, 10.0)) return false;
     video_port_ = std::atoi(readFile(dir_ / "video_port").c_str());
   }
-  return port_ > 0 && (!video_ || video_port_ > 0);
+  if (foxglove_) {
+    if (!waitUntil([&] { return exists(dir_ / "foxglove_port"); }, 10.0)) return false;
+    foxglove_port_ = std::atoi(readFile(dir_ / "foxglove_port").c_str());
+  }
+  return port_ > 0 && (!video_ || video_port_ > 0) && (!foxglove_ || foxglove_port_ > 0);
+}
+
+std::string Stack::foxgloveToken() const {
+  std::string t = readFile(dir_ / "foxglove.token");
+  while (!t.empty() && (t.back() == '\n' || t.back() == '\r')) t.pop_back();
+  return t;
 }
 
 RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,

@@ -75,6 +75,12 @@ class Stack {
   int videoPort() const { return video_port_; }
   std::string videoDir() const { return dir_ / "video"; }
 
+  /// The Foxglove bridge on for the server started after this call (off by
+  /// default: port 8765 is not the tests'): an ephemeral port, a token in <dir>/foxglove.token.
+  void enableFoxglove() { foxglove_ = true; }
+  int foxglovePort() const { return foxglove_port_; }
+  std::string foxgloveToken() const;
+
   /// Starts pc_server on an ephemeral port running `script` (console commands).
   /// Returns false if it did not report its port within 10 s.
   bool startServer(const std::string& script, const std::vector<std::string>& extra = {});
@@ -98,6 +104,8 @@ class Stack {
   int port_ = 0;
   bool video_ = false;
   int video_port_ = 0;
+  bool foxglove_ = false;
+  int foxglove_port_ = 0;
   std::vector<std::unique_ptr<RobotProcs>> robots_;
   std::map<std::string, Process> relays_;
 };

@@ -61,6 +61,8 @@ class Program {
     const auto err_path = path("stderr.txt");
     // No UDP video port 5600 (tests run in parallel); the video tests ask for an ephemeral one.
     if (std::find(args.begin(), args.end(), "--video-port") == args.end()) args.push_back("--no-video");
+    // Nor the Foxglove bridge's TCP port 8765 and a token file in the working directory.
+    if (std::find(args.begin(), args.end(), "--foxglove-port") == args.end()) args.push_back("--no-foxglove");
     // Nor a catalog in the working directory.
     if (std::find(args.begin(), args.end(), "--runs-dir") == args.end()) args.push_back("--no-record");
     // Mutual TLS with the tests' certificates unless the test says otherwise.

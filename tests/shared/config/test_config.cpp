@@ -55,6 +55,25 @@ TEST(Config, SyntaxErrorNamesLine) {
   EXPECT_NE(e.find("syntax"), std::string::npos) << e;
 }
 
+TEST(Config, CameraMount) {
+  const auto d = loadRobotConfig(ConfigNode::loadString("", "x.yaml"));
+  EXPECT_DOUBLE_EQ(d.camera.x_m, 0.20);
+  EXPECT_DOUBLE_EQ(d.camera.y_m, 0.0);
+  EXPECT_DOUBLE_EQ(d.camera.z_m, 0.60);
+  EXPECT_DOUBLE_EQ(d.camera.hfov_deg, 60.0);
+  const auto shipped = loadRobotConfigFile(inspect::test::srcPath("config/robot.yaml"));
+  EXPECT_DOUBLE_EQ(shipped.camera.x_m, d.camera.x_m);
+  EXPECT_DOUBLE_EQ(shipped.camera.z_m, d.camera.z_m);
+  EXPECT_DOUBLE_EQ(shipped.camera.hfov_deg, d.camera.hfov_deg);
+  const auto c = loadRobotConfig(ConfigNode::loadString("camera:\n  z_m: 1.2\n  hfov_deg: 90\n", "x.yaml"));
+  EXPECT_DOUBLE_EQ(c.camera.z_m, 1.2);
+  EXPECT_DOUBLE_EQ(c.camera.hfov_deg, 90.0);
+  EXPECT_NE(robotConfigError("camera:\n  hfov_deg: 180\n").find("camera.hfov_deg"), std::string::npos);
+  EXPECT_NE(robotConfigError("camera:\n  hfov_deg: 180\n").find("out of range"), std::string::npos);
+  EXPECT_NE(robotConfigError("camera:\n  z_m: 0\n").find("camera.z_m"), std::string::npos);
+  EXPECT_NE(robotConfigError("camera:\n  height_m: 1\n").find("camera.height_m: unknown key"), std::string::npos);
+}
+
 TEST(Config, WrongMountCount) {
   const auto e = robotConfigError("ultrasonic:\n  mounts:\n    - {x_m: 0, y_m: 0, yaw_rad: 0}\n");
   EXPECT_NE(e.find("exactly 4"), std::string::npos) << e;

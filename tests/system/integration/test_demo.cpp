@@ -16,6 +16,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <regex>
 
@@ -172,4 +174,32 @@ TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
                 t_read < 0 ? -1.0 : t_read - t_true);
     EXPECT_LT(a.time_unix - t_true, 15.0);
   }
+
+  // The run's MCAP holds the 3-D scene the live view shows (transforms, scene
+  // updates, gas grids, logs), every message decoding with its embedded schema
+  // (@mcap/core and protobufjs, as Foxglove reads it).
+  const char* reader = std::getenv("INSPECT_MCAP_READER");
+  ASSERT_NE(reader, nullptr) << "INSPECT_MCAP_READER: the @mcap/core reader (ctest fixture mcap_reader)";
+  std::string mcap;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "runs"))
+    if (std::filesystem::exists(e.path() / "run.mcap")) mcap = e.path() / "run.mcap";
+  ASSERT_FALSE(mcap.empty()) << "no run.mcap under " << (dir / "runs");
+  const std::string counts_path = dir / "mcap_counts.json";
+  ASSERT_EQ(std::system(("node " + std::string(reader) + " --decode " + mcap + " > " + counts_path).c_str()), 0)
+      << readFile(counts_path);
+  const std::string counts = readFile(counts_path);
+  std::printf("MCAP %s\n", counts.c_str());
+  const auto count = [&](const std::string& topic) {
+    std::smatch mm;
+    const std::regex re("\"" + topic + "\":([0-9]+)");
+    return std::regex_search(counts, mm, re) ? std::stol(mm[1]) : 0L;
+  };
+  for (const std::string topic : {"/tf", "/scene", "/log", "/gas/CH4", "/gas/H2S", "/telemetry", "/camera"})
+    EXPECT_GT(count(topic), 0) << topic << " missing from the run's MCAP: " << counts;
+  long total = 0;
+  const std::regex re_topic(R"("/[^"]+":([0-9]+))");
+  for (auto it = std::sregex_iterator(counts.begin(), counts.end(), re_topic);
+       it != std::sregex_iterator(); ++it)
+    total += std::stol((*it)[1]);
+  EXPECT_EQ(count("decoded"), total) << counts;
 }

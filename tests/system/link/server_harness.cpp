@@ -94,7 +94,7 @@ bool ServerUnderTest::start(const ServerStart& s) {
   const std::string cfg =
       s.config_path.empty() ? inspect::test::srcPath("config/server.yaml") : s.config_path;
   std::vector<std::string> argv = {bin,       "--config",   cfg,     "--bind",      "127.0.0.1",
-                                   "--port",  "0",          "--port-file", dir_ + "/port", "--no-video",
+                                   "--port",  "0",          "--port-file", dir_ + "/port", "--no-video", "--no-foxglove",
                                    "--runs-dir", runs_dir_, "--certs", s.certs_dir};
   argv.insert(argv.end(), s.extra_args.begin(), s.extra_args.end());
   // LINK_SERVER_WRAPPER="gdb -batch -ex run -ex bt --args" (or valgrind ...) runs the server under a tool.

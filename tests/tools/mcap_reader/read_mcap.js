@@ -2,7 +2,11 @@
 // Independent MCAP reader for the tests (@mcap/core from npm, the library
 // Foxglove itself uses). Prints {"<topic>": messages, ..., "schemas": n}.
 //
-//   node read_mcap.js [--stream] [--expect expected.json] file.mcap
+//   node read_mcap.js [--stream] [--decode] [--expect expected.json] file.mcap
+//
+// --decode (indexed files): every message is also decoded with its channel's
+// embedded schema (protobuf: protobufjs from the FileDescriptorSet, as
+// Foxglove does); any failure is an error, and "decoded" gives the count.
 //
 // A file that ends with the MCAP magic is opened with McapIndexedReader (footer,
 // summary, chunk indexes, every chunk's CRC) and then read again from start to
@@ -34,7 +38,16 @@ function addCount(counts, topic) {
   counts[topic] = (counts[topic] ?? 0) + 1;
 }
 
-async function readIndexed(path) {
+/// A decoder per schema id (protobuf schemas: protobufjs from the FileDescriptorSet).
+function makeDecoder(schema) {
+  if (schema.encoding !== "protobuf") throw new Error(`schema ${schema.name}: encoding ${schema.encoding}, not protobuf`);
+  const protobuf = require("protobufjs");
+  require("protobufjs/ext/descriptor");
+  const type = protobuf.Root.fromDescriptor(Buffer.from(schema.data)).lookupType(schema.name);
+  return (data) => type.decode(data);
+}
+
+async function readIndexed(path, decode) {
   const handle = await fs.promises.open(path, "r");
   try {
     const readable = {
@@ -48,8 +61,19 @@ async function readIndexed(path) {
     };
     const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
     const counts = {};
+    const decoders = new Map();
+    let decoded = 0;
     for await (const message of reader.readMessages({ validateCrcs: true })) {
-      addCount(counts, reader.channelsById.get(message.channelId).topic);
+      const channel = reader.channelsById.get(message.channelId);
+      addCount(counts, channel.topic);
+      if (!decode) continue;
+      if (!decoders.has(channel.schemaId)) decoders.set(channel.schemaId, makeDecoder(reader.schemasById.get(channel.schemaId)));
+      try {
+        decoders.get(channel.schemaId)(message.data);
+      } catch (e) {
+        throw new Error(`${channel.topic}: a message at ${message.logTime} does not decode with its schema: ${e.message}`);
+      }
+      decoded += 1;
     }
     const total = Object.values(counts).reduce((a, b) => a + b, 0);
     const stats = reader.statistics;
@@ -71,7 +95,7 @@ async function readIndexed(path) {
     } else {
       process.stderr.write("read_mcap: this node has no zlib.crc32, data section CRC not checked\n");
     }
-    return { counts, schemas: reader.schemasById.size, chunks: reader.chunkIndexes.length };
+    return { counts, schemas: reader.schemasById.size, chunks: reader.chunkIndexes.length, decoded };
   } finally {
     await handle.close();
   }
@@ -128,19 +152,21 @@ function sameJson(a, b) {
 async function main() {
   const args = process.argv.slice(2);
   let stream = false;
+  let decode = false;
   let expectPath;
   let path;
   for (let i = 0; i < args.length; i++) {
     if (args[i] === "--stream") stream = true;
+    else if (args[i] === "--decode") decode = true;
     else if (args[i] === "--expect") expectPath = args[++i];
     else if (!path) path = args[i];
     else throw new Error(`unexpected argument ${args[i]}`);
   }
-  if (!path) throw new Error("usage: node read_mcap.js [--stream] [--expect expected.json] file.mcap");
+  if (!path) throw new Error("usage: node read_mcap.js [--stream] [--decode] [--expect expected.json] file.mcap");
 
   let result;
   if (!stream && endsWithMagic(path)) {
-    result = await readIndexed(path);
+    result = await readIndexed(path, decode);
     const linear = readStream(path, true);
     if (!sameJson(result.counts, linear.counts) || linear.schemas !== result.schemas || linear.chunks !== result.chunks) {
       throw new Error(`indexed and stream readers disagree: ${JSON.stringify(result)} vs ${JSON.stringify(linear)}`);
@@ -149,6 +175,10 @@ async function main() {
     result = readStream(path, false);
   }
   const out = { ...result.counts, schemas: result.schemas };
+  if (decode) {
+    if (result.decoded === undefined) throw new Error("--decode needs a complete (indexed) file");
+    out.decoded = result.decoded;
+  }
   process.stdout.write(JSON.stringify(out) + "\n");
   if (expectPath) {
     const expected = JSON.parse(fs.readFileSync(expectPath, "utf8"));

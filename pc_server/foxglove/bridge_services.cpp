@@ -1,0 +1,180 @@
+#include "pc_server/foxglove/bridge_services.hpp"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "shared/util/number_text.hpp"
+
+namespace inspect::server::foxglove {
+
+using Json = nlohmann::json;
+
+namespace {
+
+const char* kRobotProp = R"("robot": {"type": "string", "description": "robot id; default: the session's selected robot"})";
+
+std::string schema(const std::string& props, const std::string& required = "") {
+  return std::string(R"({"type": "object", "properties": {)") + kRobotProp + (props.empty() ? "" : ", " + props) +
+         "}" + (required.empty() ? "" : R"(, "required": [)" + required + "]") + "}";
+}
+
+/// A console word from a client: printable, no spaces (console lines split on them).
+bool plainWord(const std::string& s) {
+  if (s.empty() || s.size() > 200) return false;
+  for (const unsigned char c : s)
+    if (c <= ' ' || c == 0x7f || c == '#') return false;
+  return true;
+}
+
+struct Bad {
+  std::string what;
+};
+
+double number(const Json& j, const char* key, bool required, double fallback = NAN) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) {
+    if (required) throw Bad{"missing \"" + std::string(key) + "\" (a number)"};
+    return fallback;
+  }
+  if (!it->is_number()) throw Bad{"\"" + std::string(key) + "\" must be a number"};
+  const double v = it->get<double>();
+  if (!std::isfinite(v)) throw Bad{"\"" + std::string(key) + "\" must be finite"};
+  return v;
+}
+std::string word(const Json& j, const char* key, bool required) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) {
+    if (required) throw Bad{"missing \"" + std::string(key) + "\" (a string)"};
+    return "";
+  }
+  if (!it->is_string()) throw Bad{"\"" + std::string(key) + "\" must be a string"};
+  const std::string s = it->get<std::string>();
+  if (!plainWord(s)) throw Bad{"\"" + std::string(key) + "\" must be one word (1-200 printable characters, no spaces or #)"};
+  return s;
+}
+/// Words separated by single spaces (a run name): printable, no #.
+std::string text(const Json& j, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return "";
+  const std::string s = it->is_string() ? it->get<std::string>() : std::string("\x01");
+  bool ok = !s.empty() && s.size() <= 200 && s.front() != ' ' && s.back() != ' ';
+  for (const unsigned char c : s) ok = ok && c >= ' ' && c != 0x7f && c != '#';
+  if (!ok) throw Bad{"\"" + std::string(key) + "\" must be text of 1-200 printable characters without #"};
+  return s;
+}
+bool flag(const Json& j, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return false;
+  if (!it->is_boolean()) throw Bad{"\"" + std::string(key) + "\" must be true or false"};
+  return it->get<bool>();
+}
+
+}  // namespace
+
+const std::vector<ServiceDef>& serviceDefs() {
+  static const std::vector<ServiceDef> defs{
+      {"/stop", "inspect/Stop", schema(""), "zero the robot's set-point (always allowed)"},
+      {"/estop", "inspect/EStop", schema(""), "emergency stop, latched until /resume (always allowed)"},
+      {"/resume", "inspect/Resume", schema(""), "clear a latched e-stop or failsafe (needs control)"},
+      {"/goto", "inspect/GoTo",
+       schema(R"("x": {"type": "number"}, "y": {"type": "number"}, "speed": {"type": "number", "description": "m/s, optional"})",
+              R"("x", "y")"),
+       "navigate to (x, y) of the robot's odometry frame"},
+      {"/route", "inspect/Route", schema(R"("route": {"type": "string", "description": "name in config/routes or a file"})", R"("route")"),
+       "run a route file"},
+      {"/inspect", "inspect/Inspect",
+       schema(R"("route": {"type": "string"}, "speed": {"type": "number", "description": "m/s, optional"})", R"("route")"),
+       "a recorded gas inspection round"},
+      {"/record_start", "inspect/RecordStart", schema(R"("name": {"type": "string", "description": "run name, optional"})"),
+       "start recording a run"},
+      {"/record_stop", "inspect/RecordStop", schema(""), "end the run being recorded"},
+      {"/control_take", "inspect/ControlTake",
+       schema(R"("force": {"type": "boolean", "description": "take over from another session"})"),
+       "take control of the robot (motion needs it)"},
+      {"/control_release", "inspect/ControlRelease", schema(""), "release control of the robot"},
+      {"/console", "inspect/Console",
+       schema(R"("command": {"type": "string", "description": "any console command line, as docs/console.md lists"})", R"("command")"),
+       "any console command, with the console's rules"},
+  };
+  return defs;
+}
+
+const std::string& responseSchema() {
+  static const std::string s =
+      R"({"type": "object", "properties": {"ok": {"type": "boolean"}, "message": {"type": "string"}}, "required": ["ok", "message"]})";
+  return s;
+}
+
+Service toService(const ServiceDef& d) {
+  Service s;
+  s.name = d.name;
+  s.type = d.type;
+  s.request_schema = d.request_schema;
+  s.response_schema = responseSchema();
+  return s;
+}
+
+ServiceRequest parseServiceRequest(const std::string& service, std::string_view json) {
+  ServiceRequest r;
+  Json j = json.empty() ? Json::object() : Json::parse(json, nullptr, false);
+  if (j.is_discarded()) {
+    r.error = service + ": the request is not valid JSON";
+    return r;
+  }
+  if (j.is_null()) j = Json::object();
+  if (!j.is_object()) {
+    r.error = service + ": the request must be a JSON object";
+    return r;
+  }
+  try {
+    r.robot = word(j, "robot", false);
+    const auto speed = [&] {
+      const double v = number(j, "speed", false);
+      return std::isnan(v) ? std::string() : " " + util::shortest(v);
+    };
+    if (service == "/stop") {
+      r.line = "stop";
+      r.immediate = true;
+    } else if (service == "/estop") {
+      r.line = "estop";
+      r.immediate = true;
+    } else if (service == "/resume") {
+      r.line = "resume";
+    } else if (service == "/goto") {
+      r.line = "goto " + util::shortest(number(j, "x", true)) + " " + util::shortest(number(j, "y", true)) + speed();
+    } else if (service == "/route") {
+      r.line = "route " + word(j, "route", true);
+    } else if (service == "/inspect") {
+      r.line = "inspect " + word(j, "route", true) + speed();
+    } else if (service == "/record_start") {
+      const std::string name = text(j, "name");
+      r.line = "record start" + (name.empty() ? std::string() : " " + name);
+    } else if (service == "/record_stop") {
+      r.line = "record stop";
+    } else if (service == "/control_take") {
+      r.line = flag(j, "force") ? "control take force" : "control take";
+    } else if (service == "/control_release") {
+      r.line = "control release";
+    } else if (service == "/console") {
+      const auto it = j.find("command");
+      if (it == j.end() || !it->is_string()) throw Bad{"missing \"command\" (a string)"};
+      std::string line = it->get<std::string>();
+      if (line.size() > 4096) throw Bad{"\"command\" is longer than 4096 characters"};
+      for (const unsigned char c : line)
+        if (c < ' ' && c != '\t') throw Bad{"\"command\" must be one line without control characters"};
+      r.line = std::move(line);
+    } else {
+      throw Bad{"unknown service"};
+    }
+  } catch (const Bad& b) {
+    r.error = service + ": " + b.what;
+  }
+  return r;
+}
+
+std::string serviceResponse(bool ok, const std::string& message) {
+  return Json{{"ok", ok}, {"message", message}}.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+}  // namespace inspect::server::foxglove

@@ -1,0 +1,427 @@
+#include "pc_server/foxglove/foxglove_bridge.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "pc_server/foxglove/bridge_services.hpp"
+#include "shared/record/mcap_writer.hpp"
+#include "shared/util/base64.hpp"
+#include "shared/util/clock.hpp"
+#include "shared/util/log.hpp"
+#include "shared/util/number_text.hpp"
+
+namespace inspect::server::foxglove {
+
+namespace asio = boost::asio;
+using SteadyClock = std::chrono::steady_clock;
+
+namespace {
+constexpr const char* kTag = "foxglove";
+constexpr auto kDeadmanPeriod = std::chrono::milliseconds(50);
+constexpr auto kRefusalDebounce = std::chrono::seconds(1);
+}  // namespace
+
+std::vector<uint32_t> FoxgloveBridge::RobotChannels::all() const {
+  std::vector<uint32_t> ids{telemetry, events, acks, alarms, camera, tf, scene, log};
+  for (const auto& [name, id] : grids) ids.push_back(id);
+  std::erase(ids, 0u);
+  return ids;
+}
+
+FoxgloveBridge::FoxgloveBridge(asio::io_context& ioc, Options options, RobotRegistry& registry, CommandSink& sink,
+                               ControlArbiter& control, scene::SiteMaps& maps, scene::Geometry geometry,
+                               Console::Options console_options, ClientOperator::Configure configure)
+    : ioc_(ioc), options_(std::move(options)), registry_(registry), sink_(sink), control_(control), maps_(maps),
+      geometry_(geometry), console_options_(console_options), configure_(std::move(configure)),
+      server_(ioc, options_.server, *this), tick_timer_(ioc), deadman_timer_(ioc) {
+  for (const auto& d : serviceDefs()) service_ids_[d.name] = server_.addService(toService(d));
+}
+
+FoxgloveBridge::~FoxgloveBridge() { stop(); }
+
+asio::ip::tcp::endpoint FoxgloveBridge::start() {
+  const auto ep = server_.listen();
+  tick();
+  deadman();
+  return ep;
+}
+
+void FoxgloveBridge::stop() {
+  std::map<uint64_t, Client> clients;
+  {
+    std::lock_guard lk(mu_);
+    if (stopped_) return;
+    stopped_ = true;
+    clients.swap(clients_);
+  }
+  asio::post(ioc_, [this] {
+    tick_timer_.cancel();
+    deadman_timer_.cancel();
+  });
+  server_.stop();
+  for (auto& [id, c] : clients)
+    if (!c.teleop_robot.empty()) stopRobot(c.teleop_robot);
+  clients.clear();  // the sessions end (outside the lock: their workers may be finishing a call)
+}
+
+uint32_t FoxgloveBridge::addChannel(const std::string& topic, const google::protobuf::Descriptor* d,
+                                    WsServer::Kind kind) {
+  auto it = schemas_.find(d->full_name());
+  if (it == schemas_.end())
+    it = schemas_.emplace(d->full_name(), util::base64(record::protobufFileDescriptorSet(d))).first;
+  Channel c;
+  c.topic = topic;
+  c.encoding = "protobuf";
+  c.schema_name = d->full_name();
+  c.schema = it->second;
+  c.schema_encoding = "protobuf";
+  return server_.addChannel(std::move(c), kind);
+}
+
+void FoxgloveBridge::publishMessage(uint32_t channel, uint64_t ns, const google::protobuf::Message& m) {
+  if (channel == 0 || !server_.subscribed(channel)) return;
+  server_.publish(channel, ns, std::make_shared<const std::string>(m.SerializeAsString()));
+}
+
+void FoxgloveBridge::advertiseRobot(const std::string& robot, RobotState& r) {
+  const std::string p = "/" + robot + "/";
+  auto& c = r.ch;
+  c.telemetry = addChannel(p + "telemetry", v1::Telemetry::descriptor(), WsServer::Kind::kData);
+  c.events = addChannel(p + "events", v1::Event::descriptor(), WsServer::Kind::kData);
+  c.acks = addChannel(p + "acks", v1::Ack::descriptor(), WsServer::Kind::kData);
+  c.alarms = addChannel(p + "alarms", v1::GasAlarm::descriptor(), WsServer::Kind::kData);
+  c.camera = addChannel(p + "camera", ::foxglove::CompressedVideo::descriptor(), WsServer::Kind::kVideo);
+  c.tf = addChannel(p + "tf", ::foxglove::FrameTransforms::descriptor(), WsServer::Kind::kData);
+  c.scene = addChannel(p + "scene", ::foxglove::SceneUpdate::descriptor(), WsServer::Kind::kData);
+  c.log = addChannel(p + "log", ::foxglove::Log::descriptor(), WsServer::Kind::kData);
+  r.connected = true;
+  log::info(kTag, robot, ": channels advertised");
+}
+
+void FoxgloveBridge::unadvertiseRobot(RobotState& r) {
+  for (const uint32_t id : r.ch.all()) server_.removeChannel(id);
+  r.ch = {};
+  r.connected = false;
+}
+
+void FoxgloveBridge::onEnvelope(const std::string& robot, const v1::Envelope& env, bool inbound, uint64_t time_us) {
+  const uint64_t ns = monoUsToWallNs(time_us);
+  std::lock_guard lk(mu_);
+  if (stopped_) return;
+  auto [it, fresh] = robots_.try_emplace(robot);
+  RobotState& r = it->second;
+  if (!r.scene) {
+    r.scene = std::make_unique<scene::RobotScene>(robot, geometry_);
+    if (const auto snap = registry_.snapshot(robot, monoNowNs())) r.scene->onHello(snap->hello);
+  }
+  if (!r.connected) advertiseRobot(robot, r);
+  if (!inbound) {
+    if (env.has_command()) r.scene->onCommand(env.command());
+    return;
+  }
+  switch (env.body_case()) {
+    case v1::Envelope::kHello: r.scene->onHello(env.hello()); break;
+    case v1::Envelope::kTelemetry:
+      r.scene->onTelemetry(env.telemetry(), ns);
+      publishMessage(r.ch.telemetry, ns, env.telemetry());
+      if (server_.subscribed(r.ch.tf)) publishMessage(r.ch.tf, ns, r.scene->transforms(ns));
+      break;
+    case v1::Envelope::kEvent: {
+      const auto& e = env.event();
+      r.scene->onEvent(e, ns);
+      publishMessage(r.ch.events, ns, e);
+      if (server_.subscribed(r.ch.log)) publishMessage(r.ch.log, ns, scene::RobotScene::log(robot, e, ns));
+      if (e.has_gas_alarm()) publishMessage(r.ch.alarms, ns, e.gas_alarm());
+      break;
+    }
+    case v1::Envelope::kAck: publishMessage(r.ch.acks, ns, env.ack()); break;
+    default: break;
+  }
+}
+
+void FoxgloveBridge::onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us) {
+  uint32_t channel = 0;
+  {
+    std::lock_guard lk(mu_);
+    const auto it = robots_.find(robot);
+    if (it == robots_.end() || !it->second.connected) return;
+    channel = it->second.ch.camera;
+  }
+  if (!server_.subscribed(channel)) return;
+  const uint64_t ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
+  const auto v = scene::RobotScene::cameraFrame(robot, frame, ns);
+  server_.publish(channel, ns, std::make_shared<const std::string>(v.SerializeAsString()), frame.keyframe);
+}
+
+void FoxgloveBridge::tick() {
+  {
+    std::lock_guard lk(mu_);
+    if (stopped_) return;
+    const uint64_t ns = wallNowNs();
+    const auto now = SteadyClock::now();
+    // Robots that went away lose their channels (they come back with the next connection).
+    for (const auto& snap : registry_.snapshots(monoNowNs())) {
+      const auto it = robots_.find(snap.id);
+      if (it != robots_.end() && it->second.connected && !snap.connected) {
+        unadvertiseRobot(it->second);
+        log::info(kTag, snap.id, ": disconnected, channels unadvertised");
+      }
+    }
+    for (auto& [robot, r] : robots_) {
+      if (!r.connected || !r.scene) continue;
+      const auto m = maps_.get(robot);
+      if (m.version != r.map_version) {
+        r.map_version = m.version;
+        r.scene->setMap(m.map ? std::optional<scene::SiteMap>(*m.map) : std::nullopt);
+      }
+      if (server_.subscribed(r.ch.scene)) publishMessage(r.ch.scene, ns, r.scene->scene(ns));
+      if (now - r.last_grid >= steadyDuration(1.0 / options_.grid_hz)) {
+        r.last_grid = now;
+        for (const auto& name : r.scene->gridChannels()) {
+          auto& id = r.ch.grids[name];
+          if (id == 0) id = addChannel("/" + robot + "/gas/" + name, ::foxglove::Grid::descriptor(), WsServer::Kind::kData);
+          if (server_.subscribed(id))
+            if (const auto g = r.scene->grid(name, ns)) publishMessage(id, ns, *g);
+        }
+      }
+    }
+  }
+  tick_timer_.expires_after(steadyDuration(1.0 / options_.scene_hz));
+  tick_timer_.async_wait([this](const boost::system::error_code& ec) {
+    if (!ec) tick();
+  });
+}
+
+void FoxgloveBridge::deadman() {
+  std::vector<std::pair<uint64_t, std::string>> lapsed;
+  {
+    std::lock_guard lk(mu_);
+    if (stopped_) return;
+    const auto now = SteadyClock::now();
+    for (auto& [id, c] : clients_) {
+      if (c.teleop_robot.empty() || now - c.last_teleop < steadyDuration(options_.teleop_timeout_s)) continue;
+      lapsed.emplace_back(id, c.teleop_robot);
+      c.teleop_robot.clear();
+    }
+  }
+  for (const auto& [client, robot] : lapsed) {
+    stopRobot(robot);
+    server_.status(client, StatusLevel::kInfo,
+                   "teleop: no set-point for " + util::fmtShort(options_.teleop_timeout_s) + " s; " + robot + " stopped");
+  }
+  deadman_timer_.expires_after(kDeadmanPeriod);
+  deadman_timer_.async_wait([this](const boost::system::error_code& ec) {
+    if (!ec) deadman();
+  });
+}
+
+void FoxgloveBridge::stopRobot(const std::string& robot) {
+  v1::Command stop;
+  stop.mutable_stop();
+  if (sink_.sendCommand(robot, stop) == 0) sink_.clearTeleop(robot);
+}
+
+void FoxgloveBridge::onClientOpen(uint64_t client, const std::string& peer) {
+  auto op = std::make_shared<ClientOperator>("foxglove " + peer, registry_, sink_, control_, console_options_, configure_);
+  log::info(kTag, "client ", client, " (", peer, ") is operator session ", op->name());
+  std::lock_guard lk(mu_);
+  if (stopped_) return;
+  clients_[client] = Client{std::move(op), peer, "", {}, {}};
+}
+
+void FoxgloveBridge::onClientClose(uint64_t client) {
+  Client c;
+  {
+    std::lock_guard lk(mu_);
+    const auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    c = std::move(it->second);
+    clients_.erase(it);
+  }
+  // A client that drove a robot and went away leaves it stopped.
+  if (!c.teleop_robot.empty()) stopRobot(c.teleop_robot);
+  // Ends the session (a command waiting for its Ack is interrupted at once).
+  c.op.reset();
+}
+
+void FoxgloveBridge::onSubscribe(uint64_t, uint32_t channel) {
+  // A new video subscriber needs a keyframe to start from: ask the robot (at most once a second).
+  std::string robot;
+  {
+    std::lock_guard lk(mu_);
+    for (auto& [id, r] : robots_)
+      if (r.connected && r.ch.camera == channel) robot = id;
+  }
+  if (robot.empty()) return;
+  static std::mutex kf_mu;
+  static std::map<std::string, SteadyClock::time_point> last;
+  {
+    std::lock_guard lk(kf_mu);
+    auto& t = last[robot];
+    if (SteadyClock::now() - t < std::chrono::seconds(1)) return;
+    t = SteadyClock::now();
+  }
+  v1::Command c;
+  c.mutable_video()->set_keyframe(true);
+  sink_.sendCommand(robot, std::move(c));
+}
+
+std::shared_ptr<ClientOperator> FoxgloveBridge::operatorOf(uint64_t client) const {
+  std::lock_guard lk(mu_);
+  const auto it = clients_.find(client);
+  return it == clients_.end() ? nullptr : it->second.op;
+}
+
+std::string FoxgloveBridge::robotOfTopic(const std::string& topic) const {
+  // "/<robot>/cmd_vel" names the robot; "/cmd_vel" means the session's selected one.
+  if (topic.size() > 1 && topic[0] == '/') {
+    const auto slash = topic.find('/', 1);
+    if (slash != std::string::npos) return topic.substr(1, slash - 1);
+  }
+  return "";
+}
+
+void FoxgloveBridge::refuse(uint64_t client, const std::string& why) {
+  {
+    std::lock_guard lk(mu_);
+    const auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    if (SteadyClock::now() - it->second.last_refusal < kRefusalDebounce) return;
+    it->second.last_refusal = SteadyClock::now();
+  }
+  server_.status(client, StatusLevel::kError, why);
+}
+
+void FoxgloveBridge::onClientMessage(uint64_t client, const ClientChannel& channel, std::string_view payload) {
+  const std::string& t = channel.topic;
+  if (t == "/cmd_vel" || t.ends_with("/cmd_vel")) {
+    teleop(client, robotOfTopic(t), payload);
+    return;
+  }
+  refuse(client, "topic '" + t + "' is not one this server takes (publish geometry_msgs/Twist JSON on /cmd_vel or /<robot>/cmd_vel)");
+}
+
+void FoxgloveBridge::teleop(uint64_t client, const std::string& topic_robot, std::string_view payload) {
+  using Json = nlohmann::json;
+  const Json j = Json::parse(payload, nullptr, false);
+  const auto num = [&](const char* a, const char* b) -> std::optional<double> {
+    if (!j.is_object()) return std::nullopt;
+    const auto o = j.find(a);
+    if (o == j.end() || !o->is_object()) return 0.0;  // a Twist with a part left out: zero
+    const auto v = o->find(b);
+    if (v == o->end()) return 0.0;
+    if (!v->is_number()) return std::nullopt;
+    return v->get<double>();
+  };
+  const auto v = num("linear", "x"), w = num("angular", "z");
+  if (j.is_discarded() || !v || !w || !std::isfinite(*v) || !std::isfinite(*w)) {
+    refuse(client, "teleop: not a geometry_msgs/Twist JSON ({\"linear\": {\"x\": v}, \"angular\": {\"z\": w}})");
+    return;
+  }
+  if (std::fabs(*v) > options_.max_v_m_s || std::fabs(*w) > options_.max_w_rad_s) {
+    refuse(client, "teleop: v " + util::fmtShort(*v) + " m/s, w " + util::fmtShort(*w) + " rad/s is outside +-" +
+                       util::fmtShort(options_.max_v_m_s) + " m/s, +-" + util::fmtShort(options_.max_w_rad_s) +
+                       " rad/s; set-point ignored");
+    return;
+  }
+  const auto op = operatorOf(client);
+  if (!op) return;
+  std::string robot = topic_robot;
+  if (robot.empty()) robot = op->selected();
+  if (robot.empty()) robot = registry_.firstConnected();
+  if (robot.empty()) {
+    refuse(client, "teleop: no robot connected");
+    return;
+  }
+  const auto d = control_.authorizeMotion(robot, op->session(), monoNowNs());
+  if (!d.allowed) {
+    refuse(client, "teleop refused: " + d.reason);
+    return;
+  }
+  if (sink_.setTeleop(robot, *v, *w) == 0) {
+    refuse(client, "teleop: " + robot + " is not connected");
+    return;
+  }
+  std::string previous;
+  {
+    std::lock_guard lk(mu_);
+    const auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    previous = it->second.teleop_robot;
+    it->second.teleop_robot = robot;
+    it->second.last_teleop = SteadyClock::now();
+  }
+  if (!previous.empty() && previous != robot) stopRobot(previous);
+  if (d.taken_now) server_.status(client, StatusLevel::kInfo, robot + ": controlled by " + op->name());
+}
+
+void FoxgloveBridge::onServiceCall(uint64_t client, const Service& service, uint32_t call_id, std::string_view payload) {
+  const ServiceRequest req = parseServiceRequest(service.name, payload);
+  if (!req.ok()) {
+    server_.failCall(client, service.id, call_id, req.error);
+    return;
+  }
+  const auto op = operatorOf(client);
+  if (!op) return;
+  if (req.immediate) {
+    // Stop and e-stop never wait behind another call of the session, and need no control.
+    std::string robot = req.robot.empty() ? op->selected() : req.robot;
+    if (robot.empty()) robot = registry_.firstConnected();
+    v1::Command c;
+    if (req.line == "estop") c.mutable_estop();
+    else c.mutable_stop();
+    const uint64_t id = robot.empty() ? 0 : sink_.sendCommand(robot, std::move(c));
+    if (id == 0) {
+      server_.respond(client, service.id, call_id,
+                      serviceResponse(false, robot.empty() ? "no robot connected" : robot + " is not connected"));
+      return;
+    }
+    server_.respond(client, service.id, call_id,
+                    serviceResponse(true, robot + ": " + req.line + " sent (command " + std::to_string(id) + ")"));
+    return;
+  }
+  const uint32_t sid = service.id;
+  const bool queued = op->post(req.robot, req.line, [this, client, sid, call_id](bool ok, const std::string& text) {
+    server_.respond(client, sid, call_id, serviceResponse(ok, text));
+  });
+  if (!queued)
+    server_.failCall(client, service.id, call_id,
+                     "busy: " + std::to_string(ClientOperator::kMaxQueued) + " calls of this client are waiting");
+}
+
+std::string FoxgloveBridge::report() const {
+  const auto clients = server_.clients();
+  std::ostringstream o;
+  const auto& so = server_.options();
+  o << "foxglove: " << (so.tls ? "wss" : "ws") << "://" << so.bind << ":" << so.port << "/"
+    << (so.token.empty() ? " (no token)" : " (token required)") << ", " << clients.size() << " client"
+    << (clients.size() == 1 ? "" : "s") << ", " << server_.refusedConnections() << " connection(s) refused\n";
+  std::map<uint64_t, std::string> names;
+  {
+    std::lock_guard lk(mu_);
+    for (const auto& [id, c] : clients_) names[id] = c.op ? c.op->name() : "";
+  }
+  for (const auto& c : clients) {
+    o << "  client " << c.id << " " << c.peer << " (" << names[c.id] << "), " << util::fmtShort(c.connected_s, 0)
+      << " s: " << c.subscriptions.size() << " subscriptions, queue " << c.queued_messages << " msgs / "
+      << c.queued_bytes / 1024 << " KiB, sent " << c.counters.sent << ", dropped " << c.counters.dropped_data
+      << " data + " << c.counters.dropped_video << " video (+" << c.counters.skipped_video
+      << " skipped to a keyframe), refused " << c.refused << "\n";
+    if (!c.subscriptions.empty()) {
+      o << "    subscribed:";
+      for (const auto& t : c.subscriptions) o << " " << t;
+      o << "\n";
+    }
+    if (!c.publishing.empty()) {
+      o << "    publishing:";
+      for (const auto& t : c.publishing) o << " " << t;
+      o << "\n";
+    }
+  }
+  return o.str();
+}
+
+}  // namespace inspect::server::foxglove

@@ -1,0 +1,122 @@
+#pragma once
+// pc_server's Foxglove bridge (docs/foxglove.md): every robot's telemetry,
+// events, acks, alarms, camera and 3-D scene live on the Foxglove WebSocket
+// protocol, and from the clients teleop set-points and service calls, each
+// client an operator session of its own (it observes until it takes control;
+// stop and e-stop always work; teleop lapses when the client stops sending).
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "pc_server/console/console.hpp"
+#include "pc_server/foxglove/client_operator.hpp"
+#include "pc_server/foxglove/ws_server.hpp"
+#include "pc_server/scene/robot_scene.hpp"
+#include "pc_server/scene/site_maps.hpp"
+#include "shared/video/rtp_h264.hpp"
+
+namespace inspect::server::foxglove {
+
+class FoxgloveBridge : public WsServer::Handler {
+ public:
+  struct Options {
+    WsServer::Options server;
+    double scene_hz = 10;          // SceneUpdate per robot
+    double grid_hz = 1;            // gas grids per robot and channel
+    double teleop_timeout_s = 0.5; // a set-point not refreshed this long lapses: the robot is stopped
+    double max_v_m_s = 1.0;        // teleop limits (the console's)
+    double max_w_rad_s = 2.0;
+  };
+
+  FoxgloveBridge(boost::asio::io_context& ioc, Options options, RobotRegistry& registry, CommandSink& sink,
+                 ControlArbiter& control, scene::SiteMaps& maps, scene::Geometry geometry,
+                 Console::Options console_options, ClientOperator::Configure configure);
+  ~FoxgloveBridge() override;
+
+  /// Listens and starts the timers. Throws StartupError.
+  boost::asio::ip::tcp::endpoint start();
+  /// Closes the clients (their sessions end, robots they drove are stopped); idempotent.
+  void stop();
+
+  /// Every envelope to or from a robot (LinkServer's observer; any thread).
+  void onEnvelope(const std::string& robot, const v1::Envelope& env, bool inbound, uint64_t time_us);
+  /// Every intact access unit of a robot's camera (VideoHub's hook).
+  void onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us);
+
+  /// The `foxglove` console command's text: clients, subscriptions, queues, drops.
+  std::string report() const;
+  /// Figures for tests and benchmarks.
+  std::vector<WsServer::ClientInfo> clients() const { return server_.clients(); }
+  const WsServer& server() const { return server_; }
+
+  // WsServer::Handler
+  void onClientOpen(uint64_t client, const std::string& peer) override;
+  void onClientClose(uint64_t client) override;
+  void onSubscribe(uint64_t client, uint32_t channel) override;
+  void onClientMessage(uint64_t client, const ClientChannel& channel, std::string_view payload) override;
+  void onServiceCall(uint64_t client, const Service& service, uint32_t call_id, std::string_view payload) override;
+
+ private:
+  struct RobotChannels {
+    uint32_t telemetry = 0, events = 0, acks = 0, alarms = 0, camera = 0, tf = 0, scene = 0, log = 0;
+    std::map<std::string, uint32_t> grids;  // gas channel -> channel id
+    std::vector<uint32_t> all() const;
+  };
+  struct RobotState {
+    std::unique_ptr<scene::RobotScene> scene;
+    RobotChannels ch;
+    uint64_t map_version = 0;
+    bool connected = false;
+    std::chrono::steady_clock::time_point last_grid{};
+  };
+  struct Client {
+    std::shared_ptr<ClientOperator> op;
+    std::string peer;
+    std::string teleop_robot;  // "" = not driving
+    std::chrono::steady_clock::time_point last_teleop{};
+    std::chrono::steady_clock::time_point last_refusal{};
+  };
+
+  void tick();         // every 1 / scene_hz: robots appear and go, scenes and grids
+  void deadman();      // every 50 ms: teleop set-points that lapsed
+  void advertiseRobot(const std::string& robot, RobotState& r);
+  void unadvertiseRobot(RobotState& r);
+  uint32_t addChannel(const std::string& topic, const google::protobuf::Descriptor* d, WsServer::Kind kind);
+  void publishMessage(uint32_t channel, uint64_t ns, const google::protobuf::Message& m);
+  void teleop(uint64_t client, const std::string& robot, std::string_view payload);
+  void refuse(uint64_t client, const std::string& why);
+  std::string robotOfTopic(const std::string& topic) const;
+  /// The client's operator session (null once it has gone).
+  std::shared_ptr<ClientOperator> operatorOf(uint64_t client) const;
+  void stopRobot(const std::string& robot);
+
+  boost::asio::io_context& ioc_;
+  Options options_;
+  RobotRegistry& registry_;
+  CommandSink& sink_;
+  ControlArbiter& control_;
+  scene::SiteMaps& maps_;
+  scene::Geometry geometry_;
+  Console::Options console_options_;
+  ClientOperator::Configure configure_;
+  WsServer server_;
+  boost::asio::steady_timer tick_timer_, deadman_timer_;
+  std::map<std::string, uint32_t> service_ids_;  // name -> id
+
+  mutable std::mutex mu_;
+  bool stopped_ = false;
+  std::map<std::string, RobotState> robots_;
+  std::map<uint64_t, Client> clients_;
+  std::map<std::string, std::string> schemas_;  // message type -> base64 FileDescriptorSet
+};
+
+}  // namespace inspect::server::foxglove

@@ -1,0 +1,752 @@
+#include "pc_server/foxglove/ws_server.hpp"
+
+#include <openssl/crypto.h>
+
+#include <array>
+#include <chrono>
+#include <optional>
+
+#include <boost/asio/post.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/ssl.hpp>
+#include <boost/beast/websocket.hpp>
+#include <boost/beast/websocket/ssl.hpp>
+
+#include "pc_server/app/startup_error.hpp"
+#include "shared/util/log.hpp"
+
+namespace inspect::server::foxglove {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+constexpr auto kUpgradeTimeout = std::chrono::seconds(10);
+constexpr std::size_t kMaxHeaderBytes = 8192;
+constexpr const char* kTag = "foxglove";
+
+std::string endpointText(const tcp::endpoint& e) { return e.address().to_string() + ":" + std::to_string(e.port()); }
+
+/// The token of a request: `?token=...` in the target, or "Authorization: Bearer ...".
+std::string requestToken(const http::request<http::string_body>& req) {
+  const auto auth = req[http::field::authorization];
+  if (auth.starts_with("Bearer ")) return std::string(auth.substr(7));
+  const std::string_view target(req.target().data(), req.target().size());
+  const auto q = target.find('?');
+  if (q == std::string_view::npos) return "";
+  std::string_view query = target.substr(q + 1);
+  while (!query.empty()) {
+    const auto amp = query.find('&');
+    const std::string_view kv = query.substr(0, amp);
+    if (kv.starts_with("token=")) return std::string(kv.substr(6));
+    if (amp == std::string_view::npos) break;
+    query.remove_prefix(amp + 1);
+  }
+  return "";
+}
+
+bool sameSecret(const std::string& a, const std::string& b) {
+  return a.size() == b.size() && CRYPTO_memcmp(a.data(), b.data(), a.size()) == 0;
+}
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// One client: its subscriptions, its channels, its send queue. The transport
+// (plain or TLS) is the derived template below.
+
+class ClientSession : public std::enable_shared_from_this<ClientSession> {
+ public:
+  ClientSession(WsServer& server, uint64_t id, std::string peer)
+      : server_(server), id_(id), peer_(std::move(peer)), since_(Clock::now()), queue_(server.options().limits) {
+    const double rate = server.options().requests_per_s;
+    tokens_ = rate * 2;
+  }
+  virtual ~ClientSession() = default;
+  uint64_t id() const { return id_; }
+
+  /// Queues a text message (control lane); closes the client when it is that far behind.
+  void sendText(std::string json) { pushControl(OutMessage{std::move(json), nullptr, false}); }
+  void sendBinaryControl(std::string bytes) { pushControl(OutMessage{std::move(bytes), nullptr, true}); }
+
+  void deliver(uint32_t channel, WsServer::Kind kind, uint64_t ts, const std::shared_ptr<const std::string>& payload,
+               bool keyframe) {
+    {
+      std::lock_guard lk(mu_);
+      const auto it = by_channel_.find(channel);
+      if (it == by_channel_.end()) return;
+      OutMessage m{messageDataHeader(it->second, ts), payload, true};
+      if (kind == WsServer::Kind::kVideo) queue_.pushVideo(it->second, keyframe, std::move(m));
+      else queue_.pushData(std::move(m));
+      const uint64_t dropped = queue_.dropped();
+      if (dropped > warned_drops_ && Clock::now() - last_drop_warning_ > std::chrono::milliseconds(2500)) {
+        // The same text as Foxglove's own bridges: the app shows a hint for it.
+        warned_drops_ = dropped;
+        last_drop_warning_ = Clock::now();
+        queue_.pushControl(OutMessage{statusJson(StatusLevel::kWarning, "Send buffer limit reached"), nullptr, false});
+      }
+    }
+    kick();
+  }
+  bool subscribedTo(uint32_t channel) const {
+    std::lock_guard lk(mu_);
+    return by_channel_.contains(channel);
+  }
+  /// The channel went away: its subscriptions end.
+  void dropChannel(uint32_t channel) {
+    std::lock_guard lk(mu_);
+    const auto it = by_channel_.find(channel);
+    if (it == by_channel_.end()) return;
+    queue_.forgetStream(it->second);
+    subs_.erase(it->second);
+    by_channel_.erase(it);
+  }
+  WsServer::ClientInfo info(const std::map<uint32_t, std::string>& topics) const {
+    std::lock_guard lk(mu_);
+    WsServer::ClientInfo i;
+    i.id = id_;
+    i.peer = peer_;
+    i.subprotocol = subprotocol_;
+    i.connected_s = std::chrono::duration<double>(Clock::now() - since_).count();
+    for (const auto& [ch, sub] : by_channel_)
+      if (const auto t = topics.find(ch); t != topics.end()) i.subscriptions.push_back(t->second);
+    for (const auto& [cid, c] : client_channels_) i.publishing.push_back(c.topic);
+    i.queued_bytes = queue_.queuedBytes();
+    i.queued_messages = queue_.queuedMessages();
+    i.counters = queue_.counters();
+    i.refused = refused_;
+    return i;
+  }
+  /// Closes the connection (going away); safe from any thread.
+  virtual void close() = 0;
+  /// Starts the TLS handshake (if any), the HTTP upgrade and then the session.
+  virtual void start() = 0;
+
+ protected:
+  virtual void kick() = 0;  // writes the queue if no write is under way (on the strand)
+
+  void pushControl(OutMessage m) {
+    bool ok;
+    {
+      std::lock_guard lk(mu_);
+      ok = queue_.pushControl(std::move(m));
+    }
+    if (!ok) {
+      log::warn(kTag, "client ", id_, " (", peer_, ") reads nothing of its control replies: closed");
+      close();
+      return;
+    }
+    kick();
+  }
+  std::optional<OutMessage> nextOut() {
+    std::lock_guard lk(mu_);
+    return queue_.pop();
+  }
+
+  /// Checks the upgrade request; "" = fine, else the HTTP status and text to refuse with.
+  std::pair<http::status, std::string> vet(const http::request<http::string_body>& req) {
+    const auto& o = server_.options();
+    if (!websocket::is_upgrade(req))
+      return {http::status::bad_request, "this is the Foxglove WebSocket bridge: connect with a WebSocket client"};
+    if (!o.allowed_origins.empty()) {
+      const auto origin = req[http::field::origin];
+      if (!origin.empty()) {
+        bool ok = false;
+        for (const auto& a : o.allowed_origins) ok = ok || origin == a;
+        if (!ok) return {http::status::forbidden, "origin '" + std::string(origin) + "' is not allowed"};
+      }
+    }
+    if (!o.token.empty()) {
+      const std::string t = requestToken(req);
+      if (t.empty())
+        return {http::status::unauthorized, "a token is needed: ws://host:port/?token=<token> (docs/foxglove.md)"};
+      if (!sameSecret(t, o.token)) return {http::status::unauthorized, "wrong token"};
+    }
+    std::string offered;
+    for (const auto& f : req)
+      if (f.name() == http::field::sec_websocket_protocol) offered += std::string(f.value()) + ",";
+    subprotocol_ = chooseSubprotocol(offered);
+    if (subprotocol_.empty())
+      return {http::status::bad_request, "no supported subprotocol offered (foxglove.websocket.v1 or foxglove.sdk.v1)"};
+    return {http::status::ok, ""};
+  }
+
+  /// After the upgrade: the server sends serverInfo, the channels and the
+  /// services as it attaches the session (no channel is advertised twice or
+  /// before serverInfo), then the owner hears of the client.
+  void greet() {
+    server_.attach(shared_from_this());
+    server_.handler().onClientOpen(id_, peer_);
+  }
+
+  void refuse(const std::string& why, StatusLevel level = StatusLevel::kError) {
+    {
+      std::lock_guard lk(mu_);
+      ++refused_;
+    }
+    sendText(statusJson(level, why));
+  }
+
+  /// The request rate: a token bucket of `requests_per_s`, burst 2 s.
+  bool withinRate() {
+    const double rate = server_.options().requests_per_s;
+    const auto now = Clock::now();
+    tokens_ = std::min(rate * 2, tokens_ + rate * std::chrono::duration<double>(now - last_refill_).count());
+    last_refill_ = now;
+    if (tokens_ >= 1) {
+      tokens_ -= 1;
+      return true;
+    }
+    if (now - last_rate_warning_ > std::chrono::seconds(1)) {
+      last_rate_warning_ = now;
+      refuse("too many requests: more than " + std::to_string(static_cast<int>(rate)) +
+             " messages/s; messages are refused until the rate drops");
+    } else {
+      std::lock_guard lk(mu_);
+      ++refused_;
+    }
+    return false;
+  }
+
+  /// One message from the client (on the strand).
+  void onMessage(bool text, std::string_view bytes) {
+    if (!withinRate()) return;
+    const Parsed p = text ? parseClientText(bytes) : parseClientBinary(bytes);
+    if (!p.ok()) {
+      refuse(p.error);
+      return;
+    }
+    std::visit([&](const auto& m) { handle(m); }, p.message);
+  }
+
+  void handle(const Subscribe& s) {
+    for (const auto& item : s.subscriptions) {
+      std::string problem;
+      {
+        std::lock_guard lk(mu_);
+        if (subs_.contains(item.id)) problem = "subscription id " + std::to_string(item.id) + " is already in use";
+        else if (const auto c = by_channel_.find(item.channel_id); c != by_channel_.end())
+          problem = "already subscribed to channel " + std::to_string(item.channel_id) + " (subscription " +
+                    std::to_string(c->second) + ")";
+      }
+      if (problem.empty() && !server_.channelExists(item.channel_id))
+        problem = "channel " + std::to_string(item.channel_id) + " is not advertised";
+      if (!problem.empty()) {
+        refuse(problem + "; subscription ignored");
+        continue;
+      }
+      {
+        std::lock_guard lk(mu_);
+        subs_[item.id] = item.channel_id;
+        by_channel_[item.channel_id] = item.id;
+      }
+      server_.handler().onSubscribe(id_, item.channel_id);
+    }
+  }
+  void handle(const Unsubscribe& u) {
+    for (const uint32_t id : u.subscription_ids) {
+      bool known;
+      {
+        std::lock_guard lk(mu_);
+        const auto it = subs_.find(id);
+        known = it != subs_.end();
+        if (known) {
+          by_channel_.erase(it->second);
+          queue_.forgetStream(id);
+          subs_.erase(it);
+        }
+      }
+      if (!known) refuse("unsubscribe: no subscription " + std::to_string(id), StatusLevel::kWarning);
+    }
+  }
+  void handle(const ClientAdvertise& a) {
+    for (const auto& c : a.channels) {
+      std::string problem;
+      if (c.encoding != "json") problem = "encoding '" + c.encoding + "' is not supported (json)";
+      else if (c.topic.empty() || c.topic.size() > 256) problem = "topic must be 1 to 256 characters";
+      std::lock_guard lk(mu_);
+      if (problem.empty() && client_channels_.contains(c.id))
+        problem = "client channel " + std::to_string(c.id) + " is already advertised";
+      if (problem.empty() && client_channels_.size() >= 64) problem = "at most 64 client channels";
+      if (!problem.empty()) {
+        ++refused_;
+        queue_.pushControl(OutMessage{
+            statusJson(StatusLevel::kError, "advertise: channel " + std::to_string(c.id) + ": " + problem), nullptr, false});
+        continue;
+      }
+      client_channels_[c.id] = c;
+    }
+    kick();
+  }
+  void handle(const ClientUnadvertise& u) {
+    for (const uint32_t id : u.channel_ids) {
+      bool known;
+      {
+        std::lock_guard lk(mu_);
+        known = client_channels_.erase(id) > 0;
+      }
+      if (!known) refuse("unadvertise: client channel " + std::to_string(id) + " was not advertised", StatusLevel::kWarning);
+    }
+  }
+  void handle(const ClientMessageData& d) {
+    std::optional<ClientChannel> ch;
+    {
+      std::lock_guard lk(mu_);
+      if (const auto it = client_channels_.find(d.channel_id); it != client_channels_.end()) ch = it->second;
+    }
+    if (!ch) {
+      refuse("message on client channel " + std::to_string(d.channel_id) + ", which this client did not advertise");
+      return;
+    }
+    server_.handler().onClientMessage(id_, *ch, d.payload);
+  }
+  void handle(const ServiceCallRequest& r) {
+    Service s;
+    if (!server_.findService(r.service_id, s)) {
+      {
+        std::lock_guard lk(mu_);
+        ++refused_;
+      }
+      sendText(serviceCallFailureJson(r.service_id, r.call_id, "no service " + std::to_string(r.service_id)));
+      return;
+    }
+    if (r.encoding != "json") {
+      {
+        std::lock_guard lk(mu_);
+        ++refused_;
+      }
+      sendText(serviceCallFailureJson(r.service_id, r.call_id,
+                                      "encoding '" + r.encoding.substr(0, 32) + "' is not supported (json)"));
+      return;
+    }
+    server_.handler().onServiceCall(id_, s, r.call_id, r.payload);
+  }
+  void handle(const UnsupportedOp& u) {
+    refuse("op '" + u.op + "' needs the capability '" + u.capability + "', which this server does not offer");
+  }
+
+  WsServer& server_;
+  const uint64_t id_;
+  const std::string peer_;
+  const Clock::time_point since_;
+  std::string subprotocol_;
+  mutable std::mutex mu_;
+  SendQueue queue_;
+  std::map<uint32_t, uint32_t> subs_;        // subscription id -> channel
+  std::map<uint32_t, uint32_t> by_channel_;  // channel -> subscription id
+  std::map<uint32_t, ClientChannel> client_channels_;
+  uint64_t refused_ = 0;
+  uint64_t warned_drops_ = 0;
+  Clock::time_point last_drop_warning_{};
+  // the rate limit (strand only)
+  double tokens_ = 0;
+  Clock::time_point last_refill_ = Clock::now();
+  Clock::time_point last_rate_warning_{};
+};
+
+template <class NextLayer>
+class Session final : public ClientSession {
+ public:
+  template <class... Args>
+  Session(WsServer& server, uint64_t id, std::string peer, Args&&... args)
+      : ClientSession(server, id, std::move(peer)), ws_(std::forward<Args>(args)...) {}
+
+  void start() override {
+    if constexpr (kTls) {
+      beast::get_lowest_layer(ws_).expires_after(kUpgradeTimeout);
+      ws_.next_layer().async_handshake(asio::ssl::stream_base::server,
+                                       [self = self()](beast::error_code ec) {
+                                         if (ec) {
+                                           log::info(kTag, "client ", self->peer_, ": TLS handshake failed: ", ec.message());
+                                           self->server_.noteRefused();
+                                           return;
+                                         }
+                                         self->readRequest();
+                                       });
+    } else {
+      readRequest();
+    }
+  }
+
+  void close() override {
+    asio::post(ws_.get_executor(), [self = self()] {
+      if (self->closing_ || !self->open_) {
+        beast::error_code ignored;
+        beast::get_lowest_layer(self->ws_).socket().close(ignored);
+        return;
+      }
+      self->closing_ = true;
+      self->ws_.async_close(websocket::close_code::going_away, [self](beast::error_code) {});
+    });
+  }
+
+ private:
+  static constexpr bool kTls = !std::is_same_v<NextLayer, beast::tcp_stream>;
+  std::shared_ptr<Session> self() { return std::static_pointer_cast<Session>(shared_from_this()); }
+
+  void readRequest() {
+    beast::get_lowest_layer(ws_).expires_after(kUpgradeTimeout);
+    parser_.emplace();
+    parser_->header_limit(kMaxHeaderBytes);
+    parser_->body_limit(0);
+    http::async_read(ws_.next_layer(), buffer_, *parser_, [self = self()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        log::info(kTag, "client ", self->peer_, ": no WebSocket upgrade: ", ec.message());
+        self->server_.noteRefused();
+        return;
+      }
+      self->onRequest(self->parser_->release());
+    });
+  }
+
+  void onRequest(http::request<http::string_body> req) {
+    const auto [status, why] = vet(req);
+    if (status != http::status::ok) {
+      log::warn(kTag, "client ", peer_, " refused: ", why);
+      server_.noteRefused();
+      auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
+      res->set(http::field::content_type, "text/plain");
+      res->set(http::field::connection, "close");
+      res->body() = why + "\n";
+      res->prepare_payload();
+      http::async_write(ws_.next_layer(), *res, [self = self(), res](beast::error_code, std::size_t) {
+        beast::error_code ignored;
+        beast::get_lowest_layer(self->ws_).socket().shutdown(tcp::socket::shutdown_both, ignored);
+        beast::get_lowest_layer(self->ws_).socket().close(ignored);
+      });
+      return;
+    }
+    beast::get_lowest_layer(ws_).expires_never();
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.set_option(websocket::stream_base::decorator([p = subprotocol_](websocket::response_type& res) {
+      res.set(http::field::sec_websocket_protocol, p);
+      res.set(http::field::server, "inspect pc_server");
+    }));
+    ws_.read_message_max(server_.options().max_message_bytes);
+    ws_.auto_fragment(false);
+    ws_.async_accept(req, [self = self()](beast::error_code ec) {
+      if (ec) {
+        log::info(kTag, "client ", self->peer_, ": WebSocket accept failed: ", ec.message());
+        return;
+      }
+      self->open_ = true;
+      log::info(kTag, "client ", self->id_, " (", self->peer_, ") connected (", self->subprotocol_, ")");
+      self->greet();
+      self->doRead();
+    });
+  }
+
+  void doRead() {
+    ws_.async_read(in_, [self = self()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        self->finish(ec);
+        return;
+      }
+      const auto data = self->in_.cdata();
+      const std::string_view bytes(static_cast<const char*>(data.data()), data.size());
+      self->onMessage(self->ws_.got_text(), bytes);
+      self->in_.consume(self->in_.size());
+      self->doRead();
+    });
+  }
+
+  void kick() override {
+    asio::post(ws_.get_executor(), [self = self()] { self->doWrite(); });
+  }
+  void doWrite() {
+    if (writing_ || !open_ || closing_) return;
+    auto m = nextOut();
+    if (!m) return;
+    writing_ = true;
+    out_ = std::move(*m);
+    ws_.binary(out_.binary);
+    const std::array<asio::const_buffer, 2> bufs{asio::buffer(out_.head),
+                                                 out_.body ? asio::buffer(*out_.body) : asio::const_buffer()};
+    ws_.async_write(bufs, [self = self()](beast::error_code ec, std::size_t) {
+      self->writing_ = false;
+      self->out_ = {};
+      if (ec) {
+        self->finish(ec);
+        return;
+      }
+      self->doWrite();
+    });
+  }
+
+  void finish(const beast::error_code& ec) {
+    if (finished_) return;
+    finished_ = true;
+    if (ec != websocket::error::closed && ec != asio::error::operation_aborted)
+      log::info(kTag, "client ", id_, " (", peer_, ") gone: ", ec.message());
+    else
+      log::info(kTag, "client ", id_, " (", peer_, ") closed");
+    beast::error_code ignored;
+    beast::get_lowest_layer(ws_).socket().close(ignored);
+    if (open_) {
+      open_ = false;
+      server_.detach(id_);
+    }
+  }
+
+  websocket::stream<NextLayer> ws_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+  beast::flat_buffer in_;
+  OutMessage out_;
+  bool open_ = false, writing_ = false, closing_ = false, finished_ = false;
+};
+
+// ---------------------------------------------------------------------------
+
+const std::vector<std::string>& WsServer::capabilities() {
+  static const std::vector<std::string> caps{"clientPublish", "services"};
+  return caps;
+}
+
+WsServer::WsServer(asio::io_context& ioc, Options options, Handler& handler)
+    : ioc_(ioc), options_(std::move(options)), handler_(handler), acceptor_(asio::make_strand(ioc)) {
+  session_id_ = std::to_string(
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+}
+
+WsServer::~WsServer() { stop(); }
+
+tcp::endpoint WsServer::listen() {
+  beast::error_code ec;
+  const auto addr = asio::ip::make_address(options_.bind, ec);
+  if (ec) throw StartupError("foxglove: bind address '" + options_.bind + "' is not a numeric IP address");
+  const tcp::endpoint ep(addr, options_.port);
+  const std::string where = options_.bind + ":" + std::to_string(options_.port);
+  acceptor_.open(ep.protocol(), ec);
+  if (!ec) acceptor_.set_option(asio::socket_base::reuse_address(true), ec);
+  if (!ec) acceptor_.bind(ep, ec);
+  if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec)
+    throw StartupError("foxglove: cannot listen on " + where + ": " + ec.message() +
+                       (ec == asio::error::address_in_use ? " (another program uses the port; --foxglove-port or --no-foxglove)"
+                                                          : ""));
+  doAccept();
+  const auto bound = acceptor_.local_endpoint();
+  options_.port = bound.port();  // the report shows the port in use (0 asked for any)
+  return bound;
+}
+
+void WsServer::doAccept() {
+  acceptor_.async_accept(asio::make_strand(ioc_), [this](beast::error_code ec, tcp::socket socket) {
+    if (ec) {
+      if (ec == asio::error::operation_aborted) return;
+      log::warn(kTag, "accept: ", ec.message());
+    } else {
+      beast::error_code e2;
+      const auto remote = socket.remote_endpoint(e2);
+      const std::string peer = e2 ? std::string("?") : endpointText(remote);
+      socket.set_option(tcp::no_delay(true), e2);
+      bool full;
+      {
+        std::lock_guard lk(mu_);
+        full = stopped_ || static_cast<int>(sessions_.size()) >= options_.max_clients;
+      }
+      if (full) {
+        log::warn(kTag, "client ", peer, " refused: ", options_.max_clients, " clients connected already");
+        noteRefused();
+        socket.close(e2);
+      } else {
+        const uint64_t id = nextClientId();
+        std::shared_ptr<ClientSession> s;
+        if (options_.tls)
+          s = std::make_shared<Session<beast::ssl_stream<beast::tcp_stream>>>(*this, id, peer, std::move(socket),
+                                                                               *options_.tls);
+        else
+          s = std::make_shared<Session<beast::tcp_stream>>(*this, id, peer, std::move(socket));
+        s->start();
+      }
+    }
+    bool stopped;
+    {
+      std::lock_guard lk(mu_);
+      stopped = stopped_;
+    }
+    if (!stopped) doAccept();
+  });
+}
+
+void WsServer::stop() {
+  std::map<uint64_t, std::shared_ptr<ClientSession>> sessions;
+  {
+    std::lock_guard lk(mu_);
+    if (stopped_) return;
+    stopped_ = true;
+    sessions = sessions_;
+  }
+  asio::post(acceptor_.get_executor(), [this] {
+    beast::error_code ignored;
+    acceptor_.close(ignored);
+  });
+  for (auto& [id, s] : sessions) s->close();
+}
+
+uint32_t WsServer::addChannel(Channel channel, Kind kind) {
+  std::vector<std::shared_ptr<ClientSession>> all;
+  {
+    std::lock_guard lk(mu_);
+    channel.id = next_channel_++;
+    channels_[channel.id] = {channel, kind};
+    for (auto& [id, s] : sessions_) all.push_back(s);
+  }
+  const std::string msg = advertiseJson({channel});
+  for (auto& s : all) s->sendText(msg);
+  return channel.id;
+}
+
+void WsServer::removeChannel(uint32_t id) {
+  std::vector<std::shared_ptr<ClientSession>> all;
+  {
+    std::lock_guard lk(mu_);
+    if (channels_.erase(id) == 0) return;
+    for (auto& [cid, s] : sessions_) all.push_back(s);
+  }
+  const std::string msg = unadvertiseJson({id});
+  for (auto& s : all) {
+    s->dropChannel(id);
+    s->sendText(msg);
+  }
+}
+
+uint32_t WsServer::addService(Service service) {
+  std::vector<std::shared_ptr<ClientSession>> all;
+  {
+    std::lock_guard lk(mu_);
+    service.id = next_service_++;
+    services_[service.id] = service;
+    for (auto& [id, s] : sessions_) all.push_back(s);
+  }
+  const std::string msg = advertiseServicesJson({service});
+  for (auto& s : all) s->sendText(msg);
+  return service.id;
+}
+
+void WsServer::publish(uint32_t channel, uint64_t timestamp_ns, std::shared_ptr<const std::string> payload,
+                       bool keyframe) {
+  std::vector<std::shared_ptr<ClientSession>> subs;
+  Kind kind;
+  {
+    std::lock_guard lk(mu_);
+    const auto c = channels_.find(channel);
+    if (c == channels_.end()) return;
+    kind = c->second.kind;
+    for (auto& [id, s] : sessions_)
+      if (s->subscribedTo(channel)) subs.push_back(s);
+  }
+  for (auto& s : subs) s->deliver(channel, kind, timestamp_ns, payload, keyframe);
+}
+
+bool WsServer::subscribed(uint32_t channel) const {
+  std::lock_guard lk(mu_);
+  for (const auto& [id, s] : sessions_)
+    if (s->subscribedTo(channel)) return true;
+  return false;
+}
+
+void WsServer::respond(uint64_t client, uint32_t service_id, uint32_t call_id, std::string json) {
+  if (auto s = find(client)) s->sendBinaryControl(serviceCallResponse(service_id, call_id, "json", json));
+}
+
+void WsServer::failCall(uint64_t client, uint32_t service_id, uint32_t call_id, const std::string& message) {
+  if (auto s = find(client)) s->sendText(serviceCallFailureJson(service_id, call_id, message));
+}
+
+void WsServer::status(uint64_t client, StatusLevel level, const std::string& message) {
+  std::vector<std::shared_ptr<ClientSession>> to;
+  {
+    std::lock_guard lk(mu_);
+    for (auto& [id, s] : sessions_)
+      if (client == 0 || id == client) to.push_back(s);
+  }
+  const std::string msg = statusJson(level, message);
+  for (auto& s : to) s->sendText(msg);
+}
+
+std::vector<WsServer::ClientInfo> WsServer::clients() const {
+  std::vector<std::shared_ptr<ClientSession>> all;
+  std::map<uint32_t, std::string> topics;
+  {
+    std::lock_guard lk(mu_);
+    for (const auto& [id, s] : sessions_) all.push_back(s);
+    for (const auto& [id, c] : channels_) topics[id] = c.channel.topic;
+  }
+  std::vector<ClientInfo> out;
+  for (const auto& s : all) out.push_back(s->info(topics));
+  return out;
+}
+
+std::vector<Channel> WsServer::channelList() const {
+  std::lock_guard lk(mu_);
+  std::vector<Channel> out;
+  for (const auto& [id, c] : channels_) out.push_back(c.channel);
+  return out;
+}
+
+std::vector<Service> WsServer::serviceList() const {
+  std::lock_guard lk(mu_);
+  std::vector<Service> out;
+  for (const auto& [id, s] : services_) out.push_back(s);
+  return out;
+}
+
+bool WsServer::findService(uint32_t id, Service& out) const {
+  std::lock_guard lk(mu_);
+  const auto it = services_.find(id);
+  if (it == services_.end()) return false;
+  out = it->second;
+  return true;
+}
+
+bool WsServer::channelExists(uint32_t id, Kind* kind) const {
+  std::lock_guard lk(mu_);
+  const auto it = channels_.find(id);
+  if (it == channels_.end()) return false;
+  if (kind) *kind = it->second.kind;
+  return true;
+}
+
+void WsServer::attach(const std::shared_ptr<ClientSession>& s) {
+  bool stopped;
+  {
+    // Under the lock: a channel added meanwhile is either in this list or
+    // advertised to the session after it (addChannel copies the sessions under it).
+    std::lock_guard lk(mu_);
+    stopped = stopped_;
+    if (!stopped) {
+      sessions_[s->id()] = s;
+      s->sendText(serverInfoJson(options_.name, capabilities(), {"json"}, session_id_));
+      std::vector<Channel> channels;
+      for (const auto& [id, c] : channels_) channels.push_back(c.channel);
+      s->sendText(advertiseJson(channels));
+      std::vector<Service> services;
+      for (const auto& [id, sv] : services_) services.push_back(sv);
+      if (!services.empty()) s->sendText(advertiseServicesJson(services));
+    }
+  }
+  if (stopped) s->close();
+}
+
+void WsServer::detach(uint64_t client) {
+  {
+    std::lock_guard lk(mu_);
+    if (sessions_.erase(client) == 0) return;
+  }
+  handler_.onClientClose(client);
+}
+
+std::shared_ptr<ClientSession> WsServer::find(uint64_t client) const {
+  std::lock_guard lk(mu_);
+  const auto it = sessions_.find(client);
+  return it == sessions_.end() ? nullptr : it->second;
+}
+
+}  // namespace inspect::server::foxglove

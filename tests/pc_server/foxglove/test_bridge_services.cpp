@@ -1,0 +1,55 @@
+// The bridge's services (pc_server/foxglove/bridge_services): JSON requests
+// become console lines; every bad argument is named.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "pc_server/foxglove/bridge_services.hpp"
+
+using namespace inspect::server::foxglove;
+
+TEST(BridgeServices, EveryServiceHasValidSchemas) {
+  const auto& defs = serviceDefs();
+  EXPECT_GE(defs.size(), 10u);
+  for (const auto& d : defs) {
+    const auto s = nlohmann::json::parse(d.request_schema, nullptr, false);
+    EXPECT_FALSE(s.is_discarded()) << d.name << ": " << d.request_schema;
+    EXPECT_EQ(s["type"], "object") << d.name;
+    EXPECT_TRUE(s["properties"].contains("robot")) << d.name;
+    EXPECT_EQ(toService(d).response_schema, responseSchema());
+  }
+  EXPECT_FALSE(nlohmann::json::parse(responseSchema(), nullptr, false).is_discarded());
+}
+
+TEST(BridgeServices, RequestsBecomeConsoleLines) {
+  auto r = parseServiceRequest("/goto", R"({"x": 1.5, "y": -2, "speed": 0.3, "robot": "robot2"})");
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.line, "goto 1.5 -2 0.3");
+  EXPECT_EQ(r.robot, "robot2");
+  EXPECT_FALSE(r.immediate);
+  r = parseServiceRequest("/stop", "");
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.line, "stop");
+  EXPECT_TRUE(r.immediate);
+  EXPECT_TRUE(parseServiceRequest("/estop", "{}").immediate);
+  EXPECT_EQ(parseServiceRequest("/inspect", R"({"route": "gas_lab_inspection"})").line, "inspect gas_lab_inspection");
+  EXPECT_EQ(parseServiceRequest("/control_take", R"({"force": true})").line, "control take force");
+  EXPECT_EQ(parseServiceRequest("/record_start", R"({"name": "night round B"})").line, "record start night round B");
+  EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status"})").line, "status");
+}
+
+TEST(BridgeServices, NamesWhatIsWrong) {
+  EXPECT_EQ(parseServiceRequest("/goto", "{").error, "/goto: the request is not valid JSON");
+  EXPECT_EQ(parseServiceRequest("/goto", "[]").error, "/goto: the request must be a JSON object");
+  EXPECT_EQ(parseServiceRequest("/goto", R"({"y": 1})").error, "/goto: missing \"x\" (a number)");
+  EXPECT_EQ(parseServiceRequest("/goto", R"({"x": "1", "y": 1})").error, "/goto: \"x\" must be a number");
+  EXPECT_EQ(parseServiceRequest("/route", R"({"route": "a b"})").error,
+            "/route: \"route\" must be one word (1-200 printable characters, no spaces or #)");
+  EXPECT_EQ(parseServiceRequest("/stop", R"({"robot": 3})").error, "/stop: \"robot\" must be a string");
+  EXPECT_EQ(parseServiceRequest("/control_take", R"({"force": "yes"})").error,
+            "/control_take: \"force\" must be true or false");
+  EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status\nestop"})").error,
+            "/console: \"command\" must be one line without control characters");
+  EXPECT_EQ(parseServiceRequest("/record_start", R"({"name": "a # b"})").error,
+            "/record_start: \"name\" must be text of 1-200 printable characters without #");
+}
