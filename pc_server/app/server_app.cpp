@@ -246,8 +246,8 @@ int runServer(const CliOptions& options) {
     fo.max_w_rad_s = copt.max_w_rad_s;
     bridge = std::make_unique<foxglove::FoxgloveBridge>(ioc, fo, registry, link, control, site_maps, geometry, copt,
                                                         configure);
+    const auto ep = bridge->start();  // a failure here leaves no pointer to a destroyed bridge
     bridge_ptr = bridge.get();
-    const auto ep = bridge->start();
     const std::string url = std::string(fc.tls ? "wss" : "ws") + "://" + (fc.bind == "0.0.0.0" ? "<this-host>" : fc.bind) +
                             ":" + std::to_string(ep.port()) + "/";
     std::cout << "pc_server: Foxglove WebSocket on " << url

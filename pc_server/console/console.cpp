@@ -84,7 +84,7 @@ bool Console::execute(const std::string& raw_line, int line_no) {
 }
 
 std::string Console::background() {
-  sink_.consoleAlive();
+  if (options_.feeds_watchdog) sink_.consoleAlive();
   std::string s;
   if (selected_.empty()) {
     if (auto first = registry_.firstConnected(); !first.empty()) {

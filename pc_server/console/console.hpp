@@ -37,6 +37,12 @@ class Console {
     double ack_pump_period_s = 0.05;  // waiting for a command's Ack: status and events printed this often
     double max_v_m_s = 1.0;        // drive limits (the keyboard gauge uses the same)
     double max_w_rad_s = 2.0;
+    // A Foxglove client's session (pc_server/foxglove): its teleop is the
+    // Teleop panel's (set-points that lapse), so `drive` (re-sent until stop)
+    // is refused; and it does not vouch for the server's console thread (the
+    // link's console watchdog listens to the consoles operators type in).
+    bool allow_drive = true;
+    bool feeds_watchdog = true;
   };
   /// Runs keyboard teleop on the selected robot until the operator leaves; false on failure.
   using TeleopHandler = std::function<bool(KeyboardTeleop::Mode mode, const std::string& robot_id)>;

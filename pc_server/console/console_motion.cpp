@@ -16,6 +16,9 @@
 namespace inspect::server {
 
 bool Console::cmdDrive(const Args& args, const std::string&, int) {
+  if (!options_.allow_drive)
+    return fail("drive", "not from a Foxglove session: publish geometry_msgs/Twist on /<robot>/cmd_vel (the Teleop "
+                         "panel; a set-point lapses 0.5 s after the last, docs/foxglove.md)");
   if (args.size() != 2) return fail("drive", "needs two numbers: drive <v_m_s> <w_rad_s>");
   const auto v = parseNumber(args[0]);
   if (!v) return fail("drive", "'" + args[0] + "' is not a number");

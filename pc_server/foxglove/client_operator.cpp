@@ -10,7 +10,10 @@ ClientOperator::ClientOperator(const std::string& who, RobotRegistry& registry, 
                                ControlArbiter& control, const Console::Options& options, const Configure& configure)
     : registry_(registry), sink_(sink), control_(control), session_(control.openSession(who)),
       name_(control.sessionName(session_)) {
-  console_ = std::make_unique<Console>(registry_, sink_, out_, stop_, options);
+  Console::Options o = options;
+  o.allow_drive = false;      // teleop from a client is its Teleop panel's, with the deadman
+  o.feeds_watchdog = false;   // the link's console watchdog is the typed consoles'
+  console_ = std::make_unique<Console>(registry_, sink_, out_, stop_, o);
   console_->setSession(&control_, session_);
   console_->eventsFromNow();
   if (configure) configure(*console_);

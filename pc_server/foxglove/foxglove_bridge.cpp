@@ -1,5 +1,6 @@
 #include "pc_server/foxglove/foxglove_bridge.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -57,14 +58,18 @@ void FoxgloveBridge::stop() {
     stopped_ = true;
     clients.swap(clients_);
   }
-  asio::post(ioc_, [this] {
-    tick_timer_.cancel();
-    deadman_timer_.cancel();
-  });
+  // The timers see stopped_ at their next expiry and end their chains.
   server_.stop();
   for (auto& [id, c] : clients)
-    if (!c.teleop_robot.empty()) stopRobot(c.teleop_robot);
+    if (!c.teleop_robot.empty() && c.op) stopIfHeld(c.teleop_robot, c.op->session());
   clients.clear();  // the sessions end (outside the lock: their workers may be finishing a call)
+  std::vector<Reaper> reapers;
+  {
+    std::lock_guard lk(mu_);
+    reapers.swap(reapers_);
+  }
+  for (auto& r : reapers)
+    if (r.thread.joinable()) r.thread.join();
 }
 
 uint32_t FoxgloveBridge::addChannel(const std::string& topic, const google::protobuf::Descriptor* d,
@@ -113,11 +118,12 @@ void FoxgloveBridge::onEnvelope(const std::string& robot, const v1::Envelope& en
   if (stopped_) return;
   auto [it, fresh] = robots_.try_emplace(robot);
   RobotState& r = it->second;
-  if (!r.scene) {
-    r.scene = std::make_unique<scene::RobotScene>(robot, geometry_);
+  if (!r.scene) r.scene = std::make_unique<scene::RobotScene>(robot, geometry_);
+  if (!r.connected) {
+    // A (re)connected robot: its Hello (gas channels, inlet) as the registry has it.
     if (const auto snap = registry_.snapshot(robot, monoNowNs())) r.scene->onHello(snap->hello);
+    advertiseRobot(robot, r);
   }
-  if (!r.connected) advertiseRobot(robot, r);
   if (!inbound) {
     if (env.has_command()) r.scene->onCommand(env.command());
     return;
@@ -208,7 +214,8 @@ void FoxgloveBridge::deadman() {
     }
   }
   for (const auto& [client, robot] : lapsed) {
-    stopRobot(robot);
+    const auto op = operatorOf(client);
+    if (!op || !stopIfHeld(robot, op->session())) continue;
     server_.status(client, StatusLevel::kInfo,
                    "teleop: no set-point for " + util::fmtShort(options_.teleop_timeout_s) + " s; " + robot + " stopped");
   }
@@ -222,6 +229,14 @@ void FoxgloveBridge::stopRobot(const std::string& robot) {
   v1::Command stop;
   stop.mutable_stop();
   if (sink_.sendCommand(robot, stop) == 0) sink_.clearTeleop(robot);
+}
+
+bool FoxgloveBridge::stopIfHeld(const std::string& robot, uint64_t session) {
+  // A robot another session has taken over since is that session's to stop, not ours.
+  const auto h = control_.holder(robot);
+  if (!h || h->session != session) return false;
+  stopRobot(robot);
+  return true;
 }
 
 void FoxgloveBridge::onClientOpen(uint64_t client, const std::string& peer) {
@@ -242,9 +257,22 @@ void FoxgloveBridge::onClientClose(uint64_t client) {
     clients_.erase(it);
   }
   // A client that drove a robot and went away leaves it stopped.
-  if (!c.teleop_robot.empty()) stopRobot(c.teleop_robot);
-  // Ends the session (a command waiting for its Ack is interrupted at once).
-  c.op.reset();
+  if (!c.teleop_robot.empty() && c.op) stopIfHeld(c.teleop_robot, c.op->session());
+  // Ends the session off the io thread: a command of it may still run (a
+  // report, an export); waits for an Ack end at once. stop() joins these.
+  auto done = std::make_shared<std::atomic<bool>>(false);
+  std::thread t([op = std::move(c.op), done]() mutable {
+    op.reset();
+    *done = true;
+  });
+  std::lock_guard lk(mu_);
+  // Those of earlier clients that have finished are joined (at once) and forgotten.
+  std::erase_if(reapers_, [](Reaper& r) {
+    if (!*r.done) return false;
+    r.thread.join();
+    return true;
+  });
+  reapers_.push_back({std::move(t), std::move(done)});
 }
 
 void FoxgloveBridge::onSubscribe(uint64_t, uint32_t channel) {
@@ -338,6 +366,12 @@ void FoxgloveBridge::teleop(uint64_t client, const std::string& topic_robot, std
   }
   const auto d = control_.authorizeMotion(robot, op->session(), monoNowNs());
   if (!d.allowed) {
+    {
+      // Another session holds the robot: this client drives nothing, its deadman has nothing to stop.
+      std::lock_guard lk(mu_);
+      if (const auto it = clients_.find(client); it != clients_.end() && it->second.teleop_robot == robot)
+        it->second.teleop_robot.clear();
+    }
     refuse(client, "teleop refused: " + d.reason);
     return;
   }
@@ -367,8 +401,14 @@ void FoxgloveBridge::onServiceCall(uint64_t client, const Service& service, uint
   const auto op = operatorOf(client);
   if (!op) return;
   if (req.immediate) {
-    // Stop and e-stop never wait behind another call of the session, and need no control.
-    std::string robot = req.robot.empty() ? op->selected() : req.robot;
+    // Stop and e-stop never wait behind another call of the session, and need
+    // no control. Without a robot named: the one this client drives, else its selected one.
+    std::string robot = req.robot;
+    if (robot.empty()) {
+      std::lock_guard lk(mu_);
+      if (const auto it = clients_.find(client); it != clients_.end()) robot = it->second.teleop_robot;
+    }
+    if (robot.empty()) robot = op->selected();
     if (robot.empty()) robot = registry_.firstConnected();
     v1::Command c;
     if (req.line == "estop") c.mutable_estop();

@@ -4,6 +4,7 @@
 // protocol, and from the clients teleop set-points and service calls, each
 // client an operator session of its own (it observes until it takes control;
 // stop and e-stop always work; teleop lapses when the client stops sending).
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -12,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <boost/asio/io_context.hpp>
@@ -98,6 +100,8 @@ class FoxgloveBridge : public WsServer::Handler {
   /// The client's operator session (null once it has gone).
   std::shared_ptr<ClientOperator> operatorOf(uint64_t client) const;
   void stopRobot(const std::string& robot);
+  /// Stops `robot` if `session` still holds its control; false (nothing sent) otherwise.
+  bool stopIfHeld(const std::string& robot, uint64_t session);
 
   boost::asio::io_context& ioc_;
   Options options_;
@@ -117,6 +121,12 @@ class FoxgloveBridge : public WsServer::Handler {
   std::map<std::string, RobotState> robots_;
   std::map<uint64_t, Client> clients_;
   std::map<std::string, std::string> schemas_;  // message type -> base64 FileDescriptorSet
+  /// Threads ending the sessions of clients that left (never joined on an io thread).
+  struct Reaper {
+    std::thread thread;
+    std::shared_ptr<std::atomic<bool>> done;
+  };
+  std::vector<Reaper> reapers_;
 };
 
 }  // namespace inspect::server::foxglove

@@ -63,6 +63,21 @@ void SendQueue::pushVideo(uint32_t stream, bool keyframe, OutMessage m) {
   ++counters_.queued;
 }
 
+void SendQueue::forgetStream(uint32_t stream) {
+  need_keyframe_.erase(stream);
+  if (stream == 0) return;
+  std::erase_if(data_, [&](const OutMessage& m) {
+    if (m.subscription != stream) return false;
+    data_bytes_ -= m.bytes();
+    return true;
+  });
+  std::erase_if(video_, [&](const VideoItem& v) {
+    if (v.stream != stream) return false;
+    video_bytes_ -= v.m.bytes();
+    return true;
+  });
+}
+
 std::optional<OutMessage> SendQueue::pop() {
   std::optional<OutMessage> out;
   if (!control_.empty()) {

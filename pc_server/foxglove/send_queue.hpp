@@ -22,6 +22,7 @@ struct OutMessage {
   std::string head;
   std::shared_ptr<const std::string> body;  // may be null
   bool binary = false;
+  uint32_t subscription = 0;  // message data: the client's subscription (0: control)
   std::size_t bytes() const { return head.size() + (body ? body->size() : 0); }
 };
 
@@ -54,8 +55,9 @@ class SendQueue {
   /// subscription waits for the next keyframe (queued frames of that
   /// subscription are dropped too when a keyframe needs their room).
   void pushVideo(uint32_t stream, bool keyframe, OutMessage m);
-  /// Forget a subscription's keyframe state (unsubscribed).
-  void forgetStream(uint32_t stream) { need_keyframe_.erase(stream); }
+  /// A subscription ended (unsubscribed, its channel gone): its queued
+  /// messages are dropped (the client no longer knows its id) and its keyframe state forgotten.
+  void forgetStream(uint32_t stream);
 
   /// The next message to write: control, then data, then video.
   std::optional<OutMessage> pop();

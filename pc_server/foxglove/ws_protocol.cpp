@@ -48,6 +48,9 @@ uint32_t idOf(const Json& v, const std::string& what) {
 const Json& arrayField(const Json& obj, const char* name, const std::string& op) {
   const Json& a = field(obj, name, op);
   if (!a.is_array()) throw Bad{op + ": \"" + name + "\" must be an array"};
+  if (a.size() > kMaxItemsPerMessage)
+    throw Bad{op + ": \"" + name + "\" has " + std::to_string(a.size()) + " items, at most " +
+              std::to_string(kMaxItemsPerMessage)};
   return a;
 }
 std::string stringField(const Json& obj, const char* name, const std::string& where) {

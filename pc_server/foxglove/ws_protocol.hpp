@@ -102,6 +102,9 @@ struct UnsupportedOp {
   std::string capability;
 };
 
+/// Longest list a client message may carry (subscriptions, ids, channels).
+inline constexpr std::size_t kMaxItemsPerMessage = 1024;
+
 using ClientMessage = std::variant<Subscribe, Unsubscribe, ClientAdvertise, ClientUnadvertise, ClientMessageData,
                                    ServiceCallRequest, UnsupportedOp>;
 

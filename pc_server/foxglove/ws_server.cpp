@@ -67,8 +67,13 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
     const double rate = server.options().requests_per_s;
     tokens_ = rate * 2;
   }
-  virtual ~ClientSession() = default;
+  virtual ~ClientSession() { endHandshake(); }
   uint64_t id() const { return id_; }
+  /// The connection is past its upgrade (served or refused): it no longer counts as setting up.
+  void endHandshake() {
+    if (!handshaking_.exchange(false)) return;
+    server_.handshakeEnded();
+  }
 
   /// Queues a text message (control lane); closes the client when it is that far behind.
   void sendText(std::string json) { pushControl(OutMessage{std::move(json), nullptr, false}); }
@@ -80,7 +85,7 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
       std::lock_guard lk(mu_);
       const auto it = by_channel_.find(channel);
       if (it == by_channel_.end()) return;
-      OutMessage m{messageDataHeader(it->second, ts), payload, true};
+      OutMessage m{messageDataHeader(it->second, ts), payload, true, it->second};
       if (kind == WsServer::Kind::kVideo) queue_.pushVideo(it->second, keyframe, std::move(m));
       else queue_.pushData(std::move(m));
       const uint64_t dropped = queue_.dropped();
@@ -184,6 +189,20 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
     server_.handler().onClientOpen(id_, peer_);
   }
 
+  /// One status for the problems of one message (the first three, and how many more).
+  void refuseAll(const std::string& op, const std::vector<std::string>& problems,
+                 StatusLevel level = StatusLevel::kError) {
+    if (problems.empty()) return;
+    std::string text = op + ": ";
+    for (std::size_t i = 0; i < problems.size() && i < 3; ++i) text += (i ? "; " : "") + problems[i];
+    if (problems.size() > 3) text += "; and " + std::to_string(problems.size() - 3) + " more";
+    {
+      std::lock_guard lk(mu_);
+      refused_ += problems.size() - 1;  // refuse() counts one
+    }
+    refuse(text, level);
+  }
+
   void refuse(const std::string& why, StatusLevel level = StatusLevel::kError) {
     {
       std::lock_guard lk(mu_);
@@ -215,8 +234,18 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
 
   /// One message from the client (on the strand).
   void onMessage(bool text, std::string_view bytes) {
-    if (!withinRate()) return;
     const Parsed p = text ? parseClientText(bytes) : parseClientBinary(bytes);
+    // Stop and e-stop are never refused for the rate: a flood must not keep a robot moving.
+    bool urgent = false;
+    if (const auto* call = std::get_if<ServiceCallRequest>(&p.message); call && p.ok()) {
+      Service sv;
+      urgent = server_.findService(call->service_id, sv) && (sv.name == "/stop" || sv.name == "/estop");
+    }
+    if (!urgent && !withinRate()) {
+      if (const auto* call = std::get_if<ServiceCallRequest>(&p.message); call && p.ok())
+        sendText(serviceCallFailureJson(call->service_id, call->call_id, "too many requests: call refused"));
+      return;
+    }
     if (!p.ok()) {
       refuse(p.error);
       return;
@@ -225,6 +254,7 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
   }
 
   void handle(const Subscribe& s) {
+    std::vector<std::string> problems;
     for (const auto& item : s.subscriptions) {
       std::string problem;
       {
@@ -237,7 +267,7 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
       if (problem.empty() && !server_.channelExists(item.channel_id))
         problem = "channel " + std::to_string(item.channel_id) + " is not advertised";
       if (!problem.empty()) {
-        refuse(problem + "; subscription ignored");
+        problems.push_back(problem + "; subscription ignored");
         continue;
       }
       {
@@ -247,51 +277,49 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
       }
       server_.handler().onSubscribe(id_, item.channel_id);
     }
+    if (problems.size() == 1) refuse(problems[0]);
+    else refuseAll("subscribe", problems);
   }
   void handle(const Unsubscribe& u) {
+    std::vector<std::string> problems;
     for (const uint32_t id : u.subscription_ids) {
-      bool known;
-      {
-        std::lock_guard lk(mu_);
-        const auto it = subs_.find(id);
-        known = it != subs_.end();
-        if (known) {
-          by_channel_.erase(it->second);
-          queue_.forgetStream(id);
-          subs_.erase(it);
-        }
+      std::lock_guard lk(mu_);
+      const auto it = subs_.find(id);
+      if (it == subs_.end()) {
+        problems.push_back("no subscription " + std::to_string(id));
+        continue;
       }
-      if (!known) refuse("unsubscribe: no subscription " + std::to_string(id), StatusLevel::kWarning);
+      by_channel_.erase(it->second);
+      queue_.forgetStream(id);
+      subs_.erase(it);
     }
+    refuseAll("unsubscribe", problems, StatusLevel::kWarning);
   }
   void handle(const ClientAdvertise& a) {
+    std::vector<std::string> problems;
     for (const auto& c : a.channels) {
       std::string problem;
-      if (c.encoding != "json") problem = "encoding '" + c.encoding + "' is not supported (json)";
+      if (c.encoding != "json") problem = "encoding '" + c.encoding.substr(0, 32) + "' is not supported (json)";
       else if (c.topic.empty() || c.topic.size() > 256) problem = "topic must be 1 to 256 characters";
       std::lock_guard lk(mu_);
       if (problem.empty() && client_channels_.contains(c.id))
         problem = "client channel " + std::to_string(c.id) + " is already advertised";
       if (problem.empty() && client_channels_.size() >= 64) problem = "at most 64 client channels";
       if (!problem.empty()) {
-        ++refused_;
-        queue_.pushControl(OutMessage{
-            statusJson(StatusLevel::kError, "advertise: channel " + std::to_string(c.id) + ": " + problem), nullptr, false});
+        problems.push_back("channel " + std::to_string(c.id) + ": " + problem);
         continue;
       }
       client_channels_[c.id] = c;
     }
-    kick();
+    refuseAll("advertise", problems);
   }
   void handle(const ClientUnadvertise& u) {
+    std::vector<std::string> problems;
     for (const uint32_t id : u.channel_ids) {
-      bool known;
-      {
-        std::lock_guard lk(mu_);
-        known = client_channels_.erase(id) > 0;
-      }
-      if (!known) refuse("unadvertise: client channel " + std::to_string(id) + " was not advertised", StatusLevel::kWarning);
+      std::lock_guard lk(mu_);
+      if (client_channels_.erase(id) == 0) problems.push_back("client channel " + std::to_string(id) + " was not advertised");
     }
+    refuseAll("unadvertise", problems, StatusLevel::kWarning);
   }
   void handle(const ClientMessageData& d) {
     std::optional<ClientChannel> ch;
@@ -341,6 +369,7 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
   std::map<uint32_t, uint32_t> by_channel_;  // channel -> subscription id
   std::map<uint32_t, ClientChannel> client_channels_;
   uint64_t refused_ = 0;
+  std::atomic<bool> handshaking_{true};
   uint64_t warned_drops_ = 0;
   Clock::time_point last_drop_warning_{};
   // the rate limit (strand only)
@@ -364,6 +393,7 @@ class Session final : public ClientSession {
                                          if (ec) {
                                            log::info(kTag, "client ", self->peer_, ": TLS handshake failed: ", ec.message());
                                            self->server_.noteRefused();
+                                           self->endHandshake();
                                            return;
                                          }
                                          self->readRequest();
@@ -398,6 +428,7 @@ class Session final : public ClientSession {
       if (ec) {
         log::info(kTag, "client ", self->peer_, ": no WebSocket upgrade: ", ec.message());
         self->server_.noteRefused();
+        self->endHandshake();
         return;
       }
       self->onRequest(self->parser_->release());
@@ -409,6 +440,7 @@ class Session final : public ClientSession {
     if (status != http::status::ok) {
       log::warn(kTag, "client ", peer_, " refused: ", why);
       server_.noteRefused();
+      endHandshake();
       auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
       res->set(http::field::content_type, "text/plain");
       res->set(http::field::connection, "close");
@@ -430,6 +462,7 @@ class Session final : public ClientSession {
     ws_.read_message_max(server_.options().max_message_bytes);
     ws_.auto_fragment(false);
     ws_.async_accept(req, [self = self()](beast::error_code ec) {
+      self->endHandshake();
       if (ec) {
         log::info(kTag, "client ", self->peer_, ": WebSocket accept failed: ", ec.message());
         return;
@@ -509,7 +542,8 @@ const std::vector<std::string>& WsServer::capabilities() {
 }
 
 WsServer::WsServer(asio::io_context& ioc, Options options, Handler& handler)
-    : ioc_(ioc), options_(std::move(options)), handler_(handler), acceptor_(asio::make_strand(ioc)) {
+    : ioc_(ioc), options_(std::move(options)), handler_(handler), acceptor_(asio::make_strand(ioc)),
+      accept_retry_(acceptor_.get_executor()) {
   session_id_ = std::to_string(
       std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
@@ -540,7 +574,18 @@ void WsServer::doAccept() {
   acceptor_.async_accept(asio::make_strand(ioc_), [this](beast::error_code ec, tcp::socket socket) {
     if (ec) {
       if (ec == asio::error::operation_aborted) return;
-      log::warn(kTag, "accept: ", ec.message());
+      // Out of descriptors (EMFILE) and the like: try again in a moment, not in a busy loop.
+      log::warn(kTag, "accept: ", ec.message(), "; retrying in 100 ms");
+      accept_retry_.expires_after(std::chrono::milliseconds(100));
+      accept_retry_.async_wait([this](const beast::error_code& e) {
+        bool stopped;
+        {
+          std::lock_guard lk(mu_);
+          stopped = stopped_;
+        }
+        if (!e && !stopped) doAccept();
+      });
+      return;
     } else {
       beast::error_code e2;
       const auto remote = socket.remote_endpoint(e2);
@@ -548,15 +593,17 @@ void WsServer::doAccept() {
       socket.set_option(tcp::no_delay(true), e2);
       bool full;
       {
+        // Clients served and connections still setting up (not authenticated yet) count alike.
         std::lock_guard lk(mu_);
-        full = stopped_ || static_cast<int>(sessions_.size()) >= options_.max_clients;
+        full = stopped_ || static_cast<int>(sessions_.size()) + handshaking_.load() >= options_.max_clients;
       }
       if (full) {
-        log::warn(kTag, "client ", peer, " refused: ", options_.max_clients, " clients connected already");
+        log::warn(kTag, "client ", peer, " refused: ", options_.max_clients, " clients connected or connecting already");
         noteRefused();
         socket.close(e2);
       } else {
         const uint64_t id = nextClientId();
+        ++handshaking_;
         std::shared_ptr<ClientSession> s;
         if (options_.tls)
           s = std::make_shared<Session<beast::ssl_stream<beast::tcp_stream>>>(*this, id, peer, std::move(socket),
@@ -586,6 +633,7 @@ void WsServer::stop() {
   asio::post(acceptor_.get_executor(), [this] {
     beast::error_code ignored;
     acceptor_.close(ignored);
+    accept_retry_.cancel();
   });
   for (auto& [id, s] : sessions) s->close();
 }

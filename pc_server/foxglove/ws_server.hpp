@@ -19,6 +19,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/ssl/context.hpp>
 
 #include "pc_server/foxglove/send_queue.hpp"
@@ -122,6 +123,7 @@ class WsServer {
   Handler& handler() { return handler_; }
   std::string sessionId() const { return session_id_; }
   void noteRefused() { ++refused_connections_; }
+  void handshakeEnded() { --handshaking_; }
   uint64_t nextClientId() { return next_client_.fetch_add(1); }
 
  private:
@@ -133,6 +135,8 @@ class WsServer {
   Handler& handler_;
   std::string session_id_;
   boost::asio::ip::tcp::acceptor acceptor_;
+  boost::asio::steady_timer accept_retry_;
+  std::atomic<int> handshaking_{0};  // connections accepted, not yet served or refused
   std::atomic<uint64_t> next_client_{1};
   std::atomic<uint64_t> refused_connections_{0};
   mutable std::mutex mu_;

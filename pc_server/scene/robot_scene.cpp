@@ -122,8 +122,9 @@ std::string fmt(double v, int digits = 2) {
 
 /// A colour scale from clean air (blue) through the low alarm (yellow) to the high one (red).
 std::array<uint8_t, 3> gasColor(double v, const v1::GasChannelInfo& ch) {
-  const double lo = ch.falling() ? ch.range_max() : ch.background();
-  const double hi = ch.alarm_high() != 0 ? ch.alarm_high() : (ch.range_max() > lo ? ch.range_max() : lo + 1);
+  // Clean air at 0, the HIGH threshold at 1, for rising and falling (O2) channels alike.
+  const double lo = ch.background();
+  const double hi = ch.alarm_high() != lo ? ch.alarm_high() : (ch.range_max() > lo ? ch.range_max() : lo + 1);
   double u = (v - lo) / (hi - lo);
   if (!std::isfinite(u)) u = 0;
   u = std::clamp(u, 0.0, 1.0);
@@ -195,6 +196,11 @@ void RobotScene::addGas(const v1::Telemetry& t, double t_s) {
   const double x = t.pose().x_m() + c * ix - s * iy, y = t.pose().y_m() + s * ix + c * iy;
   for (std::size_t i = 0; i < channels_.size() && static_cast<int>(i) < t.gas_size(); ++i) {
     Channel& ch = channels_[i];
+    if (!ch.window.empty() && t_s < ch.window.back().t_s) {
+      // The robot's clock started again (robot_client restarted): a new series, the map kept.
+      ch.window.clear();
+      ch.last_sample_s = -1;
+    }
     if (ch.last_sample_s >= 0 && t_s - ch.last_sample_s < kGasSamplePeriodS && t_s >= ch.last_sample_s) continue;
     ch.last_sample_s = t_s;
     ch.window.push_back({t_s, x, y, t.gas(static_cast<int>(i))});
@@ -253,22 +259,25 @@ void RobotScene::onEvent(const v1::Event& e, uint64_t) {
 
 ::foxglove::SceneUpdate RobotScene::scene(uint64_t ns) const {
   ::foxglove::SceneUpdate u;
-  // The site map, in the world frame.
-  if (map_) {
+  // The site map, in the world frame: always sent (empty without a map), so a
+  // map that is taken away or changed leaves nothing of the old one drawn.
+  {
     auto* walls = entity(u, "map/walls", "map", ns);
-    for (const auto& s : map_->walls) addWall(walls, s, kWallHeightM, 0.06, {0.72, 0.72, 0.76, 0.9});
     auto* obst = entity(u, "map/obstacles", "map", ns);
-    for (const auto& s : map_->obstacles) addWall(obst, s, kObstacleHeightM, 0.04, {0.55, 0.42, 0.30, 0.95});
-    if (!map_->floor_lines.empty()) {
-      auto* fl = entity(u, "map/floor_lines", "map", ns);
-      auto* l = fl->add_lines();
-      l->set_type(::foxglove::LinePrimitive::LINE_LIST);
-      setPose(l->mutable_pose(), 0, 0, 0.005);
-      l->set_thickness(0.03);
-      setColor(l->mutable_color(), 0.1, 0.1, 0.1, 1);
-      for (const auto& s : map_->floor_lines) {
-        addPoint(l, s.a.x, s.a.y, 0);
-        addPoint(l, s.b.x, s.b.y, 0);
+    auto* fl = entity(u, "map/floor_lines", "map", ns);
+    if (map_) {
+      for (const auto& s : map_->walls) addWall(walls, s, kWallHeightM, 0.06, {0.72, 0.72, 0.76, 0.9});
+      for (const auto& s : map_->obstacles) addWall(obst, s, kObstacleHeightM, 0.04, {0.55, 0.42, 0.30, 0.95});
+      if (!map_->floor_lines.empty()) {
+        auto* l = fl->add_lines();
+        l->set_type(::foxglove::LinePrimitive::LINE_LIST);
+        setPose(l->mutable_pose(), 0, 0, 0.005);
+        l->set_thickness(0.03);
+        setColor(l->mutable_color(), 0.1, 0.1, 0.1, 1);
+        for (const auto& s : map_->floor_lines) {
+          addPoint(l, s.a.x, s.a.y, 0);
+          addPoint(l, s.b.x, s.b.y, 0);
+        }
       }
     }
   }

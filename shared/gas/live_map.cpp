@@ -32,9 +32,12 @@ bool LiveConcentrationMap::cover(double x_min, double y_min, double x_max, doubl
     y_max = std::max(y_max, cy1);
   }
   const double nx0 = snap_down(x_min), ny0 = snap_down(y_min);
-  const auto ncols = static_cast<std::size_t>(std::llround((snap_up(x_max) - nx0) / cell_m_));
-  const auto nrows = static_cast<std::size_t>(std::llround((snap_up(y_max) - ny0) / cell_m_));
-  if (ncols * nrows > o_.max_cells) return false;
+  const double wc = (snap_up(x_max) - nx0) / cell_m_, hc = (snap_up(y_max) - ny0) / cell_m_;
+  // Each side first: far-off positions must not wrap the product round.
+  const auto cap = static_cast<double>(o_.max_cells);
+  if (!(wc >= 1 && hc >= 1) || wc > cap || hc > cap || wc * hc > cap) return false;
+  const auto ncols = static_cast<std::size_t>(std::llround(wc));
+  const auto nrows = static_cast<std::size_t>(std::llround(hc));
   std::vector<double> w(ncols * nrows, 0.0), wv(ncols * nrows, 0.0);
   if (cols_ > 0) {
     const auto ox = static_cast<std::size_t>(std::llround((x0_ - nx0) / cell_m_));

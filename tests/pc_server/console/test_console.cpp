@@ -822,3 +822,32 @@ TEST(LineReader, ALineOverTheLimitIsDroppedAndReportedOnce) {
   EXPECT_EQ(reader.nextLine(line, 1000), LineReader::Result::kEof);
   ::close(fds[0]);
 }
+
+// A Foxglove client's session (Options allow_drive / feeds_watchdog off): its
+// teleop is the Teleop panel's, whose set-points lapse; `drive` would be
+// re-sent until stop. And it does not vouch for the console thread.
+TEST(ConsoleFoxgloveSession, RefusesDriveAndDoesNotFeedTheWatchdog) {
+  StopFlag stop;
+  ManualClock clock(stop);
+  RobotRegistry registry;
+  FakeSink sink(registry, clock);
+  std::ostringstream out;
+  Console::Options o;
+  o.allow_drive = false;
+  o.feeds_watchdog = false;
+  Console c(registry, sink, out, stop, o);
+  c.setClock(clock);
+  v1::Hello h;
+  h.set_robot_id("robot1");
+  registry.onConnected("robot1", "127.0.0.1:1", kSerial, h, clock.nowNs());
+  (void)c.background();
+  EXPECT_EQ(sink.alive_calls, 0);
+  EXPECT_FALSE(c.execute("drive 0.3 0", 1));
+  EXPECT_NE(out.str().find("drive: not from a Foxglove session: publish geometry_msgs/Twist on /<robot>/cmd_vel"),
+            std::string::npos)
+      << out.str();
+  EXPECT_FALSE(sink.teleop_active);
+  EXPECT_FALSE(c.execute("try drive 0.3 0", 2) && sink.teleop_active);
+  EXPECT_FALSE(sink.teleop_active);
+  EXPECT_TRUE(c.execute("stop", 3));  // stop always works
+}

@@ -74,3 +74,18 @@ TEST(SendQueue, RefusesControlPastItsLimit) {
   EXPECT_EQ(popHead(q), "a");
   EXPECT_TRUE(q.pushControl(msg("b", 30)));
 }
+
+TEST(SendQueue, AnEndedSubscriptionLeavesNothingQueued) {
+  SendQueue q;
+  OutMessage a = msg("a1"), b = msg("b1");
+  a.subscription = 1;
+  b.subscription = 2;
+  q.pushData(a);
+  q.pushData(b);
+  q.pushVideo(1, true, msg("a-key"));
+  q.forgetStream(1);  // unsubscribed: the client no longer knows id 1
+  EXPECT_EQ(q.queuedMessages(), 1u);
+  EXPECT_EQ(popHead(q), "b1");
+  EXPECT_TRUE(q.empty());
+  EXPECT_EQ(q.queuedBytes(), 0u);
+}

@@ -5,6 +5,7 @@
 // does not hold up the others.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <thread>
 
@@ -179,23 +180,29 @@ TEST(WsServer, AClientThatNeverReadsDoesNotHoldUpTheOthers) {
   for (int i = 0; i < 100 && s.handler.subscribed < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   ASSERT_EQ(s.handler.subscribed, 2);
   const auto payload = std::make_shared<const std::string>(std::string(16 * 1024, 'x'));
-  int received = 0;
-  // 2000 messages of 16 KiB (32 MiB): far more than the slow client's socket buffers and queue hold.
+  std::atomic<int> received{0};
+  // 2000 messages of 16 KiB (32 MiB): far more than the slow client's socket
+  // buffers and queue hold. The publisher stays at most 100 messages ahead of
+  // the good client (so that it, however slow this machine, never overflows).
   std::thread reader([&] {
-    for (int i = 0; i < 2000; ++i) {
-      if (good.read().size() != 1 + 13 + payload->size()) break;
-      ++received;
+    for (int i = 0; i < 4000 && received < 2000; ++i) {
+      const std::string m = good.read();
+      if (m.rfind("error", 0) == 0) break;
+      if (m.size() == 1 + 13 + payload->size()) ++received;  // (status texts are not data)
     }
   });
-  const auto t0 = std::chrono::steady_clock::now();
+  double longest_publish_ms = 0;
   for (int i = 0; i < 2000; ++i) {
+    for (int k = 0; k < 5000 && i - received > 100; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const auto t0 = std::chrono::steady_clock::now();
     s.ws->publish(a, static_cast<uint64_t>(i), payload);
-    if (i % 50 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    longest_publish_ms =
+        std::max(longest_publish_ms, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
-  const double publish_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   reader.join();
-  EXPECT_EQ(received, 2000);  // the good client got everything (its reader keeps up)
-  EXPECT_LT(publish_s, 5.0);  // publish() never waited for the slow client (bounded, not a timing target)
+  EXPECT_EQ(received, 2000);  // the good client got everything
+  // publish() queues and returns; it never waits for the slow client's socket (bounded, not a timing target).
+  EXPECT_LT(longest_publish_ms, 1000.0);
   uint64_t slow_drops = 0;
   for (const auto& c : s.ws->clients()) slow_drops = std::max(slow_drops, c.counters.dropped_data);
   EXPECT_GT(slow_drops, 0u);  // the slow client's drops are counted

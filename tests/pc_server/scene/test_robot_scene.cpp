@@ -191,3 +191,42 @@ TEST(RobotScene, EventsAsLogLines) {
   e.set_kind(v1::Event::MODE_CHANGE);
   EXPECT_EQ(RobotScene::log("robot1", e, 0).level(), ::foxglove::Log::INFO);
 }
+
+TEST(RobotScene, TheGasMapGoesOnAcrossARestartedRobotClockAndCleanAirIsBlue) {
+  RobotScene s("robot1", Geometry{});
+  s.onHello(sceneHello());
+  for (int i = 0; i < 40; ++i) s.onTelemetry(sceneTelemetry(10.0 + i * 0.05, 0, 0.0), 0);  // clean air
+  // robot_client restarted: its clock counts from 0 again, the robot 2 m on.
+  for (int i = 0; i < 40; ++i) s.onTelemetry(sceneTelemetry(i * 0.05, 2, 15.0), 0);
+  const auto g = s.grid("CH4", 0);
+  ASSERT_TRUE(g.has_value());
+  const auto at = [&](double x, double y) {
+    const auto c = static_cast<std::size_t>((x - g->pose().position().x()) / g->cell_size().x());
+    const auto r = static_cast<std::size_t>((y - g->pose().position().y()) / g->cell_size().y());
+    return r * g->row_stride() + c * 8;
+  };
+  float before = 0, after = 0;
+  std::memcpy(&before, g->data().data() + at(0, 0.3), 4);
+  std::memcpy(&after, g->data().data() + at(2, 0.3), 4);
+  EXPECT_NEAR(before, 0.0, 1e-3);
+  EXPECT_NEAR(after, 15.0, 1e-3);  // mapped after the restart
+  // Clean air (the channel's background, 0 here) is blue.
+  const auto* cell = g->data().data() + at(0, 0.3);
+  EXPECT_GT(static_cast<uint8_t>(cell[6]), static_cast<uint8_t>(cell[4]));
+}
+
+TEST(RobotScene, AMapTakenAwayLeavesEmptyMapEntities) {
+  RobotScene s("robot1", Geometry{});
+  SiteMap m;
+  m.walls = {{{0, 0}, {4, 0}}};
+  s.setMap(m);
+  s.setMap(std::nullopt);
+  const auto u = s.scene(0);
+  bool walls = false;
+  for (const auto& e : u.entities())
+    if (e.id() == "map/walls") {
+      walls = true;
+      EXPECT_EQ(e.cubes_size(), 0);
+    }
+  EXPECT_TRUE(walls);  // sent empty: replaces the old walls in the client
+}
