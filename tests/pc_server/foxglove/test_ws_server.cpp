@@ -12,10 +12,14 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/ssl.hpp>
+#include <boost/beast/websocket/ssl.hpp>
 #include <boost/beast/websocket.hpp>
 #include <nlohmann/json.hpp>
 
 #include "pc_server/foxglove/ws_server.hpp"
+#include "shared/net/tls.hpp"
+#include "tests/support/test_certs.hpp"
 
 using namespace inspect::server::foxglove;
 namespace asio = boost::asio;
@@ -206,4 +210,32 @@ TEST(WsServer, AClientThatNeverReadsDoesNotHoldUpTheOthers) {
   uint64_t slow_drops = 0;
   for (const auto& c : s.ws->clients()) slow_drops = std::max(slow_drops, c.counters.dropped_data);
   EXPECT_GT(slow_drops, 0u);  // the slow client's drops are counted
+}
+
+TEST(WsServer, ServesWssWithTheServersCertificateAndTheToken) {
+  const std::string certs = inspect::test::testCertsDir();
+  WsServer::Options o;
+  o.token = "0123456789abcdef0123";
+  o.tls = inspect::net::makeTlsContext({"", certs + "/server.pem", certs + "/server.key"},
+                                       inspect::net::TlsRole::kWebServer);
+  Server s(o);
+  // A browser-like client: verifies the server against the CA, presents no certificate.
+  asio::io_context ioc;
+  asio::ssl::context ctx(asio::ssl::context::tls_client);
+  ctx.load_verify_file(certs + "/ca.pem");
+  ctx.set_verify_mode(asio::ssl::verify_peer);
+  websocket::stream<beast::ssl_stream<tcp::socket>> ws(ioc, ctx);
+  beast::get_lowest_layer(ws).connect({asio::ip::make_address("127.0.0.1"), s.port});
+  const timeval tv{5, 0};
+  ::setsockopt(beast::get_lowest_layer(ws).native_handle(), SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  ws.next_layer().handshake(asio::ssl::stream_base::client);
+  ws.set_option(websocket::stream_base::decorator(
+      [](websocket::request_type& r) { r.set(beast::http::field::sec_websocket_protocol, "foxglove.sdk.v1"); }));
+  ws.handshake("127.0.0.1", "/?token=" + o.token);
+  beast::flat_buffer b;
+  ws.read(b);
+  const auto info = Json::parse(beast::buffers_to_string(b.data()), nullptr, false);
+  EXPECT_EQ(info["op"], "serverInfo");
+  // Plain WebSocket to the TLS port gets no upgrade.
+  EXPECT_EQ(upgradeStatus(s.port, "/?token=" + o.token), -1);
 }
