@@ -6,7 +6,7 @@
 // to a second client, an unauthenticated client refused, bad input answered.
 //
 //   node tests/tools/foxglove_client.js --modules DIR --url ws://127.0.0.1:PORT/ --token T
-//        --truth robot1-truth.csv [--robot robot1] [--seconds 6] [--json FILE]
+//        --truth robot1-truth.csv [--robot robot1] [--seconds 6] [--layout LAYOUT.json] [--json FILE]
 //
 // Prints a table and, with --json, the same figures; exit status 1 when a
 // check fails (each failure is printed), 2 on a setup error.
@@ -232,6 +232,22 @@ async function main() {
                    "/control_take", "/control_release"])
     check(a.services.has(s), `no service ${s}`);
   a.subscribeAll();
+  // The shipped layout (config/foxglove/inspect_live.json) names only topics and services the bridge serves.
+  if (args.layout) {
+    const names = new Set();
+    const walk = (v) => {
+      if (typeof v === "string" && v.startsWith(`/${robot}/`)) names.add(v.split(".")[0]);
+      else if (v && typeof v === "object") for (const [k, x] of Object.entries(v)) (walk(k), walk(x));
+    };
+    walk(JSON.parse(fs.readFileSync(args.layout, "utf8")));
+    const topics = new Set([...a.channels.values()].map((c) => c.topic));
+    for (const n of names)
+      check(topics.has(n) || n === `/${robot}/cmd_vel` || n.startsWith(`/${robot}/gas/`), `layout names ${n}, which the bridge does not advertise`);
+    const layout = JSON.parse(fs.readFileSync(args.layout, "utf8"));
+    for (const [id, cfg] of Object.entries(layout.configById ?? {}))
+      if (id.startsWith("CallService") && cfg.serviceName) check(a.services.has(cfg.serviceName), `layout calls ${cfg.serviceName}, no such service`);
+    figures.layout_topics = names.size;
+  }
   const t0 = Date.now();
   await sleep(seconds * 1000);
   const t1 = Date.now();

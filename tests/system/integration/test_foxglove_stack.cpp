@@ -33,6 +33,7 @@ TEST(FoxgloveStack, ClientLibraryDecodesDrivesCallsAndIsRefused) {
   const std::string url = "ws://127.0.0.1:" + std::to_string(s.foxglovePort()) + "/";
   auto node = Process::spawn({"/usr/bin/env", "node", srcPath("tests/tools/foxglove_client.js"), "--modules", reader, "--url", url,
                               "--token", s.foxgloveToken(), "--truth", r.truth, "--robot", "robot1", "--seconds", "6",
+                              "--layout", srcPath("config/foxglove/inspect_live.json"),
                               "--json", s.dir() / "foxglove.json"},
                              s.dir() / "node.out", s.dir() / "node.err");
   const auto status = node.wait(100.0);
