@@ -9,11 +9,6 @@
 namespace inspect::arena {
 
 namespace {
-double wrapPi(double a) {
-  while (a > std::numbers::pi) a -= 2 * std::numbers::pi;
-  while (a < -std::numbers::pi) a += 2 * std::numbers::pi;
-  return a;
-}
 constexpr double kDeg = std::numbers::pi / 180.0;
 }  // namespace
 
@@ -26,7 +21,7 @@ behavior::Pattern truePattern(const control::Pose2& robot, const TruePerson& p, 
   const double c = std::cos(robot.theta_rad), s = std::sin(robot.theta_rad);
   const double ahead = c * dx + s * dy, lateral = -s * dx + c * dy;
   if (ahead <= 0.0 || std::hypot(ahead, lateral) > t.max_range_m) return Pattern::kNone;
-  const double phi = std::fabs(wrapPi(std::atan2(p.velocity.y, p.velocity.x) - robot.theta_rad)) / kDeg;
+  const double phi = std::fabs(control::wrapAngle(std::atan2(p.velocity.y, p.velocity.x) - robot.theta_rad)) / kDeg;
   if (phi > t.crossing_min_deg && phi < t.crossing_max_deg) return Pattern::kCrossing;
   const double side = std::fabs(lateral);
   if (side > t.max_lateral_m) return Pattern::kNone;
@@ -45,7 +40,7 @@ bool observable(const control::Pose2& robot, const TruePerson& p, const config::
     if (near > sonar.max_range_m) continue;
     // The disc reaches into the cone when its centre's bearing is within the
     // half beam plus the half angle the disc subtends.
-    const double bearing = std::fabs(wrapPi(std::atan2(dy, dx) - at.theta_rad));
+    const double bearing = std::fabs(control::wrapAngle(std::atan2(dy, dx) - at.theta_rad));
     const double subtends = d > p.radius_m ? std::asin(p.radius_m / d) : std::numbers::pi;
     if (bearing > sonar.beam_width_rad / 2 + subtends) continue;
     // Nothing solid in between (along the line to the centre, up to the disc's near side).

@@ -131,13 +131,13 @@ void FoxgloveBridge::onEnvelope(const std::string& robot, const v1::Envelope& en
   switch (env.body_case()) {
     case v1::Envelope::kHello: r.scene->onHello(env.hello()); break;
     case v1::Envelope::kTelemetry:
-      r.scene->onTelemetry(env.telemetry(), ns);
+      r.scene->onTelemetry(env.telemetry());
       publishMessage(r.ch.telemetry, ns, env.telemetry());
       if (server_.subscribed(r.ch.tf)) publishMessage(r.ch.tf, ns, r.scene->transforms(ns));
       break;
     case v1::Envelope::kEvent: {
       const auto& e = env.event();
-      r.scene->onEvent(e, ns);
+      r.scene->onEvent(e);
       publishMessage(r.ch.events, ns, e);
       if (server_.subscribed(r.ch.log)) publishMessage(r.ch.log, ns, scene::RobotScene::log(robot, e, ns));
       if (e.has_gas_alarm()) publishMessage(r.ch.alarms, ns, e.gas_alarm());
@@ -280,18 +280,15 @@ void FoxgloveBridge::onSubscribe(uint64_t, uint32_t channel) {
   std::string robot;
   {
     std::lock_guard lk(mu_);
-    for (auto& [id, r] : robots_)
-      if (r.connected && r.ch.camera == channel) robot = id;
+    for (auto& [id, r] : robots_) {
+      if (!r.connected || r.ch.camera != channel) continue;
+      const auto now = SteadyClock::now();
+      if (now - r.keyframe_asked < std::chrono::seconds(1)) return;
+      r.keyframe_asked = now;
+      robot = id;
+    }
   }
   if (robot.empty()) return;
-  static std::mutex kf_mu;
-  static std::map<std::string, SteadyClock::time_point> last;
-  {
-    std::lock_guard lk(kf_mu);
-    auto& t = last[robot];
-    if (SteadyClock::now() - t < std::chrono::seconds(1)) return;
-    t = SteadyClock::now();
-  }
   v1::Command c;
   c.mutable_video()->set_keyframe(true);
   sink_.sendCommand(robot, std::move(c));

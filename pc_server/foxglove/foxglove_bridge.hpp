@@ -79,6 +79,7 @@ class FoxgloveBridge : public WsServer::Handler {
     uint64_t map_version = 0;
     bool connected = false;
     std::chrono::steady_clock::time_point last_grid{};
+    std::chrono::steady_clock::time_point keyframe_asked{};  // for a new video subscriber, at most once a second
   };
   struct Client {
     std::shared_ptr<ClientOperator> op;

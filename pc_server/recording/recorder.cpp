@@ -354,7 +354,7 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
           r.gains_known = true;
         }
         r.mcap.write(r.ch_telemetry, log_ns, publish_ns, env.telemetry());
-        r.scene->onTelemetry(env.telemetry(), log_ns);
+        r.scene->onTelemetry(env.telemetry());
         writeScene(r, robot, log_ns, true);
         break;
       case v1::Envelope::kCommand:
@@ -364,7 +364,7 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
       case v1::Envelope::kAck: r.mcap.write(r.ch_ack, log_ns, publish_ns, env.ack()); break;
       case v1::Envelope::kEvent:
         r.mcap.write(r.ch_event, log_ns, publish_ns, env.event());
-        r.scene->onEvent(env.event(), log_ns);
+        r.scene->onEvent(env.event());
         r.mcap.write(r.ch_log, log_ns, log_ns, scene::RobotScene::log(robot, env.event(), log_ns));
         if (env.event().kind() == v1::Event::GAINS_APPLIED && env.event().has_gains()) {
           // New gains during the run: the catalog keeps the latest set and counts the changes.

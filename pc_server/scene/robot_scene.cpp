@@ -183,11 +183,10 @@ void RobotScene::onHello(const v1::Hello& hello) {
   for (const auto& ch : hello.gas_channels()) channels_.push_back({ch, gas::LiveConcentrationMap(o), {}, -1});
 }
 
-void RobotScene::onTelemetry(const v1::Telemetry& t, uint64_t wall_ns) {
+void RobotScene::onTelemetry(const v1::Telemetry& t) {
   last_ = t;
   have_telemetry_ = true;
   addGas(t, static_cast<double>(t.robot_time_us()) * 1e-6);
-  (void)wall_ns;
 }
 
 void RobotScene::addGas(const v1::Telemetry& t, double t_s) {
@@ -221,7 +220,7 @@ void RobotScene::onCommand(const v1::Command& c) {
   }
 }
 
-void RobotScene::onEvent(const v1::Event& e, uint64_t) {
+void RobotScene::onEvent(const v1::Event& e) {
   if (!e.has_gas_alarm()) return;
   if (e.kind() != v1::Event::ALARM_RAISED && e.kind() != v1::Event::ALARM_CLEARED) return;
   auto& a = alarms_[e.gas_alarm().id()];

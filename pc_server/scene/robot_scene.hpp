@@ -35,15 +35,16 @@ struct World;
 
 namespace inspect::server::scene {
 
-/// The robot's body and sensors as drawn.
+/// The robot's body and sensors as drawn (defaults: config/robot.yaml's).
 struct Geometry {
-  double body_radius_m = 0.35;
+  double body_radius_m = config::RobotGeometry{}.body_radius_m;
   double body_height_m = 0.45;
   std::array<config::UltrasonicMount, 4> sonars = config::UltrasonicConfig{}.mounts;
-  double sonar_beam_rad = 0.52;
-  double sonar_max_m = 4.5;
+  double sonar_beam_rad = config::UltrasonicConfig{}.beam_width_rad;
+  double sonar_max_m = config::UltrasonicConfig{}.max_range_m;
   double sonar_z_m = 0.25;
-  double camera_x_m = 0.20, camera_y_m = 0.0, camera_z_m = 0.60;  // config::CameraMount
+  double camera_x_m = config::CameraMount{}.x_m, camera_y_m = config::CameraMount{}.y_m,
+         camera_z_m = config::CameraMount{}.z_m;
 };
 Geometry geometryOf(const config::RobotConfig& c);
 
@@ -71,12 +72,12 @@ class RobotScene {
   void setMap(std::optional<SiteMap> map);
   bool hasMap() const { return map_.has_value(); }
   void onHello(const v1::Hello& hello);
-  /// A telemetry message received at `wall_ns` (Unix ns).
-  void onTelemetry(const v1::Telemetry& t, uint64_t wall_ns);
+  /// A telemetry message (its robot time paces the gas map).
+  void onTelemetry(const v1::Telemetry& t);
   /// A command sent to the robot (routes and goals are drawn).
   void onCommand(const v1::Command& c);
   /// A robot event (alarm markers).
-  void onEvent(const v1::Event& e, uint64_t wall_ns);
+  void onEvent(const v1::Event& e);
   bool hasTelemetry() const { return have_telemetry_; }
 
   ::foxglove::FrameTransforms transforms(uint64_t ns) const;

@@ -63,7 +63,7 @@ TEST(RobotScene, TransformsChainMapOdomBaseSensorsCamera) {
   m.start_theta_rad = std::numbers::pi;
   s.setMap(m);
   s.onHello(sceneHello());
-  s.onTelemetry(sceneTelemetry(1.0, 0.5, 0), 0);
+  s.onTelemetry(sceneTelemetry(1.0, 0.5, 0));
   const auto f = s.transforms(1'500'000'000);
   const auto* odom = find(f, "robot1/odom");
   ASSERT_NE(odom, nullptr);
@@ -105,7 +105,7 @@ TEST(RobotScene, DrawsTheMapRobotSonarsPeopleRouteAndAlarms) {
   p->set_dwell_s(10);
   g->add_points()->set_x_m(4);
   s.onCommand(c);
-  s.onTelemetry(sceneTelemetry(1.0, 0.5, 0), 0);
+  s.onTelemetry(sceneTelemetry(1.0, 0.5, 0));
   v1::Event e;
   e.set_kind(v1::Event::ALARM_RAISED);
   e.mutable_gas_alarm()->set_id(9);
@@ -114,7 +114,7 @@ TEST(RobotScene, DrawsTheMapRobotSonarsPeopleRouteAndAlarms) {
   e.mutable_gas_alarm()->set_value(25);
   e.mutable_gas_alarm()->set_unit("%LEL");
   e.mutable_gas_alarm()->mutable_pose()->set_x_m(1.5);
-  s.onEvent(e, 0);
+  s.onEvent(e);
   const auto u = s.scene(2'000'000'000);
   std::map<std::string, const ::foxglove::SceneEntity*> by;
   for (const auto& x : u.entities()) by[x.id()] = &x;
@@ -143,7 +143,7 @@ TEST(RobotScene, DrawsTheMapRobotSonarsPeopleRouteAndAlarms) {
   EXPECT_EQ(alarms.texts(0).text(), "CH4 HIGH 25.0 %LEL");
   e.set_kind(v1::Event::ALARM_CLEARED);
   e.mutable_gas_alarm()->mutable_pose()->set_x_m(3);  // cleared elsewhere: the marker stays where it was raised
-  s.onEvent(e, 0);
+  s.onEvent(e);
   const auto u2 = s.scene(0);
   for (const auto& x : u2.entities())
     if (x.id() == "gas/alarms") {
@@ -156,7 +156,7 @@ TEST(RobotScene, GasGridHasTheReadingsWhereTheInletWas) {
   RobotScene s("robot1", Geometry{});
   s.onHello(sceneHello());
   EXPECT_TRUE(s.gridChannels().empty());
-  for (int i = 0; i < 100; ++i) s.onTelemetry(sceneTelemetry(i * 0.05, 0, 15.0), 0);  // standing still: 15 %LEL
+  for (int i = 0; i < 100; ++i) s.onTelemetry(sceneTelemetry(i * 0.05, 0, 15.0));  // standing still: 15 %LEL
   ASSERT_EQ(s.gridChannels(), std::vector<std::string>{"CH4"});
   const auto g = s.grid("CH4", 0);
   ASSERT_TRUE(g.has_value());
@@ -195,9 +195,9 @@ TEST(RobotScene, EventsAsLogLines) {
 TEST(RobotScene, TheGasMapGoesOnAcrossARestartedRobotClockAndCleanAirIsBlue) {
   RobotScene s("robot1", Geometry{});
   s.onHello(sceneHello());
-  for (int i = 0; i < 40; ++i) s.onTelemetry(sceneTelemetry(10.0 + i * 0.05, 0, 0.0), 0);  // clean air
+  for (int i = 0; i < 40; ++i) s.onTelemetry(sceneTelemetry(10.0 + i * 0.05, 0, 0.0));  // clean air
   // robot_client restarted: its clock counts from 0 again, the robot 2 m on.
-  for (int i = 0; i < 40; ++i) s.onTelemetry(sceneTelemetry(i * 0.05, 2, 15.0), 0);
+  for (int i = 0; i < 40; ++i) s.onTelemetry(sceneTelemetry(i * 0.05, 2, 15.0));
   const auto g = s.grid("CH4", 0);
   ASSERT_TRUE(g.has_value());
   const auto at = [&](double x, double y) {
