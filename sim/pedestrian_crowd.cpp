@@ -47,6 +47,7 @@ void PedestrianCrowd::appear(double t_s) {
     a.position_m = toEigen(s.route.front());
     a.desired_speed_m_s = s.speed_m_s;
     a.radius_m = s.radius_m;
+    a.notices_robot = s.notices_robot;
     agents_.push_back(a);
     owner_.push_back(i);
     circles_.push_back({s.route.front(), s.radius_m});

@@ -130,7 +130,9 @@ SocialForce computeForce(const Agent& self, std::span<const Agent> others, WallV
     const Eigen::Vector2d diff = self.position_m - robot->position_m;
     const double d = diff.norm();
     const Eigen::Vector2d n = d > kTiny ? Eigen::Vector2d(diff / d) : side;
-    f.robot_m_s2 = push(n, d - (self.radius_m + robot->radius_m), p.robot, p.contact, heading, p.sidestep,
+    constexpr Repulsion kUnnoticed{0.0, 1.0, 1.0};
+    f.robot_m_s2 = push(n, d - (self.radius_m + robot->radius_m), self.notices_robot ? p.robot : kUnnoticed,
+                        p.contact, heading, self.notices_robot ? p.sidestep : 0.0,
                         leftOffset(self.position_m, heading, robot->position_m));
   }
 

@@ -79,6 +79,10 @@ struct Agent {
   Eigen::Vector2d goal_direction = Eigen::Vector2d::Zero();  // unit vector e, or zero = stand still
   double desired_speed_m_s = 0.5;                            // v0
   double radius_m = 0.25;
+  // False: someone distracted or carrying something, who keeps their line:
+  // the robot's social repulsion and sidestep are not felt, only body
+  // contact stops them (people and walls are still felt).
+  bool notices_robot = true;
 };
 
 /// A wall or obstacle edge that repels people (two-sided). Where another

@@ -28,6 +28,7 @@ PedestrianScript readOne(const config::ConfigNode& n, std::size_t index, const W
   s.start_s = n.number("start_s", s.start_s, 0.0, 1e6);
   s.arrive_m = n.number("arrive_m", s.arrive_m, 0.01, 5.0);
   s.loop = n.boolean("loop", false);
+  s.notices_robot = n.boolean("notices_robot", true);
 
   if (!n.has("route_m")) n.fail("route_m", "required list of waypoints [x0, y0, x1, y1, ...] is missing");
   const auto xy = n.numbers("route_m");

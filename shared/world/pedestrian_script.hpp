@@ -30,6 +30,7 @@ struct PedestrianScript {
   std::vector<PedestrianPause> pauses;
   bool loop = false;           // after the last waypoint walk to the first again, forever
   double arrive_m = 0.3;       // a waypoint counts as reached within this distance
+  bool notices_robot = true;   // false: keeps their line past the robot; only body contact stops them
 };
 
 /// Reads root's `pedestrians` list (walls and obstacles of `world` already

@@ -240,6 +240,36 @@ TEST_P(RobotInTheWay, StandingRobotIsWalkedAround) {
 
 INSTANTIATE_TEST_SUITE_P(Offsets, RobotInTheWay, ::testing::Values(0.0, 0.2, -0.2, 0.5));
 
+// A person who does not notice the robot (notices_robot: false) keeps their
+// line at full force until the bodies touch; the contact force still stops them.
+TEST(SocialForce, APersonWhoDoesNotNoticeTheRobotKeepsTheirLineUntilContact) {
+  const SocialForceParams p;
+  Agent robot;
+  robot.position_m = V(3, 0);
+  robot.radius_m = 0.35;
+  struct Pass {
+    double min_d = 1e9, dev_before = 0.0;
+  };
+  auto pass = [&](bool notices) {
+    Agent a = walker(V(0, 0.2), V(1, 0));
+    a.notices_robot = notices;
+    Pass r;
+    for (int k = 0; k < 30000; ++k) {
+      aimAt(a, V(8, 0.2));
+      integrate(a, computeForce(a, {}, {}, &robot, p).total(), p, kDt_s);
+      r.min_d = std::min(r.min_d, (a.position_m - robot.position_m).norm());
+      if (a.position_m.x() < robot.position_m.x() - 1.0)
+        r.dev_before = std::max(r.dev_before, std::abs(a.position_m.y() - 0.2));
+    }
+    return r;
+  };
+  const Pass noticing = pass(true), distracted = pass(false);
+  EXPECT_GT(noticing.dev_before, 0.05) << "the reference walker did not give way early";
+  EXPECT_LT(distracted.dev_before, 0.01) << "felt the robot from afar";
+  EXPECT_LT(distracted.min_d, noticing.min_d - 0.1) << "kept a social distance";
+  EXPECT_GT(distracted.min_d, 0.35 + 0.25 - 0.05) << "walked through the robot";
+}
+
 TEST(SocialForce, CoincidentAndDegenerateInputGiveFiniteForces) {
   const SocialForceParams p;
   // Two people on the same spot, same velocity and goal.
