@@ -156,8 +156,10 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
   behavior::AwarenessConfig acfg = ctx.awareness;
   acfg.enabled = true;
   acfg.policy = opt.policy;
-  auto awareness = robot::makeAwareness(ctx.robot, acfg, world::mapFromWorld(world), "scenario behaviour config");
-  const behavior::HumanAwareness* aw = awareness.get();
+  auto awareness = robot::makeAwareness(ctx.robot, acfg,
+                                       opt.site_map ? world::mapFromWorld(world) : std::vector<geometry::Segment>{},
+                                       "scenario behaviour config");
+  behavior::HumanAwareness* aw = awareness.get();
   core.setAwareness(std::move(awareness));
   core.onSerialState(true, 0.0);
   core.onLinkUp(0.0);
@@ -221,6 +223,7 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
   for (uint64_t t_ms = Simulation::kFramePeriod_ms; t_ms <= limit_ms; t_ms += Simulation::kFramePeriod_ms) {
     sim.advanceTo(t_ms);
     const double t = sim.timeS();
+    if (opt.observer) opt.observer->beforeFrame(sim, *aw, t);
     sim.takeTx(rx);
     decoder.feed({rx.data(), rx.size()}, [&](const serial::Message& msg, uint8_t) {
       if (const auto* f = std::get_if<serial::SensorFrame>(&msg)) send(core.onSensorFrame(*f, t));
@@ -323,6 +326,7 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
                             a.person ? a.distance_m : -1.0, a.speed_factor, static_cast<int>(a.pattern),
                             static_cast<int>(tp)});
 
+    if (opt.observer) opt.observer->afterTick(sim, *aw, t);
     if (m.completed) break;
     if (core.mode() == v1::FAILSAFE || core.mode() == v1::ESTOP) {
       m.failure = "robot latched " + std::string(v1::Mode_Name(core.mode()));

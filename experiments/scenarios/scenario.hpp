@@ -68,11 +68,26 @@ struct ScenarioContext {
 ScenarioContext loadScenarioContext(const std::string& robot_yaml, const std::string& control_yaml,
                                     const std::string& behavior_yaml);
 
+class Simulation;
+
+/// Watches a run tick by tick (the arena's ground truth and oracle).
+class RunObserver {
+ public:
+  virtual ~RunObserver() = default;
+  /// Before the tick's sensor frame reaches the decision core (the oracle
+  /// feeds the true nearest person to `aw` here).
+  virtual void beforeFrame(const Simulation& /*sim*/, behavior::HumanAwareness& /*aw*/, double /*t_s*/) {}
+  /// After the tick, with what the robot made of it.
+  virtual void afterTick(const Simulation& /*sim*/, const behavior::HumanAwareness& /*aw*/, double /*t_s*/) {}
+};
+
 struct RunOptions {
   behavior::SpeedPolicy policy = behavior::SpeedPolicy::kFuzzy;
   bool people = true;       // false: the scenario without its pedestrians (reference for time lost)
   uint32_t seed = 1;
   bool keep_series = false;  // fill ScenarioRun::series (plots)
+  RunObserver* observer = nullptr;
+  bool site_map = true;      // false: the robot runs without the site map (every echo may be a person)
 };
 
 /// One 10 ms tick of a run, for plots.

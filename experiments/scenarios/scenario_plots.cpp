@@ -11,7 +11,7 @@ namespace inspect::sim {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const char* const kPolicyColor[] = {"#1f77b4", "#d62728", "#2ca02c"};  // fuzzy, none, stop_and_wait
+const char* const kPolicyColor[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};  // fuzzy, none, stop_and_wait, fuzzy_no_pattern
 const char* const kPeopleColor[] = {"#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22"};
 
 const char* policyColor(behavior::SpeedPolicy p) { return kPolicyColor[static_cast<int>(p)]; }
@@ -21,6 +21,7 @@ std::string policyTitle(behavior::SpeedPolicy p) {
     case behavior::SpeedPolicy::kFuzzy: return "robot, fuzzy strategy (Eq 9)";
     case behavior::SpeedPolicy::kNone: return "robot, plain tracking";
     case behavior::SpeedPolicy::kStopAndWait: return "robot, stop-and-wait";
+    case behavior::SpeedPolicy::kFuzzyNoPattern: return "robot, Eq 9 without the pattern";
   }
   return "robot";
 }

@@ -13,6 +13,7 @@ const char* toString(SpeedPolicy p) {
     case SpeedPolicy::kFuzzy: return "fuzzy";
     case SpeedPolicy::kNone: return "none";
     case SpeedPolicy::kStopAndWait: return "stop_and_wait";
+    case SpeedPolicy::kFuzzyNoPattern: return "fuzzy_no_pattern";
   }
   return "?";
 }
@@ -21,7 +22,8 @@ SpeedPolicy parseSpeedPolicy(const std::string& s) {
   if (s == "fuzzy") return SpeedPolicy::kFuzzy;
   if (s == "none") return SpeedPolicy::kNone;
   if (s == "stop_and_wait") return SpeedPolicy::kStopAndWait;
-  throw std::invalid_argument("unknown speed policy '" + s + "' (fuzzy, none or stop_and_wait)");
+  if (s == "fuzzy_no_pattern") return SpeedPolicy::kFuzzyNoPattern;
+  throw std::invalid_argument("unknown speed policy '" + s + "' (fuzzy, none, stop_and_wait or fuzzy_no_pattern)");
 }
 
 HumanAwareness::HumanAwareness(const config::UltrasonicConfig& sonar, const AwarenessConfig& cfg,
@@ -59,19 +61,33 @@ const Awareness& HumanAwareness::step(const control::Pose2& pose, const std::arr
   } else {
     a.pattern = classifier_.stepNone(dt);
   }
+  // What the policy is given: the tracked nearest person, or the override.
+  bool person = a.person, passing = a.passing;
+  double distance = a.anticipating ? std::min(a.distance_m, a.predicted_min_m) : a.distance_m;
+  double speed = a.person_speed_m_s;
+  Pattern pattern = a.pattern;
+  const bool overridden = override_.has_value();  // the truth's "none" means nobody to react to
+  if (override_) {
+    person = override_->person;
+    passing = false;
+    distance = override_->distance_m;
+    speed = override_->speed_m_s;
+    pattern = override_->pattern;
+    override_.reset();
+  }
   // A person without a settled pattern still slows the robot as the most
   // cautious pattern would (crossing/confronting share the cautious ramp).
-  const Pattern for_speed = a.person && a.pattern == Pattern::kNone ? Pattern::kConfronting : a.pattern;
   const SpeedPolicy policy = cfg_.enabled ? cfg_.policy : SpeedPolicy::kNone;
-  if (!a.person || policy == SpeedPolicy::kNone) {
+  Pattern for_speed = person && pattern == Pattern::kNone && !overridden ? Pattern::kConfronting : pattern;
+  if (policy == SpeedPolicy::kFuzzyNoPattern) for_speed = Pattern::kConfronting;
+  if (!person || policy == SpeedPolicy::kNone) {
     a.target_factor = 1.0;
   } else if (policy == SpeedPolicy::kStopAndWait) {
-    a.target_factor = a.distance_m < cfg_.speed.max_avoidance_m ? 0.0 : 1.0;
-  } else if (a.passing) {
+    a.target_factor = distance < cfg_.speed.max_avoidance_m ? 0.0 : 1.0;
+  } else if (passing) {
     a.target_factor = 1.0;  // beside or behind and moving away: no longer interfering
   } else {
-    const double d_in = a.anticipating ? std::min(a.distance_m, a.predicted_min_m) : a.distance_m;
-    a.target_factor = strategy_.speedFactor(d_in, a.person_speed_m_s, for_speed);  // Eq 9
+    a.target_factor = strategy_.speedFactor(distance, speed, for_speed);  // Eq 9
   }
   // Rate limit (no speed steps); the first tick takes the target as it is.
   a.speed_factor = a.target_factor;
@@ -157,10 +173,12 @@ AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::s
   c.tracker.moving_for_s = t.number("moving_for_s", c.tracker.moving_for_s, 0, 10);
   c.tracker.grid_static_s = t.number("grid_static_s", c.tracker.grid_static_s, 0.1, 60);
   c.tracker.triangulate_front = t.boolean("triangulate_front", c.tracker.triangulate_front);
+  c.tracker.wall_trace = t.boolean("wall_trace", c.tracker.wall_trace);
+  c.tracker.new_track_margin_m = t.number("new_track_margin_m", c.tracker.new_track_margin_m, 0, 5);
   c.social_force = readSocialForceParams(root.optChild("social_force"));
   const auto p = root.optChild("pattern");
   c.pattern.min_speed_m_s = p.number("min_speed_m_s", c.pattern.min_speed_m_s, 0, 2);
-  c.pattern.crossing_deg = p.number("crossing_deg", c.pattern.crossing_deg, 45, 90);
+  c.pattern.crossing_deg = p.number("crossing_deg", c.pattern.crossing_deg, 20, 90);
   c.pattern.along_deg = p.number("along_deg", c.pattern.along_deg, 0, 45);
   c.pattern.confront_lateral_m = p.number("confront_lateral_m", c.pattern.confront_lateral_m, 0, 5);
   c.pattern.max_lateral_m = p.number("max_lateral_m", c.pattern.max_lateral_m, 0, 10);

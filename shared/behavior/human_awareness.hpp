@@ -23,9 +23,11 @@ enum class SpeedPolicy {
   kFuzzy,        // the paper's strategy: Eq 9 factor from distance, speed and pattern
   kNone,         // baseline: people are tracked and reported, the speed is never changed
   kStopAndWait,  // baseline: stop while anyone is within max_avoidance_m, full speed otherwise
+  kFuzzyNoPattern,  // ablation: Eq 9 from distance and speed only, the pattern input held at the most
+                    // cautious (confronting) whatever the classifier says
 };
 const char* toString(SpeedPolicy p);
-/// Parses "fuzzy", "none", "stop_and_wait"; throws std::invalid_argument otherwise.
+/// Parses "fuzzy", "none", "stop_and_wait", "fuzzy_no_pattern"; throws std::invalid_argument otherwise.
 SpeedPolicy parseSpeedPolicy(const std::string& s);
 
 struct AwarenessConfig {
@@ -73,6 +75,15 @@ struct Awareness {
   bool anticipating = false;     // the predicted distance was used for the speed factor
 };
 
+/// What the speed strategy is given instead of the perception's estimate
+/// (the arena's oracle policy: the simulator's true nearest person).
+struct SpeedInput {
+  bool person = false;
+  double distance_m = -1.0;
+  double speed_m_s = 0.0;
+  Pattern pattern = Pattern::kNone;
+};
+
 class HumanAwareness {
  public:
   HumanAwareness(const config::UltrasonicConfig& sonar, const AwarenessConfig& cfg, SpeedStrategy strategy,
@@ -80,6 +91,10 @@ class HumanAwareness {
   /// One tick (pose in the odometry frame, ranges in m with < 0 = no echo).
   const Awareness& step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s);
   const Awareness& last() const { return last_; }
+  /// The next step() feeds `in` to the speed policy in place of the tracked
+  /// nearest person (distance, speed, pattern; no passing or anticipation);
+  /// tracking and the classifier still run and are still reported. Experiments only.
+  void overrideNextSpeedInput(const SpeedInput& in) { override_ = in; }
   const HumanTracker& tracker() const { return tracker_; }
   const PatternClassifier& classifier() const { return classifier_; }
 
@@ -92,6 +107,7 @@ class HumanAwareness {
   PatternClassifier classifier_;
   SpeedStrategy strategy_;
   Awareness last_;
+  std::optional<SpeedInput> override_;
   double last_t_s_ = -1.0;
   std::vector<WallSegment> walls_;            // the map, for the prediction
   std::array<Eigen::Vector2d, 64> predicted_{};  // prediction buffer (no allocation per tick)

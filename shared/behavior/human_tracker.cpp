@@ -132,6 +132,25 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
       ++counters_.static_map;
       continue;
     }
+    // The same for the walls the side sensors traced (no map needed): a
+    // corridor's walls reach the front cones' edges at a range that slides
+    // along with the robot, as a leading person's would.
+    const bool side_sensor = std::abs(std::remainder(sonar_.mounts[i].yaw_rad, M_PI)) > M_PI / 4;
+    for (int k = -3; k <= 3 && !explained && p_.wall_trace && !side_sensor; k += 6) {
+      const double a = yaw + k * sonar_.beam_width_rad / 6.0;
+      explained = nearLearned(bx + r * std::cos(a), by + r * std::sin(a), t_s);
+    }
+    if (explained) {
+      ++counters_.static_learned;
+      // A track started on this echo before the wall was learned (the first
+      // few tenths of a second of driving) goes: the echo that fed it is the wall's.
+      std::erase_if(tracks_, [&](const HumanTrack& t) {
+        const bool wall = std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m;
+        if (wall && !t.confirmed) ++counters_.tracks_unconfirmed_dropped;
+        return wall;
+      });
+      continue;
+    }
     // Persistence: a person passes through a 0.2 m cell in well under a
     // second; structure keeps being hit in the same place for longer. Echoes
     // at a tracked person are exempt: a person who stops is still a person.
@@ -146,6 +165,16 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
         ++counters_.static_grid;
         continue;
       }
+    }
+    if (p_.wall_trace && side_sensor && tracesWall(i, Eigen::Vector2d(px, py), pose, t_s)) {
+      ++counters_.static_wall_trace;
+      // A track started on this wall before the trace was long enough goes too.
+      std::erase_if(tracks_, [&](const HumanTrack& t) {
+        const bool wall = !t.isPerson() && std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m;
+        if (wall && !t.confirmed) ++counters_.tracks_unconfirmed_dropped;
+        return wall;
+      });
+      continue;
     }
     // Measurement covariance: range noise along the beam, the cone's width across it.
     const double along = std::max(p_.range_sigma_m, 0.01);
@@ -197,7 +226,8 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
       const bool person = best->isPerson();
       person_echo_[i] = person;
       if (i == 0 && p_.triangulate_front && !echo[1].use && ranges_m[1] > 0) person_echo_[1] = person;
-    } else if (static_cast<int>(tracks_.size()) < p_.max_tracks) {
+    } else if (static_cast<int>(tracks_.size()) < p_.max_tracks &&
+               echo[i].range < sonar_.max_range_m - p_.new_track_margin_m) {
       HumanTrack t;
       t.id = next_id_++;
       t.x << z.x(), z.y(), 0, 0;
@@ -267,6 +297,67 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     }
     return false;
   });
+}
+
+bool HumanTracker::tracesWall(std::size_t i, const Eigen::Vector2d& z, const control::Pose2& pose, double t_s) {
+  Trace& tr = traces_[i];
+  tr.point[tr.head] = z;
+  tr.robot[tr.head] = {pose.x_m, pose.y_m};
+  tr.t[tr.head] = t_s;
+  tr.head = (tr.head + 1) % Trace::kSize;
+  tr.count = std::min(tr.count + 1, Trace::kSize);
+  // The points of the window, oldest first.
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  std::size_t n = 0;
+  std::size_t oldest = tr.head;  // index of the oldest point within the window
+  for (std::size_t k = 0; k < tr.count; ++k) {
+    const std::size_t j = (tr.head + Trace::kSize - 1 - k) % Trace::kSize;
+    if (t_s - tr.t[j] > p_.wall_trace_s) break;
+    mean += tr.point[j];
+    ++n;
+    oldest = j;
+  }
+  if (n < 10 || t_s - tr.t[oldest] < 0.6 * p_.wall_trace_s) return false;
+  mean /= static_cast<double>(n);
+  Eigen::Matrix2d c = Eigen::Matrix2d::Zero();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t j = (tr.head + Trace::kSize - 1 - k) % Trace::kSize;
+    const Eigen::Vector2d d = tr.point[j] - mean;
+    c += d * d.transpose();
+  }
+  c /= static_cast<double>(n);
+  // Principal axis of the points (2x2 symmetric eigenproblem in closed form).
+  const double tr_c = c(0, 0) + c(1, 1), det = c(0, 0) * c(1, 1) - c(0, 1) * c(0, 1);
+  const double disc = std::sqrt(std::max(0.0, tr_c * tr_c / 4 - det));
+  const double major = tr_c / 2 + disc, minor = std::max(0.0, tr_c / 2 - disc);
+  if (std::sqrt(minor) > p_.wall_trace_width_m) return false;
+  const double axis = 0.5 * std::atan2(2 * c(0, 1), c(0, 0) - c(1, 1));
+  const double off = std::abs(std::remainder(axis - pose.theta_rad, M_PI));
+  if (off > p_.wall_trace_angle_deg * M_PI / 180.0) return false;
+  // Spread as far as the robot moved (the echo slid with it; a standing
+  // object's echo points would stay put and go to the persistence grid).
+  const double moved = (tr.robot[(tr.head + Trace::kSize - 1) % Trace::kSize] - tr.robot[oldest]).norm();
+  const double spread = (tr.point[(tr.head + Trace::kSize - 1) % Trace::kSize] - tr.point[oldest]).norm();
+  if (!(moved > 0.03 && std::sqrt(major) > 0.01 && spread > 0.6 * moved && spread < 1.5 * moved)) return false;
+  // Remember the wall: the line through the points' mean along the robot's
+  // heading, from a metre behind to 5 m ahead (the front cones' reach). Not
+  // the points' own principal axis: over half a second of driving (0.25 m
+  // at 0.5 m/s) with 2 cm of range noise it is known to only ~5 deg, 0.4 m
+  // at the front cones' 4 m; the heading is what the trace was checked against.
+  const Eigen::Vector2d dir(std::cos(pose.theta_rad), std::sin(pose.theta_rad));
+  const Eigen::Vector2d from = mean - (0.5 * spread + 1.0) * dir, to = mean + (0.5 * spread + 5.0) * dir;
+  learned_[i] = {{{from.x(), from.y()}, {to.x(), to.y()}}, t_s};
+  return true;
+}
+
+bool HumanTracker::nearLearned(double x, double y, double t_s) const {
+  constexpr double kLearnedFor_s = 2.0;  // a traced wall holds this long after its last confirmation
+  // The fitted line's direction is known to ~2 deg: ~0.15 m at the front cones' 4 m.
+  const double margin = std::max(p_.map_margin_m, 0.3);
+  for (const auto& l : learned_)
+    if (l.t_s >= 0 && t_s - l.t_s < kLearnedFor_s && geometry::pointSegmentDistance({x, y}, l.wall) < margin)
+      return true;
+  return false;
 }
 
 const HumanTrack* HumanTracker::nearest(const control::Pose2& pose) const {

@@ -46,6 +46,18 @@ struct HumanTrackerParams {
   bool triangulate_front = true;      // fuse the two front echoes into one point when they agree
   double contradiction_margin_m = 0.4;  // a sensor hearing this much beyond a track's position contradicts it
   int contradiction_ticks = 3;        // ...on this many ticks in a row: the track is dropped
+  // A side sensor sliding along a wall (no map needed): its echo points of the
+  // last wall_trace_s lie on a line parallel to the robot's motion, spread as
+  // far as the robot moved. Such echoes are structure (a person walking
+  // alongside at the robot's speed looks the same: no pattern to react to).
+  // New tracks start only from echoes this far inside the sonar's maximum
+  // range: at its edge the cones' rims graze walls and openings (echoes that
+  // slide with the robot), while the speed rule acts inside 3 m anyway.
+  double new_track_margin_m = 0.3;
+  bool wall_trace = true;
+  double wall_trace_s = 0.5;
+  double wall_trace_width_m = 0.03;   // the points' RMS distance from their line
+  double wall_trace_angle_deg = 10;   // the line within this of the robot's heading
 };
 
 /// One tracked object (odometry frame); a person once confirmed and moving.
@@ -76,6 +88,8 @@ struct TrackerCounters {
   uint64_t tracks_unconfirmed_dropped = 0;  // likely false detections
   uint64_t tracks_static_dropped = 0;       // became static objects
   uint64_t triangulated = 0;                // front echo pairs fused into one point
+  uint64_t static_wall_trace = 0;           // dropped: a side sensor sliding along a wall
+  uint64_t static_learned = 0;              // dropped: on a wall learned that way (front cones' edges)
   uint64_t tracks_contradicted = 0;         // dropped: a sensor saw through them
 };
 
@@ -108,6 +122,25 @@ class HumanTracker {
   std::optional<std::pair<Eigen::Vector2d, Eigen::Matrix2d>> triangulate(const control::Pose2& pose, double r0,
                                                                           double r1) const;
   void update(HumanTrack& t, const Eigen::Vector2d& z, const Eigen::Matrix2d& r, double t_s);
+  /// Records sensor i's echo point and says whether its recent points trace a wall (wall_trace).
+  bool tracesWall(std::size_t i, const Eigen::Vector2d& z, const control::Pose2& pose, double t_s);
+  /// Echo points of one sensor over the last wall_trace_s (a ring), with the robot's position then.
+  struct Trace {
+    static constexpr std::size_t kSize = 64;
+    std::array<Eigen::Vector2d, kSize> point{};
+    std::array<Eigen::Vector2d, kSize> robot{};
+    std::array<double, kSize> t{};
+    std::size_t head = 0, count = 0;
+  };
+  std::array<Trace, 4> traces_{};
+  /// Walls learned from the side sensors' traces (extended ahead of the robot,
+  /// where the front cones' edges meet them), each with the time last confirmed.
+  struct Learned {
+    geometry::Segment wall;
+    double t_s = -1.0;
+  };
+  std::array<Learned, 4> learned_{};
+  bool nearLearned(double x, double y, double t_s) const;
 
   config::UltrasonicConfig sonar_;
   HumanTrackerParams p_;

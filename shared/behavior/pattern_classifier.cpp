@@ -11,7 +11,7 @@ Pattern rawPattern(double rel_x, double rel_y, double vx, double vy, Pattern pre
   const double psi = std::abs(std::atan2(vy, vx)) * 180.0 / std::numbers::pi;  // 0 = same direction, 180 = opposite
   const double across = std::abs(90.0 - psi);                                   // 0 = straight across
   if (across <= 90.0 - p.crossing_deg) return Pattern::kCrossing;
-  if (psi <= p.along_deg) return std::abs(rel_y) < p.max_lateral_m ? Pattern::kLeading : Pattern::kNone;
+  if (psi <= p.along_deg) return std::abs(rel_y) < p.confront_lateral_m ? Pattern::kLeading : Pattern::kNone;
   if (psi >= 180.0 - p.along_deg) {
     if (std::abs(rel_y) < p.confront_lateral_m) return Pattern::kConfronting;
     return std::abs(rel_y) < p.max_lateral_m ? Pattern::kEncountering : Pattern::kNone;

@@ -13,12 +13,17 @@
 
 namespace inspect::behavior {
 
+// Defaults follow the arena's ground truth (docs/scenarios.md, "Ground truth"):
+// crossing for relative headings in (30, 150) deg, leading / confronting on the
+// robot's path (|lateral| within its body plus a person's, 0.6 m), encountering
+// beside it, nobody behind the axle.
 struct PatternParams {
   double min_speed_m_s = 0.15;      // slower people have no pattern (none)
-  double behind_m = -0.3;           // relative x below this: behind the robot, none
-  double crossing_deg = 50;         // |relative heading| within 90 +- (90 - this) is crossing
-  double along_deg = 40;            // within this of 0 / 180 deg: same / opposite direction
-  double confront_lateral_m = 0.4;  // opposite direction and |lateral offset| below: confronting
+  double behind_m = 0.0;            // relative x below this: behind the robot, none
+  double crossing_deg = 30;         // |relative heading| within 90 +- (90 - this) is crossing
+  double along_deg = 25;            // within this of 0 / 180 deg: same / opposite direction
+  double confront_lateral_m = 0.6;  // |lateral offset| below: on the robot's path (confronting when opposite,
+                                    // leading when the same direction); beside it: encountering / none
   double max_lateral_m = 2.0;       // beyond this lateral offset same/opposite movers are none
   double dwell_s = 0.3;             // a new pattern must hold this long before it is reported
 };

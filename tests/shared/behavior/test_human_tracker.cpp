@@ -109,3 +109,47 @@ TEST(HumanTracker, OncomingPersonHasItsClosingSpeed) {
   EXPECT_NEAR(seen->x[2], -0.5, 0.1);
   EXPECT_NEAR(seen->x[0], 4.0 - 0.5 * 4.0 - 0.25, 0.15);
 }
+
+// Without a map, a corridor's walls slide past the side sensors at the robot's
+// speed (and reach the front cones' rims at a range that slides with it): the
+// side traces are recognised as walls and remembered for the front sensors.
+TEST(HumanTracker, CorridorWallsWithoutAMapAreNotPeople) {
+  const config::UltrasonicConfig u;
+  const std::vector<geometry::Segment> walls = {{-1, 1.2, 30, 1.2}, {-1, -1.2, 30, -1.2}};
+  auto run = [&](bool wall_trace) {
+    behavior::HumanTrackerParams p;
+    p.wall_trace = wall_trace;
+    HumanTracker tr(u, p);  // no map
+    std::mt19937 rng(6);
+    int person_ticks = 0;
+    for (int k = 0; k < 2000; ++k) {  // 20 s at 0.5 m/s
+      const control::Pose2 robot{0.005 * k, 0, 0};
+      tr.step(robot, echoes(u, robot, {}, walls, &rng), k * 0.01);
+      if (tr.nearest(robot)) ++person_ticks;
+    }
+    return std::pair{person_ticks, tr.counters().static_wall_trace};
+  };
+  const auto [with_ticks, traced] = run(true);
+  const auto [without_ticks, untraced] = run(false);
+  EXPECT_GT(without_ticks, 100) << "the case the trace is for: walls look like people walking alongside";
+  EXPECT_EQ(with_ticks, 0);
+  EXPECT_GT(traced, 1000u);
+  EXPECT_EQ(untraced, 0u);
+}
+
+// A person crossing in front of the side sensor is not a wall trace: the
+// echo points run across the robot's motion, not along it.
+TEST(HumanTracker, APersonPassingTheSideIsStillTracked) {
+  const config::UltrasonicConfig u;
+  HumanTracker tr(u, {});
+  std::mt19937 rng(7);
+  int person_ticks = 0;
+  for (int k = 0; k < 300; ++k) {
+    const double t = k * 0.01;
+    const control::Pose2 robot{0.005 * k, 0, 0};
+    const Circle p{0.5 + 0.005 * k, 2.5 - 0.6 * t, 0.25};  // walking towards the robot's left side
+    tr.step(robot, echoes(u, robot, {p}, {}, &rng), t);
+    if (tr.nearest(robot)) ++person_ticks;
+  }
+  EXPECT_GT(person_ticks, 50);
+}

@@ -30,13 +30,14 @@ INSTANTIATE_TEST_SUITE_P(
                       RawCase{"standing", 2, 0, 0.05, 0, Pattern::kNone},
                       RawCase{"behind", -2, 0, 0.5, 0, Pattern::kNone},
                       RawCase{"far_to_the_side", 2, 3, -0.5, 0, Pattern::kNone},
-                      RawCase{"diagonal_gap_keeps_none", 3, 0, -0.35, -0.35, Pattern::kNone}),
+                      RawCase{"diagonal_gap_keeps_none", 3, 0, -0.45, -0.23, Pattern::kNone},
+                      RawCase{"leading_beside_is_none", 2, 1.0, 0.4, 0, Pattern::kNone}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(PatternClassifier, HysteresisBandKeepsThePreviousPattern) {
-  // 45 deg between "opposite" (<= 40 deg off) and "crossing" (>= 50 deg off).
-  EXPECT_EQ(behavior::rawPattern(3, 0.1, -0.35, -0.35, Pattern::kConfronting, {}), Pattern::kConfronting);
-  EXPECT_EQ(behavior::rawPattern(3, 0.1, -0.35, -0.35, Pattern::kCrossing, {}), Pattern::kCrossing);
+  // 27 deg off opposite: between "opposite" (<= 25 deg off) and "crossing" (>= 30 deg off).
+  EXPECT_EQ(behavior::rawPattern(3, 0.1, -0.45, -0.23, Pattern::kConfronting, {}), Pattern::kConfronting);
+  EXPECT_EQ(behavior::rawPattern(3, 0.1, -0.45, -0.23, Pattern::kCrossing, {}), Pattern::kCrossing);
 }
 
 TEST(PatternClassifier, NeedsADwellAndDoesNotFlickerOnNoise) {
