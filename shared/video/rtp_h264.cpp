@@ -2,23 +2,14 @@
 
 #include <algorithm>
 
+#include "shared/video/byte_order.hpp"
+
 namespace inspect::video {
 namespace {
 
 constexpr uint16_t kExtProfile = 0xBEDE;   // RFC 8285 one-byte header
 constexpr std::size_t kExtBytes = 4 + 12;  // profile + length, then 1 + 8 bytes padded to 12
 constexpr uint8_t kStartCode[4] = {0, 0, 0, 1};
-
-void put16(std::vector<uint8_t>& v, uint16_t x) {
-  v.push_back(static_cast<uint8_t>(x >> 8));
-  v.push_back(static_cast<uint8_t>(x));
-}
-void put32(std::vector<uint8_t>& v, uint32_t x) {
-  put16(v, static_cast<uint16_t>(x >> 16));
-  put16(v, static_cast<uint16_t>(x));
-}
-uint16_t get16(const uint8_t* p) { return static_cast<uint16_t>(p[0] << 8 | p[1]); }
-uint32_t get32(const uint8_t* p) { return static_cast<uint32_t>(get16(p)) << 16 | get16(p + 2); }
 
 }  // namespace
 

@@ -5,19 +5,24 @@
 // skipped until a keyframe after a loss).
 //
 // Input: records (fuzz_records.hpp). tag % 8 == 7 flushes the reorder buffer
-// (a pause); any other record is one UDP datagram. tag bit 3 picks the BGR
+// (a pause); tag % 8 == 6 is an RTCP datagram (shared/video/rtcp: reports,
+// NACK, PLI; what it parses to is rebuilt by the builders and parses back
+// the same); any other record is one RTP datagram. tag bit 3 picks the BGR
 // or the luma-only decode for the frames it completes.
 // Invariants: frames hold Annex B NAL units; a frame re-packetized by the
 // robot's packetizer (small and normal MTU) comes out of a fresh
 // depacketizer with the same NAL units.
 #include <cstddef>
 #include <cstdint>
+#include <set>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "shared/util/log.hpp"
 #include "shared/video/h264_codec.hpp"
+#include "shared/video/rtcp.hpp"
 #include "shared/video/rtp_h264.hpp"
 #include "shared/video/sdp.hpp"
 #include "tests/fuzz/fuzz_records.hpp"
@@ -60,12 +65,59 @@ void checkRoundTrip(const Frame& f, std::size_t max_payload) {
   FUZZ_CHECK(out->keyframe == f.keyframe);
 }
 
+bool sameBlocks(const std::vector<rtcp::ReportBlock>& a, const std::vector<rtcp::ReportBlock>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (a[k].ssrc != b[k].ssrc || a[k].fraction_lost != b[k].fraction_lost ||
+        a[k].cumulative_lost != b[k].cumulative_lost || a[k].highest_seq != b[k].highest_seq ||
+        a[k].jitter != b[k].jitter || a[k].lsr != b[k].lsr || a[k].dlsr != b[k].dlsr)
+      return false;
+  return true;
+}
+
+// An RTCP datagram: whatever parses is rebuilt and parses back the same.
+void checkRtcp(std::span<const uint8_t> d, rtcp::ReceiverStats& stats) {
+  rtcp::Compound c;
+  const rtcp::RtcpError e = rtcp::parseCompound(d, c);
+  FUZZ_CHECK(std::string(rtcp::toString(e)) != "?");
+  std::vector<uint8_t> again;
+  for (const auto& sr : c.sender_reports) {
+    rtcp::appendSenderReport(again, sr.ssrc, sr.info, sr.blocks);
+    stats.onSenderReport(sr.info.ntp, sr.info.ntp >> 12);
+  }
+  for (const auto& rr : c.receiver_reports) rtcp::appendReceiverReport(again, rr.ssrc, rr.blocks);
+  for (const auto& [ssrc, cname] : c.cnames) rtcp::appendCname(again, ssrc, cname);
+  for (uint32_t b : c.byes) rtcp::appendBye(again, b);
+  for (const auto& n : c.nacks) rtcp::appendNack(again, n.sender_ssrc, n.media_ssrc, n.seqs);
+  for (const auto& p : c.plis) rtcp::appendPli(again, p.sender_ssrc, p.media_ssrc);
+  if (again.empty()) return;
+  rtcp::Compound back;
+  FUZZ_CHECK(rtcp::parseCompound(again, back) == rtcp::RtcpError::kNone);
+  FUZZ_CHECK(back.sender_reports.size() == c.sender_reports.size());
+  for (std::size_t k = 0; k < c.sender_reports.size(); ++k) {
+    FUZZ_CHECK(back.sender_reports[k].info.ntp == c.sender_reports[k].info.ntp);
+    FUZZ_CHECK(sameBlocks(back.sender_reports[k].blocks, c.sender_reports[k].blocks));
+  }
+  FUZZ_CHECK(back.receiver_reports.size() == c.receiver_reports.size());
+  for (std::size_t k = 0; k < c.receiver_reports.size(); ++k)
+    FUZZ_CHECK(sameBlocks(back.receiver_reports[k].blocks, c.receiver_reports[k].blocks));
+  FUZZ_CHECK(back.cnames == c.cnames);
+  FUZZ_CHECK(back.byes == c.byes);
+  FUZZ_CHECK(back.nacks.size() == c.nacks.size());
+  for (std::size_t k = 0; k < c.nacks.size(); ++k) {
+    const std::set<uint16_t> want(c.nacks[k].seqs.begin(), c.nacks[k].seqs.end());
+    FUZZ_CHECK(std::set<uint16_t>(back.nacks[k].seqs.begin(), back.nacks[k].seqs.end()) == want);
+  }
+  FUZZ_CHECK(back.plis.size() == c.plis.size());
+}
+
 struct Receiver {
   ReorderBuffer reorder{16};
   H264Depacketizer depack;
   H264Decoder decoder;
   std::vector<uint8_t> sps, pps;
   bool damaged = false;
+  rtcp::ReceiverStats stats;
   std::vector<std::pair<uint32_t, std::vector<uint8_t>>> ready;
 
   void onFrame(const Frame& f, bool luma) {
@@ -130,11 +182,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     const bool luma = r.tag & 0x08;
     if (r.tag % 8 == 7) {
       rx.reorder.flush(rx.ready);
+    } else if (r.tag % 8 == 6) {
+      checkRtcp(r.body, rx.stats);
+      (void)rx.stats.report(1, r.body.size());
     } else {
       RtpPacket p;
       const RtpError e = parseRtp(r.body, p);
       (void)toString(e);
       if (e != RtpError::kNone) continue;  // VideoReceiver counts and drops it
+      rx.stats.onPacket(p.seq, p.timestamp, p.capture_us.value_or(0));
+      FUZZ_CHECK(rx.stats.report(p.ssrc, 0).fraction_lost <= 255);
       rx.reorder.push(p.seq, std::vector<uint8_t>(r.body.begin(), r.body.end()));
       rx.reorder.pop(rx.ready);
     }

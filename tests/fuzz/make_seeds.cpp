@@ -33,6 +33,7 @@
 #include "shared/util/log.hpp"
 #include "shared/video/frame_source.hpp"
 #include "shared/video/h264_codec.hpp"
+#include "shared/video/rtcp.hpp"
 #include "shared/video/rtp_h264.hpp"
 #include "tests/fuzz/fuzz_records.hpp"
 #include "tests/support/paths.hpp"
@@ -449,6 +450,23 @@ void rtpSeeds() {
   for (std::size_t i : order) fuzz::putRecord(shuffled, 0, packets[i]);
   fuzz::putRecord(shuffled, 7, Bytes{});
   write("rtp_h264", "reordered_lossy", shuffled);
+  // RTCP both ways among the packets: the robot's SR + CNAME, the server's
+  // RR + NACK for two lost packets + PLI (record tag 6).
+  Bytes with_rtcp;
+  const video::rtcp::ReportBlock block{0xC0FFEE, 26, 2, 105, 90, 0x12345678, 6554};
+  Bytes sr, rr;
+  video::rtcp::appendSenderReport(sr, 0xC0FFEE, {video::rtcp::ntpFromUnixMicros(1767225600000000ULL), 3000, 4, 900});
+  video::rtcp::appendCname(sr, 0xC0FFEE, "robot1");
+  video::rtcp::appendReceiverReport(rr, 0x5E55, std::span(&block, 1));
+  const std::vector<uint16_t> lost{102, 104};
+  video::rtcp::appendNack(rr, 0x5E55, 0xC0FFEE, lost);
+  video::rtcp::appendPli(rr, 0x5E55, 0xC0FFEE);
+  for (std::size_t i = 0; i < packets.size(); ++i) {
+    if (i == 2) fuzz::putRecord(with_rtcp, 6, sr);
+    if (i == 4) fuzz::putRecord(with_rtcp, 6, rr);
+    if (i != 2 && i != 4) fuzz::putRecord(with_rtcp, 0, packets[i]);
+  }
+  write("rtp_h264", "with_rtcp", with_rtcp);
 }
 
 // --- files ------------------------------------------------------------------
