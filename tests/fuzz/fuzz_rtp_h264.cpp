@@ -7,7 +7,8 @@
 // Input: records (fuzz_records.hpp). tag % 8 == 7 flushes the reorder buffer
 // (a pause); tag % 8 == 6 is an RTCP datagram (shared/video/rtcp: reports,
 // NACK, PLI; what it parses to is rebuilt by the builders and parses back
-// the same); any other record is one RTP datagram. tag bit 3 picks the BGR
+// the same); any other record is one RTP datagram (also wrapped as RFC 4588
+// RTX and unwrapped: the same bytes). tag bit 3 picks the BGR
 // or the luma-only decode for the frames it completes.
 // Invariants: frames hold Annex B NAL units; a frame re-packetized by the
 // robot's packetizer (small and normal MTU) comes out of a fresh
@@ -24,6 +25,7 @@
 #include "shared/video/h264_codec.hpp"
 #include "shared/video/rtcp.hpp"
 #include "shared/video/rtp_h264.hpp"
+#include "shared/video/rtx.hpp"
 #include "shared/video/sdp.hpp"
 #include "tests/fuzz/fuzz_records.hpp"
 
@@ -190,6 +192,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
       const RtpError e = parseRtp(r.body, p);
       (void)toString(e);
       if (e != RtpError::kNone) continue;  // VideoReceiver counts and drops it
+      if (!(r.body[0] & 0x20)) {  // RFC 4588: the RTX packet of an unpadded packet unwraps to it, byte for byte
+        const auto rtx = makeRtx(r.body, 0xBEEF, kRtxPayloadType, static_cast<uint16_t>(p.seq + 7));
+        FUZZ_CHECK(rtx.has_value());
+        std::vector<uint8_t> back;
+        FUZZ_CHECK(unwrapRtx(*rtx, kRtxPayloadType, p.payload_type, p.ssrc, back) == RtxError::kNone);
+        FUZZ_CHECK(std::equal(back.begin(), back.end(), r.body.begin(), r.body.end()));
+      }
       rx.stats.onPacket(p.seq, p.timestamp, p.capture_us.value_or(0));
       FUZZ_CHECK(rx.stats.report(p.ssrc, 0).fraction_lost <= 255);
       rx.reorder.push(p.seq, std::vector<uint8_t>(r.body.begin(), r.body.end()));
