@@ -73,6 +73,9 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   vp.host = v.string("host", vp.host);
   vp.port = static_cast<int>(v.integer("port", vp.port, 1, 65535));
   vp.mtu = static_cast<int>(v.integer("mtu", vp.mtu, 256, 9000));
+  vp.retransmission = v.boolean("retransmission", vp.retransmission);
+  vp.history_packets = static_cast<int>(v.integer("history_packets", vp.history_packets, 0, 65536));
+  vp.history_s = v.number("history_s", vp.history_s, 0.01, 10);
   return c;
 }
 

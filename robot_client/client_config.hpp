@@ -23,6 +23,9 @@ struct VideoParams {
   std::string host;                  // "" = the server's host
   int port = 5600;
   int mtu = 1200;
+  bool retransmission = true;        // answer the server's NACKs with RTX, send RTCP sender reports
+  int history_packets = 1024;
+  double history_s = 1.0;
 };
 
 /// Mutual TLS on the link (docs/security.md); relative paths are from the working directory.

@@ -33,6 +33,9 @@ video::SenderSettings senderSettings(const ClientConfig& cfg) {
   s.host = v.host.empty() ? cfg.server_host : v.host;
   s.port = static_cast<uint16_t>(v.port);
   s.mtu = static_cast<std::size_t>(v.mtu);
+  s.retransmission = v.retransmission;
+  s.history_packets = static_cast<std::size_t>(v.history_packets);
+  s.history_s = v.history_s;
   return s;
 }
 

@@ -8,6 +8,7 @@
 
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
+#include "shared/video/rtcp.hpp"
 
 namespace inspect::video {
 
@@ -184,6 +185,12 @@ void VideoReceiver::doReceive() {
 
 void VideoReceiver::onDatagram(std::size_t n) {
   const std::span<const uint8_t> data(rx_buf_.data(), n);
+  if (rtcp::looksLikeRtcp(data)) {  // RFC 5761 4: payload types 192-223 on the RTP port are RTCP
+    std::lock_guard lk(mu_);
+    ++counters_.datagrams;
+    ++counters_.rtcp;
+    return;
+  }
   RtpPacket p;
   const RtpError err = parseRtp(data, p);
   const auto reject = [&](uint64_t ReceiverCounters::*counter, const std::string& why) {

@@ -60,6 +60,7 @@ struct StreamStats {
 struct ReceiverCounters {
   uint64_t datagrams = 0;
   uint64_t not_rtp = 0;          // parseRtp refused it (garbage)
+  uint64_t rtcp = 0;             // RTCP from a sender (rtcp-mux: sender reports; not used yet)
   uint64_t wrong_payload_type = 0;
   uint64_t unknown_ssrc = 0;     // no stream has this SSRC
   uint64_t wrong_source = 0;     // right SSRC, from another address than the robot's link

@@ -3,12 +3,16 @@
 #include <chrono>
 #include <random>
 
+#include <poll.h>
+
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/udp.hpp>
 
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
+#include "shared/video/rtcp.hpp"
 #include "shared/video/rtp_h264.hpp"
+#include "shared/video/rtx.hpp"
 
 namespace inspect::video {
 
@@ -40,6 +44,10 @@ std::string validate(const SenderSettings& s) {
   if (s.mtu < 256 || s.mtu > 9000) return "video.mtu: " + std::to_string(s.mtu) + " out of range [256, 9000]";
   if (s.port == 0) return "video.port: 0 is not a destination port";
   if (s.host.empty()) return "video.host: empty";
+  if (s.history_packets > 65536)
+    return "video.history_packets: " + std::to_string(s.history_packets) + " out of range [0, 65536]";
+  if (!(s.history_s >= 0.01 && s.history_s <= 10))
+    return "video.history_s: " + std::to_string(s.history_s) + " out of range [0.01, 10]";
   return validate(effectiveEncoder(s));
 }
 
@@ -47,11 +55,31 @@ struct VideoSender::Net {
   asio::io_context io;
   asio::ip::udp::socket socket{io};
   asio::ip::udp::endpoint dest;
+  std::mutex send_mu;  // the encode and feedback threads both send on `socket`
+  std::mutex history_mu;
+  RetransmissionHistory history{0, 0};
+  uint16_t rtx_seq = 0;
+  uint32_t last_rtp_ts = 0;                 // of the last frame sent (guarded by history_mu)
+  uint32_t packets_sent = 0, octets_sent = 0;  // for the SR (guarded by history_mu)
+
+  bool send(std::span<const uint8_t> d, std::string* error) {
+    std::lock_guard lk(send_mu);
+    boost::system::error_code ec;
+    socket.send_to(asio::buffer(d.data(), d.size()), dest, 0, ec);
+    if (ec && error)
+      *error = "video: send to " + dest.address().to_string() + ":" + std::to_string(dest.port()) + ": " + ec.message();
+    return !ec;
+  }
 };
 
 VideoSender::VideoSender(SenderSettings s) : s_(std::move(s)), net_(std::make_unique<Net>()) {
   if (auto why = validate(s_); !why.empty()) throw VideoError(why);
   ssrc_ = s_.ssrc ? s_.ssrc : randomSsrc();
+  do rtx_ssrc_ = randomSsrc();
+  while (rtx_ssrc_ == ssrc_);
+  net_->history = RetransmissionHistory(s_.retransmission ? s_.history_packets : 0,
+                                        static_cast<uint64_t>(s_.history_s * 1e6));
+  net_->rtx_seq = static_cast<uint16_t>(rtx_ssrc_);
   boost::system::error_code ec;
   asio::ip::udp::resolver resolver(net_->io);
   auto results = resolver.resolve(asio::ip::udp::v4(), s_.host, std::to_string(s_.port), ec);
@@ -63,6 +91,7 @@ VideoSender::VideoSender(SenderSettings s) : s_(std::move(s)), net_(std::make_un
   // Room for a whole 1080p IDR's packets, so a burst is not dropped locally.
   net_->socket.set_option(asio::socket_base::send_buffer_size(1 << 20), ec);
   st_.ssrc = ssrc_;
+  st_.rtx_ssrc = rtx_ssrc_;
 }
 
 VideoSender::~VideoSender() { stop(); }
@@ -72,6 +101,7 @@ void VideoSender::start() {
   keyframe_requested_ = true;
   capture_thread_ = std::thread([this] { captureLoop(); });
   encode_thread_ = std::thread([this] { encodeLoop(); });
+  if (s_.retransmission) feedback_thread_ = std::thread([this] { feedbackLoop(); });
 }
 
 void VideoSender::stop() {
@@ -83,6 +113,7 @@ void VideoSender::stop() {
   frame_cv_.notify_all();
   if (capture_thread_.joinable()) capture_thread_.join();
   if (encode_thread_.joinable()) encode_thread_.join();
+  if (feedback_thread_.joinable()) feedback_thread_.join();
 }
 
 std::string VideoSender::apply(const SenderChange& c) {
@@ -250,17 +281,19 @@ void VideoSender::encodeLoop() {
         packets.clear();
         const auto ts = static_cast<uint32_t>(capture_us * 9 / 100);  // 90 kHz from microseconds
         packetizer->packetize(out.annexb, ts, capture_us, packets);
+        const uint64_t now_us = monoNowUs();
         for (const auto& p : packets) {
-          boost::system::error_code ec;
-          net_->socket.send_to(asio::buffer(p), net_->dest, 0, ec);
-          if (ec) {
+          if (!net_->send(p, &send_error)) {
             ++send_errors;
-            send_error = "video: send to " + net_->dest.address().to_string() + ":" +
-                         std::to_string(net_->dest.port()) + ": " + ec.message();
-          } else {
-            ++npackets;
-            bytes += p.size();
+            continue;
           }
+          ++npackets;
+          bytes += p.size();
+          std::lock_guard hl(net_->history_mu);
+          net_->history.remember(static_cast<uint16_t>(p[2] << 8 | p[3]), p, now_us);
+          net_->last_rtp_ts = ts;
+          ++net_->packets_sent;
+          net_->octets_sent += static_cast<uint32_t>(p.size() - kRtpHeaderSize);
         }
       }
     }
@@ -284,6 +317,103 @@ void VideoSender::encodeLoop() {
       window_start = Clock::now();
     }
   }
+}
+
+void VideoSender::feedbackLoop() {
+  std::vector<uint8_t> buf(2048);
+  auto next_sr = Clock::now();
+  while (running_) {
+    if (Clock::now() >= next_sr) {
+      sendSenderReport();
+      next_sr = Clock::now() + std::chrono::seconds(1);
+    }
+    // Wait for RTCP at most 50 ms at a time, so that stop() returns soon
+    // (asio's blocking read would wait for ever: it polls again on EAGAIN).
+    pollfd pfd{net_->socket.native_handle(), POLLIN, 0};
+    if (::poll(&pfd, 1, 50) <= 0) continue;
+    asio::ip::udp::endpoint from;
+    boost::system::error_code ec;
+    const std::size_t n = net_->socket.receive_from(asio::buffer(buf), from, 0, ec);
+    if (ec) continue;  // an ICMP error of an earlier send (nobody listening yet)
+    if (from != net_->dest) continue;  // only the destination gives feedback
+    onFeedback(std::span<const uint8_t>(buf.data(), n));
+  }
+}
+
+void VideoSender::sendSenderReport() {
+  rtcp::SenderInfo info;
+  {
+    std::lock_guard hl(net_->history_mu);
+    if (net_->packets_sent == 0) return;  // nothing to map yet
+    info.packets = net_->packets_sent;
+    info.octets = net_->octets_sent;
+  }
+  // The RTP clock is the capture clock (CLOCK_MONOTONIC) at 90 kHz; the NTP
+  // time is the wall clock at the same instant.
+  info.rtp_timestamp = static_cast<uint32_t>(monoNowUs() * 9 / 100);
+  info.ntp = rtcp::ntpFromUnixMicros(wallNowNs() / 1000);
+  std::vector<uint8_t> d;
+  rtcp::appendSenderReport(d, ssrc_, info);
+  rtcp::appendCname(d, ssrc_, "inspect-robot-" + std::to_string(ssrc_));
+  if (net_->send(d, nullptr)) {
+    std::lock_guard lk(mu_);
+    ++st_.sender_reports;
+  }
+}
+
+void VideoSender::onFeedback(std::span<const uint8_t> datagram) {
+  rtcp::Compound c;
+  const rtcp::RtcpError e = rtcp::parseCompound(datagram, c);
+  if (e != rtcp::RtcpError::kNone) {
+    std::lock_guard lk(mu_);
+    ++st_.rtcp_errors;
+    st_.error = std::string("video: RTCP from the receiver: ") + rtcp::toString(e);
+    return;
+  }
+  const uint32_t now_middle = rtcp::ntpMiddle(rtcp::ntpFromUnixMicros(wallNowNs() / 1000));
+  std::optional<double> rtt_s, loss;
+  uint64_t blocks = 0;
+  for (const auto& rr : c.receiver_reports)
+    for (const auto& b : rr.blocks) {
+      if (b.ssrc != ssrc_) continue;
+      ++blocks;
+      loss = b.fraction_lost / 2.56;
+      if (auto r = rtcp::roundTripSeconds(now_middle, b.lsr, b.dlsr)) rtt_s = r;
+    }
+  uint64_t asked = 0, sent = 0, missed = 0, nacks = 0;
+  const uint64_t now_us = monoNowUs();
+  for (const auto& n : c.nacks) {
+    if (n.media_ssrc != ssrc_) continue;
+    ++nacks;
+    for (uint16_t seq : n.seqs) {
+      ++asked;
+      std::optional<std::vector<uint8_t>> rtx;
+      {
+        std::lock_guard hl(net_->history_mu);
+        if (const auto* orig = net_->history.find(seq, now_us))
+          rtx = makeRtx(*orig, rtx_ssrc_, kRtxPayloadType, net_->rtx_seq++);
+      }
+      if (!rtx) {
+        ++missed;
+        continue;
+      }
+      if (net_->send(*rtx, nullptr)) ++sent;
+    }
+  }
+  uint64_t plis = 0;
+  for (const auto& p : c.plis)
+    if (p.media_ssrc == ssrc_) ++plis;
+  if (plis) keyframe_requested_ = true;
+  std::lock_guard lk(mu_);
+  st_.receiver_reports += blocks;
+  if (loss) st_.peer_loss_pct = *loss;
+  if (rtt_s) st_.rtt_ms = *rtt_s * 1000.0;
+  st_.nacks += nacks;
+  st_.nacked_packets += asked;
+  st_.retransmitted += sent;
+  st_.not_in_history += missed;
+  st_.plis += plis;
+  st_.keyframe_requests += plis;
 }
 
 }  // namespace inspect::video

@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 
@@ -31,6 +32,12 @@ struct SenderSettings {
   uint16_t port = 5600;
   std::size_t mtu = 1200;   // bytes per datagram including IP/UDP headers; [256, 9000]
   uint32_t ssrc = 0;        // 0 = random
+  /// RTCP on the same socket (RFC 5761 rtcp-mux): sender reports to the
+  /// destination every second; NACKs answered with RFC 4588 RTX packets from
+  /// the history, PLIs with a keyframe, receiver reports into the stats.
+  bool retransmission = true;
+  std::size_t history_packets = 1024;  // packets kept for retransmission; [0, 65536]
+  double history_s = 1.0;              // ...and for at most this long; [0.01, 10]
 };
 
 /// Checks the settings (ranges, encoder settings); "" or the first problem.
@@ -48,6 +55,18 @@ struct SenderStats {
   uint64_t captured = 0, encoded = 0, dropped = 0, keyframes = 0;
   uint64_t packets = 0, bytes = 0, send_errors = 0;
   uint64_t keyframe_requests = 0;
+  // RTCP (rtcp-mux, docs/video.md "RTCP"):
+  uint32_t rtx_ssrc = 0;
+  uint64_t sender_reports = 0;       // SRs sent
+  uint64_t receiver_reports = 0;     // report blocks about this stream received
+  uint64_t nacks = 0;                // NACK packets received
+  uint64_t nacked_packets = 0;       // sequence numbers asked for
+  uint64_t retransmitted = 0;        // RTX packets sent
+  uint64_t not_in_history = 0;       // asked for but no longer held
+  uint64_t plis = 0;                 // picture loss indications received
+  uint64_t rtcp_errors = 0;          // datagrams on the socket that were not RTCP we accept
+  double peer_loss_pct = -1;         // the receiver's last reported fraction lost; < 0 = no report yet
+  double rtt_ms = -1;                // from the last report's LSR/DLSR; < 0 = none yet
   double encode_ms = 0;     // mean over the last second
   std::string error;        // last error, "" = none
 };
@@ -82,6 +101,9 @@ class VideoSender {
  private:
   void captureLoop();
   void encodeLoop();
+  void feedbackLoop();
+  void onFeedback(std::span<const uint8_t> datagram);
+  void sendSenderReport();
   void setError(const std::string& e);
 
   mutable std::mutex mu_;
@@ -99,7 +121,8 @@ class VideoSender {
   std::atomic<bool> keyframe_requested_{false};
   std::atomic<bool> running_{false};
   uint32_t ssrc_;
-  std::thread capture_thread_, encode_thread_;
+  uint32_t rtx_ssrc_;
+  std::thread capture_thread_, encode_thread_, feedback_thread_;
   struct Net;
   std::unique_ptr<Net> net_;
 };
