@@ -75,6 +75,10 @@ std::string videoReport(const std::string& robot_id, const std::optional<RobotSn
                          std::to_string(st->frames_skipped) + ", decode errors " +
                          std::to_string(st->decode_errors) + ", keyframe requests " +
                          std::to_string(st->keyframe_requests));
+    line("repair", "NACKs " + std::to_string(st->nacks_sent) + " for " + std::to_string(st->nacked_packets) +
+                       " packets, retransmissions " + std::to_string(st->retransmissions) + ", unneeded " +
+                       std::to_string(st->rtx_unneeded) + ", PLIs " + std::to_string(st->plis_sent) + ", RTT " +
+                       (st->rtt_ms < 0 ? std::string("-") : fmtFixed(st->rtt_ms, 1) + " ms"));
   }
   const auto c = video->counters();
   line("rejected datagrams", "not RTP " + std::to_string(c.not_rtp) + ", unknown SSRC " + std::to_string(c.unknown_ssrc) +

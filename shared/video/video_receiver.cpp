@@ -9,6 +9,7 @@
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
 #include "shared/video/rtcp.hpp"
+#include "shared/video/rtx.hpp"
 
 namespace inspect::video {
 
@@ -20,6 +21,8 @@ constexpr std::size_t kMaxDatagram = 65536;
 constexpr auto kTick = std::chrono::milliseconds(100);
 constexpr int kTicksPerWindow = 10;            // rates over 1 s
 constexpr std::size_t kLatencyHistory = 300;
+constexpr uint32_t kReceiverSsrc = 0x5E55AE01;  // the server's RTCP SSRC (it sends no media)
+constexpr std::size_t kNackWindow = 1024;        // packets a gap may hold behind it while waiting for RTX
 
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return -1;
@@ -31,7 +34,7 @@ double percentile(std::vector<double> v, double q) {
 
 struct VideoReceiver::Stream {
   Stream(uint32_t ssrc_, asio::ip::address source_, int64_t offset, std::size_t window, bool decode)
-      : ssrc(ssrc_), source(std::move(source_)), offset_us(offset), reorder(window) {
+      : ssrc(ssrc_), source(std::move(source_)), offset_us(offset), reorder(window), nacks(nackSettings()) {
     if (decode) decoder = std::make_unique<H264Decoder>();
   }
   uint32_t ssrc;
@@ -54,6 +57,19 @@ struct VideoReceiver::Stream {
   double w_latency_sum = 0;
   uint64_t w_latency_n = 0;
   std::vector<std::pair<uint32_t, std::vector<uint8_t>>> ready;  // scratch
+  // RTCP feedback.
+  rtcp::ReceiverStats rstats;
+  NackList nacks;
+  asio::ip::udp::endpoint feedback_to;  // where this stream's RTP comes from; unset = nothing yet
+  std::map<uint16_t, uint64_t> nacked_at_us;  // first NACK time per sequence number, for the RTT
+  double rtt_us = 20000;                      // assumed until measured
+  bool rtt_measured = false;
+
+  static NackSettings nackSettings() {
+    NackSettings n;
+    n.reorder_wait_us = 0;  // loss on Wi-Fi is far more common than reordering: ask at once
+    return n;
+  }
 };
 
 VideoReceiver::VideoReceiver(ReceiverSettings s)
@@ -104,7 +120,9 @@ void VideoReceiver::setStream(const std::string& name, uint32_t ssrc, const asio
       s->offset_us = clock_offset_us;
       return;
     }
-    s = std::make_unique<Stream>(ssrc, source, clock_offset_us, settings_.reorder_window, settings_.decode);
+    s = std::make_unique<Stream>(ssrc, source, clock_offset_us,
+                                 settings_.nack ? std::max(settings_.reorder_window, kNackWindow) : settings_.reorder_window,
+                                 settings_.decode);
     s->st.ssrc = ssrc;
     log::info(log::tag::kVideo, name, ": expecting SSRC ", ssrc, " from ", source.is_unspecified() ? "any address" : source.to_string());
   });
@@ -186,10 +204,12 @@ void VideoReceiver::doReceive() {
 void VideoReceiver::onDatagram(std::size_t n) {
   const std::span<const uint8_t> data(rx_buf_.data(), n);
   if (rtcp::looksLikeRtcp(data)) {  // RFC 5761 4: payload types 192-223 on the RTP port are RTCP
-    std::lock_guard lk(mu_);
-    ++counters_.datagrams;
-    ++counters_.rtcp;
-    return;
+    {
+      std::lock_guard lk(mu_);
+      ++counters_.datagrams;
+      ++counters_.rtcp;
+    }
+    return onRtcp(data);
   }
   RtpPacket p;
   const RtpError err = parseRtp(data, p);
@@ -200,6 +220,7 @@ void VideoReceiver::onDatagram(std::size_t n) {
     counters_.last_reject = "from " + sender_.address().to_string() + ":" + std::to_string(sender_.port()) + ": " + why;
   };
   if (err != RtpError::kNone) return reject(&ReceiverCounters::not_rtp, std::string("not RTP: ") + toString(err));
+  if (p.payload_type == kRtxPayloadType && settings_.nack) return onRtx(data);
   if (p.payload_type != kPayloadType)
     return reject(&ReceiverCounters::wrong_payload_type, "payload type " + std::to_string(p.payload_type));
   for (auto& [name, s] : streams_) {
@@ -211,14 +232,88 @@ void VideoReceiver::onDatagram(std::size_t n) {
       std::lock_guard lk(mu_);
       ++counters_.datagrams;
     }
+    s->feedback_to = sender_;
+    s->rstats.onPacket(p.seq, p.timestamp, monoNowUs());
     handlePacket(*s, name, p.seq, std::vector<uint8_t>(data.begin(), data.end()));
     return;
   }
   reject(&ReceiverCounters::unknown_ssrc, "unknown SSRC " + std::to_string(p.ssrc));
 }
 
-void VideoReceiver::handlePacket(Stream& s, const std::string& name, uint16_t seq, std::vector<uint8_t> datagram) {
+void VideoReceiver::onRtcp(std::span<const uint8_t> data) {
+  rtcp::Compound c;
+  if (rtcp::parseCompound(data, c) != rtcp::RtcpError::kNone) return;  // counted as rtcp; nothing to use
+  for (const auto& sr : c.sender_reports)
+    for (auto& [name, s] : streams_)
+      if (s->ssrc == sr.ssrc && s->feedback_to == sender_) s->rstats.onSenderReport(sr.info.ntp, monoNowUs());
+}
+
+void VideoReceiver::onRtx(std::span<const uint8_t> data) {
+  // An RTX packet belongs to the stream whose media comes from the same
+  // address and port (the robot sends both from one socket).
+  for (auto& [name, s] : streams_) {
+    if (s->feedback_to != sender_) continue;
+    std::vector<uint8_t> orig;
+    if (unwrapRtx(data, kRtxPayloadType, kPayloadType, s->ssrc, orig) != RtxError::kNone) return;
+    const uint16_t seq = static_cast<uint16_t>(orig[2] << 8 | orig[3]);
+    {
+      std::lock_guard lk(mu_);
+      ++counters_.datagrams;
+    }
+    if (!s->nacks.missing(seq)) {
+      ++s->st.rtx_unneeded;
+      return;
+    }
+    if (auto it = s->nacked_at_us.find(seq); it != s->nacked_at_us.end()) {
+      const double sample = static_cast<double>(monoNowUs() - it->second);
+      s->rtt_us = s->rtt_measured ? 0.875 * s->rtt_us + 0.125 * sample : sample;  // RFC 6298-style smoothing
+      s->rtt_measured = true;
+      s->st.rtt_ms = s->rtt_us / 1000.0;
+    }
+    ++s->st.retransmissions;  // not counted in rstats: the reports give the loss on the wire
+    handlePacket(*s, name, seq, std::move(orig), true);
+    return;
+  }
+  std::lock_guard lk(mu_);
+  ++counters_.datagrams;
+  ++counters_.unknown_ssrc;
+  counters_.last_reject = "from " + sender_.address().to_string() + ":" + std::to_string(sender_.port()) +
+                          ": RTX from an address no stream's media comes from";
+}
+
+void VideoReceiver::sendFeedback(Stream& s, const std::vector<uint8_t>& d) {
+  if (s.feedback_to.port() == 0 || d.empty()) return;
+  boost::system::error_code ec;
+  socket_.send_to(asio::buffer(d), s.feedback_to, 0, ec);  // loss of feedback is recovered by the next one
+}
+
+void VideoReceiver::sendNacks(Stream& s) {
+  if (!settings_.nack) return;
+  const uint64_t now_us = monoNowUs();
+  const auto due = s.nacks.due(now_us, static_cast<uint64_t>(s.rtt_us));
+  if (due.empty()) return;
+  std::vector<uint8_t> d;
+  rtcp::appendNack(d, kReceiverSsrc, s.ssrc, due);
+  sendFeedback(s, d);
+  ++s.st.nacks_sent;
+  s.st.nacked_packets += due.size();
+  for (uint16_t q : due) s.nacked_at_us.try_emplace(q, now_us);
+  while (s.nacked_at_us.size() > kNackWindow) s.nacked_at_us.erase(s.nacked_at_us.begin());
+}
+
+Clock::duration VideoReceiver::gapWait(const Stream& s) const {
+  const double base = settings_.reorder_timeout_s;
+  if (!settings_.nack) return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(base));
+  // Time for a NACK and its retransmission, twice (one lost either way), plus scheduling slack.
+  const double w = std::clamp(2.0 * s.rtt_us / 1e6 + 0.015, base, std::max(base, settings_.max_wait_s));
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(w));
+}
+
+void VideoReceiver::handlePacket(Stream& s, const std::string& name, uint16_t seq, std::vector<uint8_t> datagram,
+                                 bool retransmitted) {
   const auto now = Clock::now();
+  if (settings_.nack) s.nacks.onPacket(seq, monoNowUs());
+  if (retransmitted) s.nacked_at_us.erase(seq);
   s.last_packet = now;
   ++s.st.packets;
   ++s.w_packets;
@@ -235,10 +330,13 @@ void VideoReceiver::handlePacket(Stream& s, const std::string& name, uint16_t se
     s.gap_since = {};
   } else if (s.gap_since == Clock::time_point{}) {
     s.gap_since = now;
-  } else if (now - s.gap_since >= std::chrono::duration<double>(settings_.reorder_timeout_s)) {
+  } else if (now - s.gap_since >= gapWait(s)) {
     s.reorder.flush(s.ready);
     s.gap_since = {};
   }
+  // What is no longer held behind a gap is given up (nothing more to NACK).
+  if (s.reorder.held() == 0 && s.nacks.size() > 0) (void)s.nacks.expire(~0ull, 0, 0);
+  sendNacks(s);
   depacketizeReady(s, name);
   maybeRequestKeyframe(s, name);
 }
@@ -261,6 +359,12 @@ void VideoReceiver::maybeRequestKeyframe(Stream& s, const std::string& name) {
   s.last_request = now;
   ++s.st.keyframe_requests;
   if (keyframe_request_) keyframe_request_(name);
+  if (settings_.nack) {  // and over RTCP, which reaches the robot without the TCP link's queue
+    std::vector<uint8_t> d;
+    rtcp::appendPli(d, kReceiverSsrc, s.ssrc);
+    sendFeedback(s, d);
+    ++s.st.plis_sent;
+  }
 }
 
 void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) {
@@ -320,14 +424,15 @@ void VideoReceiver::tick() {
   for (auto& [name, sp] : streams_) {
     Stream& s = *sp;
     // A gap nobody will fill (the stream paused): release what is held.
-    if (s.reorder.held() > 0 && s.gap_since != Clock::time_point{} &&
-        now - s.gap_since >= std::chrono::duration<double>(settings_.reorder_timeout_s)) {
+    if (s.reorder.held() > 0 && s.gap_since != Clock::time_point{} && now - s.gap_since >= gapWait(s)) {
       s.ready.clear();
       s.reorder.flush(s.ready);
       s.gap_since = {};
+      (void)s.nacks.expire(~0ull, 0, 0);
       depacketizeReady(s, name);
       maybeRequestKeyframe(s, name);
     }
+    if (settings_.nack) sendNacks(s);  // retries while no packet arrives
     const auto& dc = s.depack.counters();
     s.w_lost += dc.lost_packets - s.st.lost_packets;
     s.st.frames = dc.frames;
@@ -337,6 +442,13 @@ void VideoReceiver::tick() {
     s.st.duplicates = s.reorder.duplicates();
     s.st.late = s.reorder.late();
     s.st.active = s.last_packet != Clock::time_point{} && now - s.last_packet < std::chrono::seconds(2);
+    if (window_end && settings_.nack && s.rstats.started()) {
+      const rtcp::ReportBlock b = s.rstats.report(s.ssrc, monoNowUs());
+      std::vector<uint8_t> d;
+      rtcp::appendReceiverReport(d, kReceiverSsrc, std::span(&b, 1));
+      sendFeedback(s, d);
+      ++s.st.reports_sent;
+    }
     if (window_end) {
       s.st.fps_received = static_cast<double>(s.w_frames);
       s.st.fps_decoded = static_cast<double>(s.w_decoded);

@@ -11,6 +11,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -33,6 +34,13 @@ struct ReceiverSettings {
   double reorder_timeout_s = 0.02;      // ...and for at most this long (a gap is given up then)
   double keyframe_min_interval_s = 0.3; // at most one keyframe request per this per stream
   bool decode = true;                   // false: reassemble and count only
+  /// RTCP feedback to each stream's sender (rtcp-mux, to the address its
+  /// RTP comes from): NACKs for missing packets (their RTX repairs are taken
+  /// in), a PLI with each keyframe request, a receiver report every second.
+  /// A gap then waits for its retransmission up to about two round trips
+  /// (at least reorder_timeout_s, at most max_wait_s) before it is given up.
+  bool nack = true;
+  double max_wait_s = 0.25;
 };
 
 /// Live figures of one stream (rates over the last second).
@@ -54,6 +62,14 @@ struct StreamStats {
   uint64_t frames_skipped = 0; // intact frames not decoded: they follow a loss and the
                                // keyframe that repairs the picture has not come yet
   uint64_t keyframe_requests = 0;
+  // RTCP feedback (ReceiverSettings::nack):
+  uint64_t nacks_sent = 0;          // NACK packets
+  uint64_t nacked_packets = 0;      // sequence numbers asked for (each try)
+  uint64_t retransmissions = 0;     // RTX packets that filled a hole
+  uint64_t rtx_unneeded = 0;        // RTX packets for a hole already filled or given up
+  uint64_t plis_sent = 0;
+  uint64_t reports_sent = 0;        // receiver reports
+  double rtt_ms = -1;               // NACK -> its retransmission, smoothed; < 0 = none yet
 };
 
 /// Datagrams that no stream took.
@@ -118,7 +134,13 @@ class VideoReceiver {
   struct Stream;
   void doReceive();
   void onDatagram(std::size_t n);
-  void handlePacket(Stream& s, const std::string& name, uint16_t seq, std::vector<uint8_t> datagram);
+  void handlePacket(Stream& s, const std::string& name, uint16_t seq, std::vector<uint8_t> datagram,
+                    bool retransmitted = false);
+  void onRtcp(std::span<const uint8_t> data);
+  void onRtx(std::span<const uint8_t> data);
+  void sendFeedback(Stream& s, const std::vector<uint8_t>& rtcp);
+  void sendNacks(Stream& s);
+  std::chrono::steady_clock::duration gapWait(const Stream& s) const;
   void checkNotStarted() const;
   /// Feeds the reorder buffer's released packets (s.ready) to the depacketizer.
   void depacketizeReady(Stream& s, const std::string& name);

@@ -6,7 +6,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <deque>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -43,27 +45,76 @@ UdpRelay::~UdpRelay() {
 }
 
 void UdpRelay::run() {
-  std::mt19937_64 rng(p_.seed);
+  using Clock = std::chrono::steady_clock;
+  std::mt19937_64 rng(p_.seed), back_rng(p_.seed ^ 0x9E3779B97F4A7C15ULL);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const sockaddr_in to = loopbackAddress(target_);
-  auto send = [&](const std::vector<uint8_t>& d) {
-    ::sendto(out_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
-    ++c_.sent;
+  sockaddr_in from{};  // the last sender: where feedback goes
+  bool have_from = false;
+  const auto delay = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(p_.delay_ms));
+  struct Due {
+    Clock::time_point at;
+    bool back;
+    std::vector<uint8_t> d;
   };
+  std::deque<Due> queue;  // in release order (the delay is the same for every datagram)
+  auto emit = [&](bool back, const std::vector<uint8_t>& d) {
+    if (back) {
+      ::sendto(in_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&from), sizeof from);
+      ++c_.back_sent;
+    } else {
+      ::sendto(out_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+      ++c_.sent;
+    }
+  };
+  auto send = [&](bool back, std::vector<uint8_t> d) {
+    if (delay.count() > 0)
+      queue.push_back({Clock::now() + delay, back, std::move(d)});
+    else
+      emit(back, d);
+  };
+  // out_ must have a local port before the target can answer it.
+  {
+    sockaddr_in a = loopbackAddress(0);
+    ::bind(out_, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  }
   std::vector<uint8_t> buf(65536), held;
   bool holding = false;
   uint64_t index = 0;
   while (!stop_) {
-    pollfd pfd{in_, POLLIN, 0};
-    if (::poll(&pfd, 1, 20) <= 0) {
-      if (holding) {  // nothing came after the held one: let it go
-        send(held);
+    while (!queue.empty() && queue.front().at <= Clock::now()) {
+      emit(queue.front().back, queue.front().d);
+      queue.pop_front();
+    }
+    int wait_ms = 20;
+    if (!queue.empty())
+      wait_ms = static_cast<int>(std::clamp<int64_t>(
+          std::chrono::duration_cast<std::chrono::milliseconds>(queue.front().at - Clock::now()).count(), 0, 20));
+    pollfd pfd[2] = {{in_, POLLIN, 0}, {out_, POLLIN, 0}};
+    if (::poll(pfd, 2, wait_ms) <= 0) {
+      if (holding && queue.empty()) {  // nothing came after the held one: let it go
+        send(false, std::move(held));
         holding = false;
       }
       continue;
     }
-    const ssize_t n = ::recv(in_, buf.data(), buf.size(), 0);
+    if (pfd[1].revents & POLLIN) {  // feedback from the target
+      const ssize_t n = ::recv(out_, buf.data(), buf.size(), 0);
+      if (n >= 0) {
+        ++c_.back_received;
+        if (!have_from || (p_.drop_back && u(back_rng) < p_.drop))
+          ++c_.back_dropped;
+        else
+          send(true, std::vector<uint8_t>(buf.begin(), buf.begin() + n));
+      }
+    }
+    if (!(pfd[0].revents & POLLIN)) continue;
+    sockaddr_in src{};
+    socklen_t slen = sizeof src;
+    const ssize_t n = ::recvfrom(in_, buf.data(), buf.size(), 0, reinterpret_cast<sockaddr*>(&src), &slen);
     if (n < 0) continue;
+    from = src;
+    have_from = true;
     ++c_.received;
     const uint64_t i = index++;
     std::vector<uint8_t> d(buf.begin(), buf.begin() + n);
@@ -72,20 +123,20 @@ void UdpRelay::run() {
       ++c_.dropped;
       continue;
     }
-    if (p_.delay_ms > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(p_.delay_ms));
     if (!holding && u(rng) < p_.reorder) {
       held = std::move(d);
       holding = true;
       ++c_.reordered;
       continue;
     }
-    send(d);
-    if (u(rng) < p_.duplicate) {
-      send(d);
+    const bool dup = u(rng) < p_.duplicate;
+    if (dup) {
+      send(false, d);
       ++c_.duplicated;
     }
+    send(false, std::move(d));
     if (holding) {
-      send(held);
+      send(false, std::move(held));
       holding = false;
     }
   }

@@ -60,10 +60,13 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   s.enableVideo();
   const int player_port = freeUdpPort();
   ASSERT_GT(player_port, 0);
-  // GOP 600 (20 s) and a burst of 20 lost packets ~1.5 s in (a UDP relay
-  // between robot and server): the picture comes back within the run only
-  // because the server's keyframe request reaches the robot over TCP.
-  writeFile(s.dir() / "client.yaml", "video:\n  gop: 600\n");
+  // GOP 600 (20 s) and a burst of 40 lost packets ~1.5 s in (a UDP relay
+  // between robot and server) with the robot's retransmission history cut
+  // to its last 20 packets: the newest of the burst are repaired by NACK +
+  // RTX, the oldest cannot be, and the picture comes back within the run
+  // only because the server's keyframe request (PLI, and over TCP) reaches
+  // the robot.
+  writeFile(s.dir() / "client.yaml", "video:\n  gop: 600\n  history_packets: 20\n");
   writeFile(s.dir() / "server.yaml", "video:\n  forward_base_port: " + std::to_string(player_port) +
                                           "\n  snapshot_period_s: 1\n  window: off\n");
   const std::string snap = s.dir() / "snap.png";
@@ -88,7 +91,7 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
       << s.logs();
   UdpRelayParams lossy;
   lossy.burst_from = 250;
-  lossy.burst_len = 20;
+  lossy.burst_len = 40;
   UdpRelay relay(static_cast<uint16_t>(s.videoPort()), lossy);
   auto& robot = s.startRobot("robot1", "square_room.yaml", {}, {},
                              {"--config", s.dir() / "client.yaml", "--video-port", std::to_string(relay.port())});
@@ -130,6 +133,11 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   const auto counters = statsNumbers(out, "counters", 0);  // packets, lost, ...
   ASSERT_GE(counters.size(), 2u) << out;
   EXPECT_GE(counters[1], 20) << "the relay's burst was seen as lost\n" << out;
+  const auto repair = statsNumbers(out, "repair", 0);  // NACKs, packets, retransmissions, unneeded, PLIs, RTT
+  ASSERT_GE(repair.size(), 5u) << out;
+  EXPECT_GE(repair[0], 1) << "NACKs sent\n" << out;
+  EXPECT_GE(repair[2], 1) << "retransmissions taken\n" << out;
+  EXPECT_GE(repair[4], 1) << "a PLI with the keyframe request\n" << out;
   EXPECT_NE(out.find("| video "), std::string::npos) << out;
   EXPECT_NE(out.find("fps"), std::string::npos) << out;
   EXPECT_TRUE(exists(snap)) << out;
