@@ -133,15 +133,32 @@ else
   summary2+=" build $((t_built2 - t_suite)) s (ccache hits ${hits2:-?}), tests $((t_done2 - t_built2)) s"
 fi
 
+# The one command that reruns just the failed tests of build dir $1, whose
+# phases' failed lists are the files after it: they become ctest's own
+# LastTestsFailed.log (each phase's run overwrote it), so that
+# `ctest --rerun-failed` takes exactly those.
+rerun_hint() {
+  local dir=$1
+  shift
+  local merged=$dir/Testing/Temporary/LastTestsFailed.log
+  mkdir -p "$(dirname "$merged")"
+  cat "$@" 2>/dev/null | sort -t: -k1,1n -u > "$merged" || true
+  [ -s "$merged" ] || return 0
+  echo "test: rerun just the failed ones: (cd $dir && ctest --rerun-failed --output-on-failure)"
+}
+rerun1="" rerun2=""
 if [ $stage1 -ne 0 ]; then
   for phase in unit stack; do
     report_failures "$BUILD/Testing/$phase-failed.log" "$BUILD/Testing/$phase.log" "stage 1 ($phase phase)"
   done
+  rerun1=$(rerun_hint "$BUILD" "$BUILD/Testing/unit-failed.log" "$BUILD/Testing/stack-failed.log")
 fi
 if [ $stage2 -ne 0 ] && [ -n "${log2:-}" ]; then
   report_failures "$ASAN_DIR/Testing/sanitize-failed.log" "$ASAN_DIR/Testing/sanitize.log" "stage 2"
+  rerun2=$(rerun_hint "$ASAN_DIR" "$ASAN_DIR/Testing/sanitize-failed.log")
 fi
 echo "test: setup $((t_setup - t0)) s, all $(($(date +%s) - t0)) s"
 echo "test: $summary1"
 echo "test: $summary2"
+for hint in "$rerun1" "$rerun2"; do [ -z "$hint" ] || echo "$hint"; done
 [ $stage1 -eq 0 ] && [ $stage2 -eq 0 ]

@@ -2,13 +2,22 @@
 #include "tests/support/test_certs.hpp"
 
 #include <algorithm>
-
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <regex>
 #include <sstream>
 
 namespace inspect::test {
 
+
+double expectedValue(const std::string& console_out, const std::string& field, int occurrence) {
+  const std::regex re("expect ok \\(line \\d+\\): " + field + " = ([-0-9.e+]+)");
+  int n = 0;
+  for (auto it = std::sregex_iterator(console_out.begin(), console_out.end(), re); it != std::sregex_iterator(); ++it)
+    if (n++ == occurrence) return std::stod((*it)[1]);
+  return std::nan("");
+}
 
 Truth readTruth(const std::string& path) {
   Truth t;

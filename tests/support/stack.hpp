@@ -50,6 +50,10 @@ struct Truth {
 };
 Truth readTruth(const std::string& path);
 
+/// The value a console `expect` printed for `field` ("expect ok (line N):
+/// field = V"), its `occurrence`-th time (0 = the first); NaN when absent.
+double expectedValue(const std::string& console_out, const std::string& field, int occurrence = 0);
+
 
 /// A simulated robot: mcu_sim + robot_client.
 struct RobotProcs {

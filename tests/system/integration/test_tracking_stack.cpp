@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <sstream>
@@ -36,12 +37,14 @@ sim::ClosedLoopMetrics inProcess(control::WheelControl wc, double dead_time_s, u
 }
 }  // namespace
 
-TEST(TrackingStack, CircleMatchesTheInProcessExperimentSpreadWithin20Percent) {
+TEST(TrackingStack, CircleTrackedNoWorseThanTheInProcessExperimentBy20Percent) {
   // The maxima are peaks of a lightly damped oscillation: they move with the
   // noise and with the link's latency (about 10 ms of wall time, 20 ms of
   // sim time at --rate 2; up to 30 ms when a shared machine schedules a
-  // process late). The full stack must land within 20 % of the in-process
-  // spread over 5 noise seeds x those latencies.
+  // process late). The full stack must not track worse than 20 % above the
+  // worst in-process run over 5 noise seeds x those latencies. One-sided:
+  // tracking better than the in-process spread is never wrong (the stack's
+  // figures come from 50 Hz telemetry, which can step over a peak).
   double pos_lo = 1e9, pos_hi = 0, ang_lo = 1e9, ang_hi = 0;
   for (uint32_t seed = 1; seed <= 5; ++seed)
     for (double d : {0.0, 0.01, 0.02, 0.03}) {
@@ -51,16 +54,12 @@ TEST(TrackingStack, CircleMatchesTheInProcessExperimentSpreadWithin20Percent) {
       ang_lo = std::min(ang_lo, m.max_ang_err_rad);
       ang_hi = std::max(ang_hi, m.max_ang_err_rad);
     }
-  const auto band = [](double lo, double hi) {
-    const double a = 0.8 * lo, b = 1.2 * hi;
-    return std::to_string((a + b) / 2) + " " + std::to_string((b - a) / 2);
-  };
+  const double pos_limit = 1.2 * pos_hi, ang_limit = 1.2 * ang_hi;
   std::ostringstream script;
   script << "expect robots >= 1 within 15\nexpect sensor_hz > 50 within 5\n"
          << "track circle 3.5 0.5 1 fuzzy_pid\nexpect mode == TRACKING within 1\n"
          << "expect mode == IDLE within 40\nexpect progress ~ 1 0.001\nstatus\n"
-         << "expect max_pos_err ~ " << band(pos_lo, pos_hi) << "\n"
-         << "expect max_ang_err ~ " << band(ang_lo, ang_hi) << "\n";
+         << "expect max_pos_err > 0\nexpect max_ang_err > 0\n";
   Stack s("track");
   ASSERT_TRUE(s.startServer(script.str())) << s.logs();
   // 2x faster than real time: the client's loop runs on the MCU's clock (dt
@@ -68,7 +67,13 @@ TEST(TrackingStack, CircleMatchesTheInProcessExperimentSpreadWithin20Percent) {
   s.startRobot("robot1", "empty.yaml", {}, {"--rate", "2"});
   const auto rc = s.server().wait(90);
   ASSERT_TRUE(rc.has_value()) << s.logs();
-  std::printf("TRACK in-process max position error %.4f-%.4f m, max angle error %.4f-%.4f rad\n%s", pos_lo, pos_hi,
-              ang_lo, ang_hi, s.serverOutput().c_str());
+  const std::string out = s.serverOutput();
+  const double pos = expectedValue(out, "max_pos_err"), ang = expectedValue(out, "max_ang_err");
+  std::printf("%sTRACK max position error: full stack %.4f m, in-process %.4f-%.4f m, limit %.4f m\n"
+              "TRACK max angle error:    full stack %.4f rad, in-process %.4f-%.4f rad, limit %.4f rad\n",
+              out.c_str(), pos, pos_lo, pos_hi, pos_limit, ang, ang_lo, ang_hi, ang_limit);
   EXPECT_EQ(*rc, 0) << s.logs();
+  ASSERT_TRUE(std::isfinite(pos) && std::isfinite(ang)) << "the console printed no tracking figures\n" << out;
+  EXPECT_LE(pos, pos_limit) << "the full stack tracks the circle worse than the in-process experiment";
+  EXPECT_LE(ang, ang_limit) << "the full stack tracks the circle worse than the in-process experiment";
 }

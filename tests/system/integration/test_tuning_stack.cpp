@@ -65,14 +65,6 @@ std::vector<CircleFigures> circles(const Truth& truth, double r) {
   return out;
 }
 
-double expectValue(const std::string& out, const std::string& field, int occurrence) {
-  const std::regex re("expect ok \\(line \\d+\\): " + field + " = ([-0-9.e+]+)");
-  int n = 0;
-  for (auto it = std::sregex_iterator(out.begin(), out.end(), re); it != std::sregex_iterator(); ++it)
-    if (n++ == occurrence) return std::stod((*it)[1]);
-  return std::nan("");
-}
-
 }  // namespace
 
 TEST(TuningStack, IdentifyTunePushAndTheCircleIsTrackedBetter) {
@@ -112,8 +104,8 @@ TEST(TuningStack, IdentifyTunePushAndTheCircleIsTrackedBetter) {
   EXPECT_NE(out.find("robot1: gains v2 accepted"), std::string::npos) << "revert pushes the previous set as v2";
 
   // The robot's own figures (odometry against the reference): better with the tuned gains.
-  const double paper_pos = expectValue(out, "max_pos_err", 0), tuned_pos = expectValue(out, "max_pos_err", 1);
-  const double paper_ang = expectValue(out, "max_ang_err", 0), tuned_ang = expectValue(out, "max_ang_err", 1);
+  const double paper_pos = expectedValue(out, "max_pos_err", 0), tuned_pos = expectedValue(out, "max_pos_err", 1);
+  const double paper_ang = expectedValue(out, "max_ang_err", 0), tuned_ang = expectedValue(out, "max_ang_err", 1);
   std::printf("TUNING robot max position error %.4f -> %.4f m, max angle error %.4f -> %.4f rad\n", paper_pos,
               tuned_pos, paper_ang, tuned_ang);
   EXPECT_LT(tuned_pos, paper_pos);
