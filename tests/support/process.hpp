@@ -24,6 +24,15 @@ class Process {
   /// from `stdin_path` (default /dev/null).
   static Process spawn(const std::vector<std::string>& argv, const std::string& stdout_path,
                        const std::string& stderr_path, const std::string& stdin_path = "/dev/null");
+  /// As spawn, for a program with a real-time loop (mcu_sim, robot_client):
+  /// its main thread runs SCHED_FIFO at kRealtimePriority with
+  /// SCHED_RESET_ON_FORK, so the threads it starts (video encoder, camera)
+  /// are ordinary ones, as robot_client.service runs it on the robot. Without
+  /// the privilege (not root, no CAP_SYS_NICE / RLIMIT_RTPRIO) it runs at
+  /// normal priority and its stderr file says so.
+  static Process spawnRealtime(const std::vector<std::string>& argv, const std::string& stdout_path,
+                               const std::string& stderr_path);
+  static constexpr int kRealtimePriority = 10;
 
   pid_t pid() const { return pid_; }
   bool running();
@@ -34,6 +43,8 @@ class Process {
   void terminate(double grace_s = 3.0);
 
  private:
+  static Process start(const std::vector<std::string>& argv, const std::string& stdout_path,
+                       const std::string& stderr_path, const std::string& stdin_path, bool realtime);
   pid_t pid_ = -1;
   std::optional<int> status_;
 };

@@ -145,14 +145,14 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
   std::vector<std::string> sim_argv = {binPath("mcu_sim"), "--world", srcPath("config/worlds/" + world), "--robot",
                                        srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
-  r->sim = Process::spawn(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
+  r->sim = Process::spawnRealtime(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
   waitUntil([&] { return exists(sim_pty); }, 10.0);
   r->pty = sim_pty;
   if (!relay_args.empty()) {
     r->pty = dir_ / (id + "-relay");
     std::vector<std::string> argv = {binPath("serial_relay"), "--mcu", sim_pty, "--pty-link", r->pty};
     argv.insert(argv.end(), relay_args.begin(), relay_args.end());
-    relays_.emplace(id, Process::spawn(argv, dir_ / (id + "-relay.out"), dir_ / (id + "-relay.err")));
+    relays_.emplace(id, Process::spawnRealtime(argv, dir_ / (id + "-relay.out"), dir_ / (id + "-relay.err")));
     waitUntil([&] { return exists(r->pty); }, 10.0);
   }
   std::vector<std::string> client_argv = {binPath("robot_client"), "--config", srcPath("config/client.yaml"),
@@ -171,7 +171,7 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     client_argv.push_back(testCertsDir({id}));
   }
   client_argv.insert(client_argv.end(), client_args.begin(), client_args.end());
-  r->client = Process::spawn(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
+  r->client = Process::spawnRealtime(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
   robots_.push_back(std::move(r));
   return *robots_.back();
 }
