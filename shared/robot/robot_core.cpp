@@ -287,9 +287,15 @@ void RobotCore::checkTimeouts(double now_s) {
   }
   if (estimate_.haveFrame() && !(faults_ & v1::FAULT_SENSOR_STALE) &&
       now_s - estimate_.lastFrameS() > safety_.sensor_timeout_s) {
-    raise(v1::FAULT_SENSOR_STALE, "");
+    // Say how long, and whether this process itself was not run for most of
+    // it (a stalled host or CPU) rather than the MCU having gone quiet.
+    std::string why = "no frame for " + std::to_string(std::lround((now_s - estimate_.lastFrameS()) * 1e3)) + " ms";
+    if (last_run_s_ >= 0.0 && now_s - last_run_s_ > safety_.sensor_timeout_s / 2)
+      why += ", this process not run for " + std::to_string(std::lround((now_s - last_run_s_) * 1e3)) + " ms";
+    raise(v1::FAULT_SENSOR_STALE, why);
     if (moving()) latchFailsafe("sensor frames stale");
   }
+  last_run_s_ = now_s;
 }
 
 double RobotCore::obstacleFactor() {

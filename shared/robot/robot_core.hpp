@@ -181,6 +181,10 @@ class RobotCore {
   GasBridge gas_;
   std::unique_ptr<behavior::HumanAwareness> awareness_;
   bool obstacle_stopped_ = false;
+  /// When the core last ran (a tick or a frame): a gap in it is this
+  /// process not being scheduled, told apart from a silent MCU in the
+  /// SENSOR_STALE text.
+  double last_run_s_ = -1.0;
 
   // Output.
   control::Twist cmd_twist_;

@@ -37,14 +37,15 @@ std::string formatSerialStats(const SerialStats& s) {
   std::snprintf(buf, sizeof buf,
                 "serial sent=%llu bytes (%.0f B/s of sim time, line utilisation %.1f %% of 11520 B/s) "
                 "dropped=%llu frames=%llu received=%llu bytes frames_ok=%llu bad_cobs=%llu bad_crc=%llu "
-                "bad_length=%llu unknown_id=%llu overflow=%llu seq_gaps=%llu sim_s=%.3f wall_s=%.3f",
+                "bad_length=%llu unknown_id=%llu overflow=%llu seq_gaps=%llu sim_s=%.3f wall_s=%.3f stalls=%llu "
+                "max_stall_ms=%.0f",
                 static_cast<unsigned long long>(s.bytes_sent), s.txBytesPerSimSecond(), 100.0 * s.lineUtilisation(),
                 static_cast<unsigned long long>(s.bytes_dropped), static_cast<unsigned long long>(s.frames_sent),
                 static_cast<unsigned long long>(s.bytes_received), static_cast<unsigned long long>(s.rx.frames_ok),
                 static_cast<unsigned long long>(s.rx.bad_cobs), static_cast<unsigned long long>(s.rx.bad_crc),
                 static_cast<unsigned long long>(s.rx.bad_length), static_cast<unsigned long long>(s.rx.unknown_id),
                 static_cast<unsigned long long>(s.rx.overflow), static_cast<unsigned long long>(s.rx.seq_gaps), s.sim_s,
-                s.wall_s);
+                s.wall_s, static_cast<unsigned long long>(s.stalls), s.max_stall_ms);
   return buf;
 }
 
@@ -77,6 +78,8 @@ SerialStats RealtimeRunner::stats(double wall_s) const {
   s.rx = sim_.mcu().rxCounters();
   s.sim_s = sim_.timeS();
   s.wall_s = wall_s;
+  s.stalls = stalls_;
+  s.max_stall_ms = max_stall_ms_;
   return s;
 }
 
@@ -99,7 +102,21 @@ RunSummary RealtimeRunner::run() {
     return t;
   };
   auto catchUp = [&] {
-    sim_.advanceTo(simNowMs(monoNowNs()));
+    const uint64_t target_ms = simNowMs(monoNowNs());
+    // Wall time since the first frame still to send was due: beyond a frame
+    // period, this process was not run when it should have been.
+    constexpr uint64_t kP = Simulation::kFramePeriod_ms;
+    const uint64_t due_ms = (sim_.timeMs() + kP - 1) / kP * kP;
+    if (target_ms > due_ms + kP) {
+      const double late_ms = static_cast<double>(target_ms - due_ms) / rate;
+      if (late_ms > kStallReport_ms) {
+        ++stalls_;
+        max_stall_ms_ = std::max(max_stall_ms_, late_ms);
+        std::fprintf(stderr, "mcu_sim: not run for %.0f ms (sim t=%.3f s): the host got no frames meanwhile\n",
+                     late_ms, static_cast<double>(due_ms) / 1e3);
+      }
+    }
+    sim_.advanceTo(target_ms);
     sim_.takeTx(tx);
     if (!tx.empty()) port_.write(tx);
     if (opts_.on_caught_up) opts_.on_caught_up(sim_);

@@ -25,6 +25,11 @@ struct SerialStats {
   serial::DecoderCounters rx;  // host -> MCU decoder
   double sim_s = 0.0;
   double wall_s = 0.0;
+  /// Times this process caught up with the wall clock more than
+  /// kStallReport_ms late (it was not run: a loaded or stalled host), and the
+  /// worst such delay; the host saw no frames for that long.
+  uint64_t stalls = 0;
+  double max_stall_ms = 0.0;
   /// Bytes the MCU produced per second of sim time (= per second on a real line).
   double txBytesPerSimSecond() const;
   /// Share of the 115200 8N1 line (11520 bytes/s) the MCU -> host traffic uses.
@@ -46,6 +51,9 @@ class RealtimeRunner {
  public:
   /// Bytes per second of a 115200 baud 8N1 line.
   static constexpr double kLineBytesPerS = 11520.0;
+  /// A catch-up this much later than the frame it sends (wall ms) is a stall:
+  /// counted, and logged on stderr with its length.
+  static constexpr double kStallReport_ms = 30.0;
 
   struct Options {
     double rate = 1.0;                 // sim seconds per wall second
@@ -67,6 +75,8 @@ class RealtimeRunner {
 
  private:
   SerialStats stats(double wall_s) const;
+  uint64_t stalls_ = 0;
+  double max_stall_ms_ = 0.0;
   Simulation& sim_;
   PtyPort& port_;
   SimObserver* observer_;
