@@ -15,6 +15,7 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   ClientConfig c;
   c.robot_id = root.string("robot_id", c.robot_id);
   if (!validRobotId(c.robot_id)) root.fail("robot_id", "'" + c.robot_id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
+  c.realtime_priority = static_cast<int>(root.integer("realtime_priority", c.realtime_priority, 0, 99));
   const auto s = root.optChild("server");
   c.server_host = s.string("host", c.server_host);
   if (c.server_host.empty()) s.fail("host", "must not be empty");

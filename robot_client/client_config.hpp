@@ -50,6 +50,8 @@ struct ClientConfig {
   int baud = 115200;
   double serial_reopen_period_s = 1.0;
   double mcu_heartbeat_period_s = 0.1;
+  /// SCHED_FIFO priority of the control loop (the main thread) once started; 0: normal scheduling.
+  int realtime_priority = 10;
   robot::SafetyParams safety;
   VideoParams video;
   TlsParams tls;

@@ -22,6 +22,7 @@
 #include "shared/net/tls.hpp"
 #include "shared/util/cli_args.hpp"
 #include "shared/util/log.hpp"
+#include "shared/util/realtime.hpp"
 #include "shared/world/world.hpp"
 
 namespace {
@@ -52,6 +53,9 @@ options:
   --plaintext          no TLS: the link is neither encrypted nor authenticated
                        (isolated test benches only; the server needs --plaintext too)
   --cmd-log FILE       write every wheel command sent to the MCU (CSV; for tests)
+  --realtime-priority N  SCHED_FIFO priority of the control loop once started,
+                       N in [0, 99], 0 = normal (overrides realtime_priority;
+                       needs root, CAP_SYS_NICE or LimitRTPRIO, else a warning)
   --video-source URI   camera stream source (overrides video.source): synthetic,
                        v4l2:/dev/videoN, file:PATH or sim:PATH (the simulated
                        camera of mcu_sim --camera PATH)
@@ -82,7 +86,7 @@ int main(int argc, char** argv) {
   std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
   std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
   std::string serial_dev, server, id, cmd_log, map_path, video_source;
-  std::optional<int> video_port;
+  std::optional<int> video_port, realtime_priority;
   std::optional<robot::GasReaction> gas_reaction;
   bool no_video = false, plaintext = false;
   std::string certs_dir;
@@ -107,6 +111,7 @@ int main(int argc, char** argv) {
       else if (a.is("--video-source")) video_source = a.path();
       else if (a.is("--video-port")) video_port = static_cast<int>(a.integer(1, 65535));
       else if (a.is("--certs")) certs_dir = a.path();
+      else if (a.is("--realtime-priority")) realtime_priority = static_cast<int>(a.integer(0, 99));
       else if (a.is("--plaintext")) plaintext = true;
       else if (a.is("--no-video")) no_video = true;
       else if (a.is("--gas-reaction")) gas_reaction = robot::gasReactionOf(a.choice({"continue", "stop", "retreat"}));
@@ -155,6 +160,7 @@ int main(int argc, char** argv) {
     if (!video_source.empty()) cfg.video.source = video_source;
     if (no_video) cfg.video.enabled = false;
     if (video_port) cfg.video.port = *video_port;
+    if (realtime_priority) cfg.realtime_priority = *realtime_priority;
 
     config::ControlConfig control;
     if (!control_path.empty()) control = config::loadControlConfigFile(control_path);
@@ -189,6 +195,13 @@ int main(int argc, char** argv) {
     log::info("main", "robot_client ", INSPECT_VERSION, " id=", cfg.robot_id, " serial=", cfg.serial_device,
               " server=", cfg.server_host, ":", cfg.server_port);
     app.start();
+    // The loop real-time only now that start-up (libraries, lookup tables,
+    // the encoder) is done: a process starting at SCHED_FIFO holds a core
+    // for ~300 ms from every other loop on the machine (issue 36).
+    if (const std::string why = util::enterRealtime(cfg.realtime_priority); !why.empty())
+      log::warn("main", "control loop at normal priority: ", why);
+    else if (cfg.realtime_priority > 0)
+      log::info("main", "control loop SCHED_FIFO priority ", cfg.realtime_priority);
     io.run();
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "robot_client: %s\n", e.what());

@@ -70,13 +70,12 @@ if [ "$JOB" = tuning ]; then
 else
   WORLD=config/worlds/gas_lab.yaml; SCRIPT=scripts/demo/gas_inspection.console; SIM_ARGS=(--people-wait-motion)
 fi
-# The real-time loops (the simulated MCU, the robot's control loop) run
-# SCHED_FIFO with reset-on-fork when this user may (root, CAP_SYS_NICE), as
-# robot_client.service runs the client on the robot: a busy machine then does
-# not starve them into a stale-sensor failsafe (docs/testing.md, "Scheduling").
-RT=()
-if chrt --reset-on-fork --fifo 10 true 2>/dev/null; then RT=(chrt --reset-on-fork --fifo 10); fi
-"${RT[@]}" "$BIN/mcu_sim" --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
+# The real-time loops make themselves SCHED_FIFO once started when this user
+# may (root, CAP_SYS_NICE; else a warning in their logs): the simulated MCU
+# at 20, above the robot's control loop (realtime_priority: 10 in
+# config/client.yaml), so a busy machine does not starve them into a
+# stale-sensor failsafe (docs/testing.md, "Scheduling").
+"$BIN/mcu_sim" --realtime-priority 20 --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
   --pty-link "$OUT/mcu" --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
 SIM=$!
 PIDS+=("$SIM")
@@ -87,7 +86,7 @@ head -n 1 "$OUT/mcu_sim.out"
 # robot_client starts once pc_server has reported its port.
 (
   for _ in $(seq 200); do [ -s "$OUT/port" ] && [ -s "$OUT/video_port" ] && break; sleep 0.05; done
-  exec "${RT[@]}" "$BIN/robot_client" --config config/client.yaml --robot-config config/robot.yaml \
+  exec "$BIN/robot_client" --config config/client.yaml --robot-config config/robot.yaml \
     --serial "$OUT/mcu" --server "127.0.0.1:$(cat "$OUT/port")" --video-port "$(cat "$OUT/video_port")" \
     --map "$WORLD" --id robot1 --video-source "sim:$CAM" 2>"$OUT/robot_client.err"
 ) &

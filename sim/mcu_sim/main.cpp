@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "shared/config/robot_config.hpp"
+#include "shared/util/realtime.hpp"
 #include "sim/mcu_sim/camera_feed.hpp"
 #include "sim/mcu_sim/pty_port.hpp"
 #include "sim/mcu_sim/realtime_runner.hpp"
@@ -67,6 +68,10 @@ int main(int argc, char** argv) {
     sim::RealtimeRunner::Options run_opts{opt.rate, opt.duration_s, {}};
     if (camera) run_opts.on_caught_up = [&camera](const sim::Simulation& s) { camera->publish(s); };
     sim::RealtimeRunner runner(simulation, port, truth.get(), run_opts);
+    // Real-time only now, start-up done: loading the world and the libraries
+    // at SCHED_FIFO would hold a core from the other loops on the machine.
+    if (const std::string why = util::enterRealtime(opt.realtime_priority); !why.empty())
+      std::fprintf(stderr, "mcu_sim: warning: running at normal priority: %s\n", why.c_str());
     const sim::RunSummary r = runner.run();
     if (camera) camera->stop();
 

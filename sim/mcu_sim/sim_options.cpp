@@ -40,6 +40,9 @@ std::string simUsage() {
          "                   for robot_client --video-source sim:PATH (docs/video.md)\n"
          "  --camera-size WxH  its picture size, each in [64, 4096] (default 640x480; needs --camera)\n"
          "  --camera-fps N   its frame rate on the wall clock, N in [1, 120] (default 30; needs --camera)\n"
+         "  --realtime-priority N  run the simulation loop SCHED_FIFO at priority N in [1, 99] once\n"
+         "                   started (it stands for the MCU, a chip of its own: above robot_client's\n"
+         "                   loop, e.g. 20; needs root or CAP_SYS_NICE, else a warning); 0 = normal (default)\n"
          "  --help           print this help and exit\n";
 }
 
@@ -59,6 +62,7 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     else if (a.is("--rate")) o.rate = a.number(0.1, 100.0);
     else if (a.is("--duration")) o.duration_s = a.numberAbove(0.0, 1e6);
     else if (a.is("--seed")) o.seed = a.unsignedInteger();
+    else if (a.is("--realtime-priority")) o.realtime_priority = static_cast<int>(a.integer(0, 99));
     else if (a.is("--camera")) o.camera_path = a.path();
     else if (a.is("--camera-size")) readSize(a, o.camera_width, o.camera_height), camera_size = true;
     else if (a.is("--camera-fps")) o.camera_fps = a.number(1.0, 120.0), camera_fps = true;

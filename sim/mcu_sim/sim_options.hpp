@@ -19,6 +19,7 @@ struct SimOptions {
   double rate = 1.0;                 // sim seconds per wall second, [0.1, 100]
   std::optional<double> duration_s;  // sim seconds; empty: until SIGINT/SIGTERM
   uint64_t seed = 1;
+  int realtime_priority = 0;         // SCHED_FIFO priority of the simulation loop once started; 0: normal
   bool people_wait_motion = false;   // pedestrians' clock starts at the robot's first wheel motion
   std::string camera_path;           // empty: no camera; else the frame slot the camera's view is written to
   int camera_width = 640;            // --camera-size WxH, each in [64, 4096]

@@ -65,7 +65,7 @@ Process Process::start(const std::vector<std::string>& argv, const std::string& 
     ::dup2(err, 2);
     if (realtime) {
       sched_param sp{};
-      sp.sched_priority = kRealtimePriority;
+      sp.sched_priority = kHardwarePriority;
       if (::sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &sp) != 0) {
         static const char kNote[] = "test harness: SCHED_FIFO not permitted; running at normal priority\n";
         [[maybe_unused]] const auto n = ::write(2, kNote, sizeof kNote - 1);

@@ -145,7 +145,8 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
   std::vector<std::string> sim_argv = {binPath("mcu_sim"), "--world", srcPath("config/worlds/" + world), "--robot",
                                        srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
-  r->sim = Process::spawnRealtime(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
+  sim_argv.insert(sim_argv.end(), {"--realtime-priority", std::to_string(Process::kHardwarePriority)});
+  r->sim = Process::spawn(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
   waitUntil([&] { return exists(sim_pty); }, 10.0);
   r->pty = sim_pty;
   if (!relay_args.empty()) {
@@ -171,7 +172,7 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     client_argv.push_back(testCertsDir({id}));
   }
   client_argv.insert(client_argv.end(), client_args.begin(), client_args.end());
-  r->client = Process::spawnRealtime(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
+  r->client = Process::spawn(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
   robots_.push_back(std::move(r));
   return *robots_.back();
 }

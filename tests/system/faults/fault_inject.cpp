@@ -661,7 +661,7 @@ class FaultRunner {
       case Fault::kServerStop: s.server().signal(SIGCONT); break;
       case Fault::kClientKill:
         r.client.wait(5);
-        r.client = Process::spawnRealtime(client_argv, s.dir() / "robot1-client.out", s.dir() / "robot1-client.err");
+        r.client = Process::spawn(client_argv, s.dir() / "robot1-client.out", s.dir() / "robot1-client.err");
         break;
       case Fault::kClientStop: r.client.signal(SIGCONT); break;
       case Fault::kSerialCut:
