@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # Installs every Debian package the project needs. Idempotent: when all are
 # present it only checks (well under a second) and installs nothing.
+#
+#   scripts/setup.sh [PACKAGE...]
+#
+# PACKAGEs are installed too (scripts/cross_pi.sh adds its cross tools so).
 set -euo pipefail
 
 PACKAGES=(
@@ -22,6 +26,7 @@ PACKAGES=(
   ffmpeg
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev libopencv-highgui-dev
   gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-plugins-ugly gstreamer1.0-libav
+  "$@"
 )
 
 missing=()
