@@ -1,7 +1,6 @@
 #include "tests/support/process.hpp"
 
 #include <fcntl.h>
-#include <sched.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -40,16 +39,6 @@ Process::~Process() {
 
 Process Process::spawn(const std::vector<std::string>& argv, const std::string& stdout_path,
                        const std::string& stderr_path, const std::string& stdin_path) {
-  return start(argv, stdout_path, stderr_path, stdin_path, false);
-}
-
-Process Process::spawnRealtime(const std::vector<std::string>& argv, const std::string& stdout_path,
-                               const std::string& stderr_path) {
-  return start(argv, stdout_path, stderr_path, "/dev/null", true);
-}
-
-Process Process::start(const std::vector<std::string>& argv, const std::string& stdout_path,
-                       const std::string& stderr_path, const std::string& stdin_path, bool realtime) {
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
@@ -63,14 +52,6 @@ Process Process::start(const std::vector<std::string>& argv, const std::string& 
     ::dup2(in, 0);
     ::dup2(out, 1);
     ::dup2(err, 2);
-    if (realtime) {
-      sched_param sp{};
-      sp.sched_priority = kHardwarePriority;
-      if (::sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &sp) != 0) {
-        static const char kNote[] = "test harness: SCHED_FIFO not permitted; running at normal priority\n";
-        [[maybe_unused]] const auto n = ::write(2, kNote, sizeof kNote - 1);
-      }
-    }
     ::execv(args[0], args.data());
     ::_exit(127);
   }

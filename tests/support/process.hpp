@@ -24,19 +24,6 @@ class Process {
   /// from `stdin_path` (default /dev/null).
   static Process spawn(const std::vector<std::string>& argv, const std::string& stdout_path,
                        const std::string& stderr_path, const std::string& stdin_path = "/dev/null");
-  /// As spawn, for a small test tool that stands in for hardware (the
-  /// serial wire's relay): its main thread runs SCHED_FIFO at
-  /// kHardwarePriority with SCHED_RESET_ON_FORK from the start. Without the
-  /// privilege (not root, no CAP_SYS_NICE / RLIMIT_RTPRIO) it runs at normal
-  /// priority and its stderr file says so. The project's own loops make
-  /// themselves real-time once started (mcu_sim --realtime-priority,
-  /// robot_client's realtime_priority), not through this.
-  static Process spawnRealtime(const std::vector<std::string>& argv, const std::string& stdout_path,
-                               const std::string& stderr_path);
-  /// Above robot_client's loop (10, config/client.yaml): the simulated MCU and
-  /// the wire are chips and cables of their own on a real robot, never
-  /// starved by the Pi's processes.
-  static constexpr int kHardwarePriority = 20;
 
   pid_t pid() const { return pid_; }
   bool running();
@@ -47,8 +34,6 @@ class Process {
   void terminate(double grace_s = 3.0);
 
  private:
-  static Process start(const std::vector<std::string>& argv, const std::string& stdout_path,
-                       const std::string& stderr_path, const std::string& stdin_path, bool realtime);
   pid_t pid_ = -1;
   std::optional<int> status_;
 };

@@ -19,6 +19,7 @@
 
 #include "shared/util/cli_args.hpp"
 #include "shared/util/clock.hpp"
+#include "shared/util/realtime.hpp"
 #include "sim/mcu_sim/pty_port.hpp"
 
 namespace {
@@ -35,6 +36,8 @@ options:
   --ber-down X        bit error rate towards robot_client (default 0)
   --garbage-per-s N   bursts of 1-24 random bytes per second, each direction (default 0)
   --seed N            random seed (default 1)
+  --realtime-priority N  relay SCHED_FIFO at priority N in [0, 99] once started (a wire stand-in:
+                      above robot_client's loop, e.g. 20); 0 = normal (default)
   --control FIFO      read commands from FIFO (made if missing), one per line:
                         stall up|down|both   cut that direction: bytes read from it are dropped
                         flow                 both directions pass again
@@ -119,6 +122,7 @@ int main(int argc, char** argv) {
   Direction up{"up", 1}, down{"down", 0};
   double garbage_per_s = 0;
   unsigned seed = 1;
+  int realtime_priority = 0;
   inspect::cli::readOrExit("serial_relay", argc, argv, [&](inspect::cli::ArgReader& a) {
     if (a.isHelp()) {
       std::fputs(kUsage, stdout);
@@ -135,6 +139,8 @@ int main(int argc, char** argv) {
       garbage_per_s = a.number(0);
     } else if (a.is("--control")) {
       control_path = a.path();
+    } else if (a.is("--realtime-priority")) {
+      realtime_priority = static_cast<int>(a.integer(0, 99));
     } else if (a.is("--seed")) {
       seed = static_cast<unsigned>(a.integer(0, 4294967295LL));
     } else {
@@ -166,6 +172,9 @@ int main(int argc, char** argv) {
 
   std::signal(SIGINT, [](int) { g_stop = 1; });
   std::signal(SIGTERM, [](int) { g_stop = 1; });
+
+  if (const std::string why = inspect::util::enterRealtime(realtime_priority); !why.empty())
+    std::fprintf(stderr, "serial_relay: warning: running at normal priority: %s\n", why.c_str());
 
   Damage dmg(seed);
   dmg.seedCarry(up.ber, down.ber);
