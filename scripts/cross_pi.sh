@@ -28,7 +28,7 @@ DIR=${ARM64_BUILD_DIR:-build-arm64}
 tests=1
 case "${1:-}" in
   --no-tests) tests=0 ;;
-  -h|--help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   "") ;;
   *) echo "cross_pi.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
 esac
