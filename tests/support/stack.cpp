@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <regex>
+#include <stdexcept>
 #include <sstream>
 
 namespace inspect::test {
@@ -18,6 +20,20 @@ namespace {
 constexpr const char* kHardwarePriority = "20";
 }  // namespace
 
+
+std::string sharedHostClientConfig(const TempDir& dir) {
+  std::string yaml = readFile(srcPath("config/client.yaml"));
+  // Replace the value on the one `  sensor_timeout_s:` line, keeping its comment.
+  const std::regex re("\\n  sensor_timeout_s: *([0-9.]+)");
+  std::smatch m;
+  if (!std::regex_search(yaml, m, re) ||
+      std::distance(std::sregex_iterator(yaml.begin(), yaml.end(), re), std::sregex_iterator()) != 1)
+    throw std::runtime_error("config/client.yaml: no single '  sensor_timeout_s:' line under safety to replace");
+  yaml.replace(static_cast<std::size_t>(m.position(1)), static_cast<std::size_t>(m.length(1)), kSharedHostSensorTimeoutS);
+  const std::string path = dir / "client-shared-host.yaml";
+  writeFile(path, yaml);
+  return path;
+}
 
 double expectedValue(const std::string& console_out, const std::string& field, int occurrence) {
   const std::regex re("expect ok \\(line \\d+\\): " + field + " = ([-0-9.e+]+)");
@@ -165,7 +181,9 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     relays_.emplace(id, Process::spawn(argv, dir_ / (id + "-relay.out"), dir_ / (id + "-relay.err")));
     waitUntil([&] { return exists(r->pty); }, 10.0);
   }
-  std::vector<std::string> client_argv = {binPath("robot_client"), "--config", srcPath("config/client.yaml"),
+  const std::string client_config =
+      product_sensor_timeout_ ? srcPath("config/client.yaml") : sharedHostClientConfig(dir_);
+  std::vector<std::string> client_argv = {binPath("robot_client"), "--config", client_config,
                                           "--robot-config", srcPath("config/robot.yaml"), "--control-config",
                                           srcPath("config/control.yaml"), "--behavior-config",
                                           srcPath("config/behavior.yaml"), "--serial", r->pty, "--server",

@@ -54,6 +54,20 @@ Truth readTruth(const std::string& path);
 /// field = V"), its `occurrence`-th time (0 = the first); NaN when absent.
 double expectedValue(const std::string& console_out, const std::string& field, int occurrence = 0);
 
+/// The robot's sensor timeout in the tests that do not measure that failsafe
+/// (config/client.yaml's 0.1 s is kept by the fault tests). On a shared test
+/// host the kernel itself can hold a pseudo-terminal's bytes for longer: a
+/// pty's reads are delivered by a tty work item on a normal-priority kernel
+/// worker, and ftrace on this 2-core VM, stack phase beside a nice build,
+/// measured that work item's queue-to-run delay at p99.9 48 ms and up to
+/// 331 ms (idle: up to 15 ms; docs/testing.md). A stack test whose robot
+/// latched FAILSAFE on that would fail on what it does not check.
+inline constexpr const char* kSharedHostSensorTimeoutS = "0.5";
+/// config/client.yaml with `safety.sensor_timeout_s` set to
+/// kSharedHostSensorTimeoutS, written to <dir>/client-shared-host.yaml;
+/// returns its path.
+std::string sharedHostClientConfig(const TempDir& dir);
+
 
 /// A simulated robot: mcu_sim + robot_client.
 struct RobotProcs {
@@ -85,6 +99,11 @@ class Stack {
   int foxglovePort() const { return foxglove_port_; }
   std::string foxgloveToken() const;
 
+  /// The robots started after this call keep config/client.yaml's sensor
+  /// timeout (the fault tests, which measure it); otherwise they get
+  /// sharedHostClientConfig().
+  void keepProductSensorTimeout() { product_sensor_timeout_ = true; }
+
   /// Starts pc_server on an ephemeral port running `script` (console commands).
   /// Returns false if it did not report its port within 10 s.
   bool startServer(const std::string& script, const std::vector<std::string>& extra = {});
@@ -110,6 +129,7 @@ class Stack {
   int video_port_ = 0;
   bool foxglove_ = false;
   int foxglove_port_ = 0;
+  bool product_sensor_timeout_ = false;
   std::vector<std::unique_ptr<RobotProcs>> robots_;
   std::map<std::string, Process> relays_;
 };

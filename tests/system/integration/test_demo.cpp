@@ -82,7 +82,7 @@ TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
   TempDir dir("demo");
   ::setenv("BUILD_DIR", (binDir() + "/..").c_str(), 1);
   Process demo = Process::spawn({"/bin/bash", srcPath("scripts/run_demo.sh"), "--batch", "--port", "0", "--out",
-                                 dir.path()},
+                                 dir.path(), "--client-config", sharedHostClientConfig(dir)},
                                 dir / "demo.out", dir / "demo.err");
   const auto rc = demo.wait(240);
   // CLOCK_MONOTONIC -> Unix time, for the truth log against the catalog.

@@ -66,7 +66,9 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   // RTX, the oldest cannot be, and the picture comes back within the run
   // only because the server's keyframe request (PLI, and over TCP) reaches
   // the robot.
-  writeFile(s.dir() / "client.yaml", "video:\n  gop: 600\n  history_packets: 20\n");
+  // (Its own client config, so the shared host's sensor timeout too.)
+  writeFile(s.dir() / "video-client.yaml", std::string("safety:\n  sensor_timeout_s: ") + kSharedHostSensorTimeoutS +
+                                                "\nvideo:\n  gop: 600\n  history_packets: 20\n");
   writeFile(s.dir() / "server.yaml", "video:\n  forward_base_port: " + std::to_string(player_port) +
                                           "\n  snapshot_period_s: 1\n  window: off\n");
   const std::string snap = s.dir() / "snap.png";
@@ -94,7 +96,7 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   lossy.burst_len = 40;
   UdpRelay relay(static_cast<uint16_t>(s.videoPort()), lossy);
   auto& robot = s.startRobot("robot1", "square_room.yaml", {}, {},
-                             {"--config", s.dir() / "client.yaml", "--video-port", std::to_string(relay.port())});
+                             {"--config", s.dir() / "video-client.yaml", "--video-port", std::to_string(relay.port())});
 
   // A standard player on the forwarded stream, while it runs.
   const std::string sdp = s.videoDir() + "/robot1.sdp";
