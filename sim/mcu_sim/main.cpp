@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(opt.seed), opt.rate, port.slavePath().c_str());
       truth->onEvent(0.0, "start", detail);
     }
-    sim::RealtimeRunner::Options run_opts{opt.rate, opt.duration_s, {}};
+    sim::RealtimeRunner::Options run_opts{opt.rate, opt.duration_s, {}, opt.freeze_on_stall};
     if (camera) run_opts.on_caught_up = [&camera](const sim::Simulation& s) { camera->publish(s); };
     sim::RealtimeRunner runner(simulation, port, truth.get(), run_opts);
     // Real-time only now, start-up done: loading the world and the libraries

@@ -90,7 +90,7 @@ RunSummary RealtimeRunner::run() {
       opts_.duration_s ? std::optional<uint64_t>(static_cast<uint64_t>(std::llround(*opts_.duration_s * 1000.0)))
                        : std::nullopt;
   const uint64_t start_ms = sim_.timeMs();
-  const int64_t t0_ns = monoNowNs();
+  int64_t t0_ns = monoNowNs();  // moved on by a frozen stall
   std::vector<uint8_t> tx;
   std::array<uint8_t, 4096> rx{};
 
@@ -102,7 +102,7 @@ RunSummary RealtimeRunner::run() {
     return t;
   };
   auto catchUp = [&] {
-    const uint64_t target_ms = simNowMs(monoNowNs());
+    uint64_t target_ms = simNowMs(monoNowNs());
     // Wall time since the first frame still to send was due: beyond a frame
     // period, this process was not run when it should have been.
     constexpr uint64_t kP = Simulation::kFramePeriod_ms;
@@ -112,8 +112,14 @@ RunSummary RealtimeRunner::run() {
       if (late_ms > kStallReport_ms) {
         ++stalls_;
         max_stall_ms_ = std::max(max_stall_ms_, late_ms);
-        std::fprintf(stderr, "mcu_sim: not run for %.0f ms (sim t=%.3f s): the host got no frames meanwhile\n",
-                     late_ms, static_cast<double>(due_ms) / 1e3);
+        std::fprintf(stderr, "mcu_sim: not run for %.0f ms (sim t=%.3f s): the host got no frames meanwhile%s\n",
+                     late_ms, static_cast<double>(due_ms) / 1e3, opts_.freeze_on_stall ? "; the world waited" : "");
+        if (opts_.freeze_on_stall) {
+          // The world resumes where the stall began: the wall clock's
+          // origin moves on by the stall, and the frame that was due is next.
+          t0_ns += static_cast<int64_t>((static_cast<double>(target_ms - due_ms) / rate) * 1e6);
+          target_ms = simNowMs(monoNowNs());
+        }
       }
     }
     sim_.advanceTo(target_ms);

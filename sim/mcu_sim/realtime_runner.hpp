@@ -62,6 +62,10 @@ class RealtimeRunner {
     /// with the wall clock (mcu_sim's camera takes its snapshot there); must
     /// be quick. Empty: none.
     std::function<void(const Simulation&)> on_caught_up;
+    /// A stall (a catch-up more than kStallReport_ms late) pauses the
+    /// simulated world for its length instead of simulating it in one step
+    /// with the last wheel commands and no frames out (mcu_sim --freeze-on-stall).
+    bool freeze_on_stall = false;
   };
 
   /// Blocks SIGINT/SIGTERM and installs handlers that only set a flag; the

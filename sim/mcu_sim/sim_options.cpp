@@ -43,6 +43,10 @@ std::string simUsage() {
          "  --realtime-priority N  run the simulation loop SCHED_FIFO at priority N in [1, 99] once\n"
          "                   started (it stands for the MCU, a chip of its own: above robot_client's\n"
          "                   loop, e.g. 20; needs root or CAP_SYS_NICE, else a warning); 0 = normal (default)\n"
+         "  --freeze-on-stall  when this process was not run for more than 30 ms (a loaded host), the\n"
+         "                   simulated world waits for it instead of catching up in one step with the\n"
+         "                   robot blind: the host's stall is not the robot's (stack tests that measure\n"
+         "                   control quality; never for failsafe timing, which the stall is part of)\n"
          "  --help           print this help and exit\n";
 }
 
@@ -63,6 +67,7 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     else if (a.is("--duration")) o.duration_s = a.numberAbove(0.0, 1e6);
     else if (a.is("--seed")) o.seed = a.unsignedInteger();
     else if (a.is("--realtime-priority")) o.realtime_priority = static_cast<int>(a.integer(0, 99));
+    else if (a.is("--freeze-on-stall")) o.freeze_on_stall = true;
     else if (a.is("--camera")) o.camera_path = a.path();
     else if (a.is("--camera-size")) readSize(a, o.camera_width, o.camera_height), camera_size = true;
     else if (a.is("--camera-fps")) o.camera_fps = a.number(1.0, 120.0), camera_fps = true;

@@ -20,6 +20,7 @@ struct SimOptions {
   std::optional<double> duration_s;  // sim seconds; empty: until SIGINT/SIGTERM
   uint64_t seed = 1;
   int realtime_priority = 0;         // SCHED_FIFO priority of the simulation loop once started; 0: normal
+  bool freeze_on_stall = false;      // a stall of this process pauses the world instead of a catch-up
   bool people_wait_motion = false;   // pedestrians' clock starts at the robot's first wheel motion
   std::string camera_path;           // empty: no camera; else the frame slot the camera's view is written to
   int camera_width = 640;            // --camera-size WxH, each in [64, 4096]

@@ -24,6 +24,7 @@
 #include "shared/serial/frame_codec.hpp"
 #include "shared/util/clock.hpp"
 #include "tests/support/paths.hpp"
+#include "tests/support/stack.hpp"
 
 using namespace inspect;
 
@@ -361,4 +362,49 @@ TEST(McuSimProgram, SigtermPrintsFinalPoseAndCleansUp) {
   EXPECT_EQ(sim.readLine(1000), "mcu_sim: final pose x=2.0000 y=4.0000 theta=0.0000");
   struct stat st{};
   EXPECT_NE(lstat(link.c_str(), &st), 0);
+}
+
+namespace {
+// mcu_sim stopped for `stall_ms` of wall time half-way through 1 s of sim
+// time; returns the wall time its truth log spans minus the sim time.
+double wallMinusSimAfterStall(bool freeze, int stall_ms, std::string& err) {
+  TempDir dir;
+  const std::string truth = dir.path() + "/truth.csv", err_path = dir.path() + "/sim.err";
+  std::vector<std::string> args = {"--world", inspect::test::srcPath("config/worlds/empty.yaml"), "--robot",
+                                   inspect::test::srcPath("config/robot.yaml"), "--truth", truth, "--duration", "1"};
+  if (freeze) args.push_back("--freeze-on-stall");
+  // stderr to a file: the stall's line.
+  const int saved = dup(STDERR_FILENO);
+  const int fd = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  dup2(fd, STDERR_FILENO);
+  SimProcess sim(args);
+  dup2(saved, STDERR_FILENO);
+  ::close(fd);
+  ::close(saved);
+  if (!sim.started()) return -1;
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  kill(sim.pid(), SIGSTOP);
+  std::this_thread::sleep_for(std::chrono::milliseconds(stall_ms));
+  kill(sim.pid(), SIGCONT);
+  if (sim.wait(5000) != 0) return -1;
+  err = inspect::test::readFile(err_path);
+  const auto t = inspect::test::readTruth(truth);
+  if (t.rows.size() < 2) return -1;
+  return static_cast<double>(t.rows.back().mono_ns - t.rows.front().mono_ns) * 1e-9 -
+         (t.rows.back().t - t.rows.front().t);
+}
+}  // namespace
+
+TEST(McuSimProgram, FreezeOnStallPausesTheWorldInsteadOfCatchingUp) {
+  std::string err;
+  // Caught up: the truth log's sim time keeps up with the wall clock.
+  const double caught_up = wallMinusSimAfterStall(false, 400, err);
+  EXPECT_GE(caught_up, -0.05) << err;
+  EXPECT_LT(caught_up, 0.15) << err;
+  EXPECT_NE(err.find("mcu_sim: not run for"), std::string::npos) << err;
+  // Frozen: the 400 ms stall is missing from sim time.
+  const double frozen = wallMinusSimAfterStall(true, 400, err);
+  EXPECT_GT(frozen, 0.3) << err;
+  EXPECT_LT(frozen, 0.6) << err;
+  EXPECT_NE(err.find("; the world waited"), std::string::npos) << err;
 }

@@ -170,6 +170,7 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
                                        srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
   sim_argv.insert(sim_argv.end(), {"--realtime-priority", kHardwarePriority});
+  if (!measure_failsafes_) sim_argv.push_back("--freeze-on-stall");
   r->sim = Process::spawn(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
   waitUntil([&] { return exists(sim_pty); }, 10.0);
   r->pty = sim_pty;
@@ -182,7 +183,7 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     waitUntil([&] { return exists(r->pty); }, 10.0);
   }
   const std::string client_config =
-      product_sensor_timeout_ ? srcPath("config/client.yaml") : sharedHostClientConfig(dir_);
+      measure_failsafes_ ? srcPath("config/client.yaml") : sharedHostClientConfig(dir_);
   std::vector<std::string> client_argv = {binPath("robot_client"), "--config", client_config,
                                           "--robot-config", srcPath("config/robot.yaml"), "--control-config",
                                           srcPath("config/control.yaml"), "--behavior-config",
@@ -199,6 +200,7 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
     client_argv.push_back(testCertsDir({id}));
   }
   client_argv.insert(client_argv.end(), client_args.begin(), client_args.end());
+  client_argv.insert(client_argv.begin(), client_prefix_.begin(), client_prefix_.end());
   r->client = Process::spawn(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
   robots_.push_back(std::move(r));
   return *robots_.back();

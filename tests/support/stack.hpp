@@ -99,10 +99,17 @@ class Stack {
   int foxglovePort() const { return foxglove_port_; }
   std::string foxgloveToken() const;
 
-  /// The robots started after this call keep config/client.yaml's sensor
-  /// timeout (the fault tests, which measure it); otherwise they get
-  /// sharedHostClientConfig().
-  void keepProductSensorTimeout() { product_sensor_timeout_ = true; }
+  /// The robots started after this call are as deployed, for the tests that
+  /// measure the failsafes (fault_inject): config/client.yaml's sensor
+  /// timeout, and an mcu_sim that catches up after a stall of its own. By
+  /// default a stack test's robot gets sharedHostClientConfig() and an
+  /// mcu_sim whose world waits through its stalls (--freeze-on-stall): a test
+  /// of tracking, navigation, video or recording then measures the software,
+  /// not how long the shared host left the simulated MCU unrun.
+  void measureFailsafes() { measure_failsafes_ = true; }
+  /// robot_client is started through this command for the robots started
+  /// after this call (bench_loop: {"taskset", "-c", "1"}).
+  void setClientPrefix(std::vector<std::string> prefix) { client_prefix_ = std::move(prefix); }
 
   /// Starts pc_server on an ephemeral port running `script` (console commands).
   /// Returns false if it did not report its port within 10 s.
@@ -129,7 +136,8 @@ class Stack {
   int video_port_ = 0;
   bool foxglove_ = false;
   int foxglove_port_ = 0;
-  bool product_sensor_timeout_ = false;
+  bool measure_failsafes_ = false;
+  std::vector<std::string> client_prefix_;
   std::vector<std::unique_ptr<RobotProcs>> robots_;
   std::map<std::string, Process> relays_;
 };

@@ -438,7 +438,7 @@ class FaultRunner {
     FaultResult res;
     res.def = &def_;
     Stack s(std::string("fault-") + def_.name);
-    s.keepProductSensorTimeout();  // what these faults measure
+    s.measureFailsafes();
     res.dir = s.dir().path();
     if (o_.video) s.enableVideo();
     const bool kill_server = def_.f == Fault::kServerKill;
@@ -925,7 +925,7 @@ BerResult runBer(double ber, const Options& o, unsigned seed) {
   BerResult res;
   res.ber = ber;
   Stack s("ber");
-  s.keepProductSensorTimeout();  // what the bit errors are measured against
+  s.measureFailsafes();
   Script sc;
   prologue(sc);
   const int rounds = std::max(1, static_cast<int>(std::ceil(o.ber_seconds / 5.0)));
