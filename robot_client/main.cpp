@@ -10,6 +10,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <functional>
 
 #include "robot_client/client_config.hpp"
 #include "robot_client/robot_app.hpp"
@@ -63,6 +64,9 @@ options:
   --no-video           do not stream video (overrides video.enabled)
   --version            print the version and exit
   --help               print this help and exit
+
+SIGUSR1 logs the control loop's figures so far (sensor frame in -> wheel command out)
+and counts them anew; they are logged at the end too.
 
 exit status: 0 after SIGINT/SIGTERM, 2 on a bad option or configuration.
 )";
@@ -148,8 +152,12 @@ int main(int argc, char** argv) {
       cfg.tls.cert = certs_dir + "/" + cfg.robot_id + ".pem";
       cfg.tls.key = certs_dir + "/" + cfg.robot_id + ".key";
     }
-    if (cfg.tls.cert.empty()) cfg.tls.cert = "certs/" + cfg.robot_id + ".pem";
-    if (cfg.tls.key.empty()) cfg.tls.key = "certs/" + cfg.robot_id + ".key";
+    // Unset: the robot's files beside the CA's (certs/ by default,
+    // /etc/inspect/certs in the package).
+    const auto ca_slash = cfg.tls.ca.rfind('/');
+    const std::string ca_dir = ca_slash == std::string::npos ? std::string(".") : cfg.tls.ca.substr(0, ca_slash);
+    if (cfg.tls.cert.empty()) cfg.tls.cert = ca_dir + "/" + cfg.robot_id + ".pem";
+    if (cfg.tls.key.empty()) cfg.tls.key = ca_dir + "/" + cfg.robot_id + ".key";
     if (cfg.tls.server_name.empty()) cfg.tls.server_name = cfg.server_host;
     cfg.tls.plaintext = plaintext;
     if (plaintext) {
@@ -192,6 +200,17 @@ int main(int argc, char** argv) {
       io.poll();
       io.stop();
     });
+    // SIGUSR1: the loop's figures so far in the log, then counted anew
+    // (bench_loop's measurement window; `kill -USR1` on a robot).
+    boost::asio::signal_set usr1(io, SIGUSR1);
+    std::function<void()> wait_usr1 = [&] {
+      usr1.async_wait([&](const boost::system::error_code& ec, int) {
+        if (ec) return;
+        app.logLoopFigures();
+        wait_usr1();
+      });
+    };
+    wait_usr1();
     log::info("main", "robot_client ", INSPECT_VERSION, " id=", cfg.robot_id, " serial=", cfg.serial_device,
               " server=", cfg.server_host, ":", cfg.server_port);
     app.start();

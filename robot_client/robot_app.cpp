@@ -113,6 +113,12 @@ void RobotApp::stop() {
   // Leave the motors commanded to zero before going.
   if (serial_.isOpen()) sendWheels(serial::WheelCommand{});
   link_.stop();
+  logLoopFigures();
+}
+
+void RobotApp::logLoopFigures() {
+  log::info("loop", "sensor frame in -> wheel command out: ", frame_to_command_.summary("frames"));
+  frame_to_command_ = util::LatencyHistogram{};
 }
 
 void RobotApp::sendWheels(const serial::WheelCommand& c) {
@@ -124,6 +130,7 @@ void RobotApp::sendWheels(const serial::WheelCommand& c) {
 void RobotApp::onSerialMessage(const serial::Message& m) {
   if (const auto* f = std::get_if<serial::SensorFrame>(&m)) {
     sendWheels(core_.onSensorFrame(*f, now()));
+    frame_to_command_.record(monoNowNs() - serial_.lastReadNs());
     flushEvents();
   }
   // Messages meant for the MCU (echoes on a loop-back) are ignored.

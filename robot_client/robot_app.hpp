@@ -14,6 +14,7 @@
 #include "robot_client/server_link.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
+#include "shared/util/latency_histogram.hpp"
 #include "shared/video/video_sender.hpp"
 
 namespace inspect::client {
@@ -26,6 +27,9 @@ class RobotApp {
   ~RobotApp();
   void start();
   void stop();
+  /// Logs the loop's figures so far (frame in -> command out) and starts
+  /// them anew (SIGUSR1; stop() logs them too).
+  void logLoopFigures();
   void setAwareness(std::unique_ptr<behavior::HumanAwareness> a) { core_.setAwareness(std::move(a)); }
 
  private:
@@ -57,6 +61,9 @@ class RobotApp {
   double ptz_pan_rad_ = 0, ptz_tilt_rad_ = 0;
   v1::Envelope telemetry_env_;  // reused to avoid reallocating repeated fields
   std::vector<robot::CoreEvent> events_;  // flushEvents' buffer, swapped with the core's
+  // Sensor frame read -> its wheel command handed to the serial port
+  // (logged at stop: the loop's figures of bench_loop, docs/deploy.md).
+  util::LatencyHistogram frame_to_command_;
 };
 
 }  // namespace inspect::client

@@ -9,6 +9,7 @@
 
 #include "shared/serial/cobs.hpp"
 #include "shared/serial/crc16.hpp"
+#include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
 
 namespace inspect::client {
@@ -90,6 +91,7 @@ void SerialLink::fail(const std::string& why) {
 
 void SerialLink::doRead() {
   port_.async_read_some(asio::buffer(rx_buf_), [this](const boost::system::error_code& ec, std::size_t n) {
+    last_read_ns_ = monoNowNs();
     if (ec) {
       if (ec != asio::error::operation_aborted && !stopped_) fail("read failed: " + ec.message());
       return;

@@ -36,6 +36,9 @@ class SerialLink {
   uint64_t bytesTx() const { return bytes_tx_; }
   uint64_t framesTx() const { return frames_tx_; }
   uint64_t framesDropped() const { return frames_dropped_; }
+  /// When the bytes being decoded were read (monoNowNs): a handler of a
+  /// message knows how long ago its frame came in.
+  int64_t lastReadNs() const { return last_read_ns_; }
 
  private:
   void tryOpen();
@@ -55,6 +58,7 @@ class SerialLink {
   MessageHandler on_message_;
   StateHandler on_state_;
   bool stopped_ = false;
+  int64_t last_read_ns_ = 0;
   bool log_frames_ = false;  // INSPECT_LOG=debug: one line per accepted frame
   std::string last_error_;
 

@@ -10,6 +10,7 @@
 #             real time or a few times faster.
 #   long      not in CI: the long forms of measurements (by hand or -L long).
 #   bench     the smoke runs of the benchmarks (timing figures: run alone).
+#   package   the Debian packages installed into a clean root (root, mirror).
 #   fuzz, sanitize   the second stage of scripts/test.sh (build-asan/).
 # Further labels name an area (faults, link, load, record ...).
 #
@@ -108,8 +109,8 @@ macro(_inspect_test_properties out)
     message(FATAL_ERROR "a test needs a TIMEOUT: tests/InspectTest.cmake")
   endif()
   list(GET A_LABELS 0 _kind)
-  if(NOT _kind MATCHES "^(unit|stack|bench|long|sanitize)$")
-    message(FATAL_ERROR "a test's first label is its kind: unit, stack, bench or long, not '${_kind}'")
+  if(NOT _kind MATCHES "^(unit|stack|bench|package|long|sanitize)$")
+    message(FATAL_ERROR "a test's first label is its kind: unit, stack, bench, package or long, not '${_kind}'")
   endif()
   set(${out} TIMEOUT ${A_TIMEOUT})
   if(A_SERIAL)

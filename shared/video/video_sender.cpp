@@ -4,6 +4,7 @@
 #include <random>
 
 #include <poll.h>
+#include <pthread.h>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/udp.hpp>
@@ -99,9 +100,21 @@ VideoSender::~VideoSender() { stop(); }
 void VideoSender::start() {
   if (running_.exchange(true)) return;
   keyframe_requested_ = true;
-  capture_thread_ = std::thread([this] { captureLoop(); });
-  encode_thread_ = std::thread([this] { encodeLoop(); });
-  if (s_.retransmission) feedback_thread_ = std::thread([this] { feedbackLoop(); });
+  // Named, so that top -H and bench_loop's CPU per thread say which is which
+  // (the encoder's own threads inherit "video-encode").
+  capture_thread_ = std::thread([this] {
+    pthread_setname_np(pthread_self(), "video-capture");
+    captureLoop();
+  });
+  encode_thread_ = std::thread([this] {
+    pthread_setname_np(pthread_self(), "video-encode");
+    encodeLoop();
+  });
+  if (s_.retransmission)
+    feedback_thread_ = std::thread([this] {
+      pthread_setname_np(pthread_self(), "video-rtcp");
+      feedbackLoop();
+    });
 }
 
 void VideoSender::stop() {

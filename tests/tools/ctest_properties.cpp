@@ -20,7 +20,7 @@ int main() {
     std::fprintf(stderr, "ctest_properties: stdin is not ctest's JSON: %s\n", e.what());
     return 1;
   }
-  const std::set<std::string> kinds = {"unit", "stack", "bench", "long", "fuzz", "sanitize"};
+  const std::set<std::string> kinds = {"unit", "stack", "bench", "package", "long", "fuzz", "sanitize"};
   int bad = 0, n = 0;
   for (const auto& t : j.value("tests", nlohmann::json::array())) {
     ++n;
