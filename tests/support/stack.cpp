@@ -170,7 +170,7 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
                                        srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
   sim_argv.insert(sim_argv.end(), {"--realtime-priority", kHardwarePriority});
-  if (!measure_failsafes_) sim_argv.push_back("--freeze-on-stall");
+  if (!measure_failsafes_ && !catch_up_) sim_argv.push_back("--freeze-on-stall");
   r->sim = Process::spawn(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
   waitUntil([&] { return exists(sim_pty); }, 10.0);
   r->pty = sim_pty;

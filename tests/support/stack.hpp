@@ -107,6 +107,11 @@ class Stack {
   /// of tracking, navigation, video or recording then measures the software,
   /// not how long the shared host left the simulated MCU unrun.
   void measureFailsafes() { measure_failsafes_ = true; }
+  /// The robots started after this call get an mcu_sim that simulates a
+  /// stall of its own in one step (no --freeze-on-stall), for a test that
+  /// times a manoeuvre by the wall clock (drive for 2 s, then stop): a world
+  /// that waited would move less than the operator's wait said.
+  void catchUpAfterStalls() { catch_up_ = true; }
   /// robot_client is started through this command for the robots started
   /// after this call (bench_loop: {"taskset", "-c", "1"}).
   void setClientPrefix(std::vector<std::string> prefix) { client_prefix_ = std::move(prefix); }
@@ -137,6 +142,7 @@ class Stack {
   bool foxglove_ = false;
   int foxglove_port_ = 0;
   bool measure_failsafes_ = false;
+  bool catch_up_ = false;
   std::vector<std::string> client_prefix_;
   std::vector<std::unique_ptr<RobotProcs>> robots_;
   std::map<std::string, Process> relays_;
