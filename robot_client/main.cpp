@@ -5,12 +5,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
-#include <functional>
 
 #include "robot_client/client_config.hpp"
 #include "robot_client/robot_app.hpp"
@@ -154,10 +155,9 @@ int main(int argc, char** argv) {
     }
     // Unset: the robot's files beside the CA's (certs/ by default,
     // /etc/inspect/certs in the package).
-    const auto ca_slash = cfg.tls.ca.rfind('/');
-    const std::string ca_dir = ca_slash == std::string::npos ? std::string(".") : cfg.tls.ca.substr(0, ca_slash);
-    if (cfg.tls.cert.empty()) cfg.tls.cert = ca_dir + "/" + cfg.robot_id + ".pem";
-    if (cfg.tls.key.empty()) cfg.tls.key = ca_dir + "/" + cfg.robot_id + ".key";
+    const auto ca_dir = std::filesystem::path(cfg.tls.ca).parent_path();
+    if (cfg.tls.cert.empty()) cfg.tls.cert = (ca_dir / (cfg.robot_id + ".pem")).string();
+    if (cfg.tls.key.empty()) cfg.tls.key = (ca_dir / (cfg.robot_id + ".key")).string();
     if (cfg.tls.server_name.empty()) cfg.tls.server_name = cfg.server_host;
     cfg.tls.plaintext = plaintext;
     if (plaintext) {

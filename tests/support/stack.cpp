@@ -20,7 +20,6 @@ namespace {
 constexpr const char* kHardwarePriority = "20";
 }  // namespace
 
-
 std::string sharedHostClientConfig(const TempDir& dir) {
   std::string yaml = readFile(srcPath("config/client.yaml"));
   // Replace the value on the one `  sensor_timeout_s:` line, keeping its comment.

@@ -65,7 +65,7 @@ struct Options {
 
 struct ThreadCpu {
   std::string name;
-  double ticks = 0;
+  double percent = 0;  // of one core over the window
 };
 
 // utime + stime (clock ticks) of every thread of `pid`, summed per name.
@@ -251,7 +251,7 @@ int main(int argc, char** argv) {
     threads.push_back({name, pct});
     total_pct += pct;
   }
-  std::sort(threads.begin(), threads.end(), [](const ThreadCpu& a, const ThreadCpu& b) { return a.ticks > b.ticks; });
+  std::sort(threads.begin(), threads.end(), [](const ThreadCpu& a, const ThreadCpu& b) { return a.percent > b.percent; });
 
   std::printf("\nbench_loop: %.0f s, robot_client on core %d of %d with libx264 640x480 at 30 fps\n\n", wall_s, o.cpu,
               ncpu);
@@ -266,7 +266,7 @@ int main(int argc, char** argv) {
               "(the hypervisor ran something else) %.1f %% of the machine in the window\n\n",
               o.cpu, ref_why.empty() ? "" : (" (" + ref_why + ")").c_str(), steal_pct);
   std::printf("| robot_client thread | CPU %% of one core |\n|---|---|\n");
-  for (const auto& t : threads) std::printf("| %s | %.1f |\n", t.name.c_str(), t.ticks);
+  for (const auto& t : threads) std::printf("| %s | %.1f |\n", t.name.c_str(), t.percent);
   std::printf("| all | %.1f |\n\nencoder: %.2f ms per frame (libx264, the server's video stats)\n", total_pct, encode_ms);
 
   std::string json = "{\n  \"seconds\": " + std::to_string(wall_s) + ",\n  \"cpu\": " + std::to_string(o.cpu) +
@@ -279,7 +279,7 @@ int main(int argc, char** argv) {
                      "},\n  \"steal_percent\": " + std::to_string(steal_pct) + ",\n  \"encode_ms_per_frame\": " +
                      std::to_string(encode_ms) + ",\n  \"thread_cpu_percent\": {";
   for (std::size_t i = 0; i < threads.size(); ++i)
-    json += (i ? ", \"" : "\"") + threads[i].name + "\": " + std::to_string(threads[i].ticks);
+    json += (i ? ", \"" : "\"") + threads[i].name + "\": " + std::to_string(threads[i].percent);
   json += "},\n  \"total_cpu_percent\": " + std::to_string(total_pct);
 
   if (!o.smoke) {
