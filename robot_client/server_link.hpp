@@ -11,7 +11,7 @@
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/steady_timer.hpp>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "robot_client/client_config.hpp"
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/tls.hpp"

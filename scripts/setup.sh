@@ -12,7 +12,7 @@ PACKAGES=(
   clang libclang-rt-14-dev
   libssl-dev openssl
   libboost-dev
-  libprotobuf-dev protobuf-compiler
+  libprotobuf-dev protobuf-compiler python3-protobuf
   libyaml-cpp-dev
   libeigen3-dev
   libgtest-dev libgmock-dev

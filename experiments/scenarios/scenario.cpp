@@ -5,7 +5,7 @@
 #include <cmath>
 #include <map>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/robot/awareness.hpp"
 #include "shared/robot/robot_core.hpp"
 #include "shared/world/robot_map.hpp"

@@ -371,7 +371,7 @@ bool Console::cmdExpect(const Args& args, const std::string&, int line_no) {
   bool interrupted = false;
   for (;;) {
     r = readField(spec.field, registry_, selected_, clock_->nowNs());
-    if (r.ok && compare(spec.op, r.value, spec.value, spec.tol)) {
+    if (satisfied(spec, r)) {
       out_ << "expect ok (line " << line_no << "): " << spec.field << " = " << r.text << "\n";
       ++tally_.expects_passed;
       return true;

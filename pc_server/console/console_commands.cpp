@@ -222,6 +222,7 @@ const std::vector<Console::CommandDef>& Console::commands() {
        "  and: robots (number of connected robots).\n"
        "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING, WHEEL_TEST; nav_mode takes NONE,\n"
        "  GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL; integer fields take 0x.. too.\n"
+       "  a field the robot left out reads 'unknown' and fails every comparison; '== unknown' checks that.\n"
        "  examples: expect robots >= 1 within 5\n"
        "            expect x ~ 2.0 0.05 within 10\n"
        "            expect mode == ESTOP within 1\n"

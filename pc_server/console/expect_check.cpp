@@ -15,20 +15,29 @@ namespace inspect::server {
 
 namespace {
 
+using Value = std::optional<double>;  // nullopt = unknown: the robot left the field out
+
 struct FieldDef {
   std::string name;
   bool integer;        // printed without decimals
   bool needs_robot;    // reads the selected robot
   bool needs_telemetry;
-  std::function<double(const RobotSnapshot&)> get;
+  std::function<Value(const RobotSnapshot&)> get;
 };
+
+// An `optional` Telemetry field (link protocol 2): its value, or unknown.
+template <auto Has, auto Get>
+Value opt(const RobotSnapshot& s) {
+  return (s.telemetry.*Has)() ? Value(static_cast<double>((s.telemetry.*Get)())) : std::nullopt;
+}
 
 // Telemetry.nav_mode is a string; expect compares its index here ("" = NONE).
 constexpr std::array<const char*, 9> kNavModes = {"NONE",       "GO_TO_GOAL", "AVOID", "FOLLOW_CW", "FOLLOW_CCW",
                                                   "AT_GOAL",    "DWELL",      "GAS_HOLD", "RETREAT"};
 
-double gasValue(const RobotSnapshot& s, int i) {
-  return i < s.telemetry.gas_size() ? s.telemetry.gas(i) : std::numeric_limits<double>::quiet_NaN();
+// A channel past the end of Telemetry.gas is unknown; NaN = the sensor gives no data.
+Value gasValue(const RobotSnapshot& s, int i) {
+  return i < s.telemetry.gas_size() ? Value(s.telemetry.gas(i)) : std::nullopt;
 }
 
 double alarmCount(const RobotSnapshot& s, bool high_only) {
@@ -53,50 +62,53 @@ std::optional<int> navModeFromName(std::string text) {
 
 const std::vector<FieldDef>& fieldDefs() {
   using S = RobotSnapshot;
+  using T = v1::Telemetry;
   static const std::vector<FieldDef> kDefs = {
       {"x", false, true, true, [](const S& s) { return s.telemetry.pose().x_m(); }},
       {"y", false, true, true, [](const S& s) { return s.telemetry.pose().y_m(); }},
       {"theta", false, true, true, [](const S& s) { return s.telemetry.pose().theta_rad(); }},
-      {"v", false, true, true, [](const S& s) { return s.telemetry.v_m_s(); }},
-      {"w", false, true, true, [](const S& s) { return s.telemetry.w_rad_s(); }},
-      {"cmd_v", false, true, true, [](const S& s) { return s.telemetry.cmd_v_m_s(); }},
-      {"cmd_w", false, true, true, [](const S& s) { return s.telemetry.cmd_w_rad_s(); }},
-      {"wheel_l", false, true, true, [](const S& s) { return s.telemetry.wheel_left_rad_s(); }},
-      {"wheel_r", false, true, true, [](const S& s) { return s.telemetry.wheel_right_rad_s(); }},
+      {"v", false, true, true, opt<&T::has_v_m_s, &T::v_m_s>},
+      {"w", false, true, true, opt<&T::has_w_rad_s, &T::w_rad_s>},
+      {"cmd_v", false, true, true, opt<&T::has_cmd_v_m_s, &T::cmd_v_m_s>},
+      {"cmd_w", false, true, true, opt<&T::has_cmd_w_rad_s, &T::cmd_w_rad_s>},
+      {"wheel_l", false, true, true, opt<&T::has_wheel_left_rad_s, &T::wheel_left_rad_s>},
+      {"wheel_r", false, true, true, opt<&T::has_wheel_right_rad_s, &T::wheel_right_rad_s>},
       {"mode", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.mode()); }},
       {"faults", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.faults()); }},
       {"mcu_faults", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.mcu_faults()); }},
       {"connected", true, true, false, [](const S& s) { return s.connected ? 1.0 : 0.0; }},
       {"telemetry_hz", false, true, false, [](const S& s) { return s.telemetry_hz; }},
       {"telemetry_age", false, true, true, [](const S& s) { return s.telemetry_age_s; }},
-      {"sensor_hz", false, true, true, [](const S& s) { return s.telemetry.sensor_rate_hz(); }},
-      {"battery", false, true, true, [](const S& s) { return s.telemetry.battery_v(); }},
+      {"sensor_hz", false, true, true, opt<&T::has_sensor_rate_hz, &T::sensor_rate_hz>},
+      {"battery", false, true, true, opt<&T::has_battery_v, &T::battery_v>},
       {"serial_bad_crc", true, true, true,
        [](const S& s) { return static_cast<double>(s.telemetry.serial().bad_crc()); }},
       {"serial_frames_ok", true, true, true,
        [](const S& s) { return static_cast<double>(s.telemetry.serial().frames_ok()); }},
-      {"pos_err", false, true, true, [](const S& s) { return s.telemetry.position_error_m(); }},
-      {"ang_err", false, true, true, [](const S& s) { return s.telemetry.angle_error_rad(); }},
-      {"max_pos_err", false, true, true, [](const S& s) { return s.telemetry.track_max_position_error_m(); }},
-      {"max_ang_err", false, true, true, [](const S& s) { return s.telemetry.track_max_angle_error_rad(); }},
-      {"progress", false, true, true, [](const S& s) { return s.telemetry.track_progress(); }},
-      {"ref_x", false, true, true, [](const S& s) { return s.telemetry.reference().x_m(); }},
-      {"ref_y", false, true, true, [](const S& s) { return s.telemetry.reference().y_m(); }},
-      {"kp", false, true, true, [](const S& s) { return s.telemetry.kp(); }},
-      {"ki", false, true, true, [](const S& s) { return s.telemetry.ki(); }},
-      {"kd", false, true, true, [](const S& s) { return s.telemetry.kd(); }},
+      {"pos_err", false, true, true, opt<&T::has_position_error_m, &T::position_error_m>},
+      {"ang_err", false, true, true, opt<&T::has_angle_error_rad, &T::angle_error_rad>},
+      {"max_pos_err", false, true, true, opt<&T::has_track_max_position_error_m, &T::track_max_position_error_m>},
+      {"max_ang_err", false, true, true, opt<&T::has_track_max_angle_error_rad, &T::track_max_angle_error_rad>},
+      {"progress", false, true, true, opt<&T::has_track_progress, &T::track_progress>},
+      {"ref_x", false, true, true,
+       [](const S& s) { return s.telemetry.has_reference() ? Value(s.telemetry.reference().x_m()) : std::nullopt; }},
+      {"ref_y", false, true, true,
+       [](const S& s) { return s.telemetry.has_reference() ? Value(s.telemetry.reference().y_m()) : std::nullopt; }},
+      {"kp", false, true, true, opt<&T::has_kp, &T::kp>},
+      {"ki", false, true, true, opt<&T::has_ki, &T::ki>},
+      {"kd", false, true, true, opt<&T::has_kd, &T::kd>},
       {"pattern", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.pattern()); }},
-      {"person_m", false, true, true, [](const S& s) { return s.telemetry.nearest_person_m(); }},
-      {"speed_factor", false, true, true, [](const S& s) { return s.telemetry.speed_factor(); }},
-      {"people", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.people_tracked()); }},
+      {"person_m", false, true, true, opt<&T::has_nearest_person_m, &T::nearest_person_m>},
+      {"speed_factor", false, true, true, opt<&T::has_speed_factor, &T::speed_factor>},
+      {"people", true, true, true, opt<&T::has_people_tracked, &T::people_tracked>},
       {"nav_mode", true, true, true, [](const S& s) { return navModeNumber(s.telemetry.nav_mode()); }},
-      {"goal_dist", false, true, true, [](const S& s) { return s.telemetry.goal_distance_m(); }},
+      {"goal_dist", false, true, true, opt<&T::has_goal_distance_m, &T::goal_distance_m>},
       {"goal_index", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.goal_index()); }},
       {"goal_count", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.goal_count()); }},
       {"nav_switches", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.nav_switches()); }},
-      {"dwell", false, true, true, [](const S& s) { return s.telemetry.dwell_remaining_s(); }},
+      {"dwell", false, true, true, opt<&T::has_dwell_remaining_s, &T::dwell_remaining_s>},
       {"gains_version", true, true, true, [](const S& s) { return static_cast<double>(s.telemetry.gains_version()); }},
-      {"wheel_test_progress", false, true, true, [](const S& s) { return s.telemetry.wheel_test_progress(); }},
+      {"wheel_test_progress", false, true, true, opt<&T::has_wheel_test_progress, &T::wheel_test_progress>},
       {"alarms", true, true, true, [](const S& s) { return alarmCount(s, false); }},
       {"alarms_high", true, true, true, [](const S& s) { return alarmCount(s, true); }},
       {"gas0", false, true, true, [](const S& s) { return gasValue(s, 0); }},
@@ -163,7 +175,12 @@ std::variant<ExpectSpec, std::string> parseExpect(const std::vector<std::string>
   s.op = op->second;
   s.op_text = args[1];
   s.value_text = args[2];
-  if (const auto v = parseNumber(args[2])) {
+  if (args[2] == kUnknown) {
+    // expect person_m == unknown: the robot left the field out (link protocol 2, "Presence").
+    if (s.op != ExpectOp::kEq && s.op != ExpectOp::kNe)
+      return "expect: 'unknown' goes with == or != only (expect person_m == unknown)";
+    s.unknown = true;
+  } else if (const auto v = parseNumber(args[2])) {
     s.value = *v;
   } else if (s.field == "mode" && modeFromName(args[2])) {
     s.value = *modeFromName(args[2]);
@@ -212,7 +229,7 @@ FieldReading readField(const std::string& field, const RobotRegistry& registry, 
     r.error = "unknown field '" + field + "'";
     return r;
   }
-  double v = 0;
+  Value v = 0.0;
   if (!def->needs_robot) {
     v = registry.connectedCount();
   } else {
@@ -239,12 +256,24 @@ FieldReading readField(const std::string& field, const RobotRegistry& registry, 
     }
   }
   r.ok = true;
-  r.value = v;
-  if (field == "mode") r.text = modeName(static_cast<int>(v));
-  else if (field == "nav_mode") r.text = v >= 0 && v < static_cast<double>(kNavModes.size()) ? kNavModes[static_cast<std::size_t>(v)] : "?";
-  else if (def->integer) r.text = std::to_string(static_cast<long long>(v));
-  else r.text = fmtShort(v, 3);
+  r.known = v.has_value();
+  if (!r.known) {
+    r.text = kUnknown;
+    return r;
+  }
+  r.value = *v;
+  if (field == "mode") r.text = modeName(static_cast<int>(r.value));
+  else if (field == "nav_mode")
+    r.text = r.value >= 0 && r.value < static_cast<double>(kNavModes.size()) ? kNavModes[static_cast<std::size_t>(r.value)] : "?";
+  else if (def->integer) r.text = std::to_string(static_cast<long long>(r.value));
+  else r.text = fmtShort(r.value, 3);
   return r;
+}
+
+bool satisfied(const ExpectSpec& spec, const FieldReading& r) {
+  if (!r.ok) return false;
+  if (spec.unknown) return (spec.op == ExpectOp::kEq) == !r.known;
+  return r.known && compare(spec.op, r.value, spec.value, spec.tol);
 }
 
 bool compare(ExpectOp op, double actual, double value, double tol) {

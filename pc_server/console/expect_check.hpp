@@ -23,13 +23,15 @@ struct ExpectSpec {
   std::string tol_text;
   double within_s = 0;         // 0 = check once
   bool has_within = false;
+  bool unknown = false;        // "== unknown" / "!= unknown": whether the robot left the field out
 };
 
 /// A field's value at one instant, or why it has none.
 struct FieldReading {
   bool ok = false;
+  bool known = true;  // false: the robot left this field out (link protocol 2, "Presence"); text "unknown"
   double value = 0;
-  std::string text;   // formatted value ("1.998", "TELEOP")
+  std::string text;   // formatted value ("1.998", "TELEOP", "unknown")
   std::string error;  // when !ok ("no robot selected", "no telemetry from robot1 yet")
 };
 
@@ -45,6 +47,9 @@ FieldReading readField(const std::string& field, const RobotRegistry& registry, 
 
 /// The comparison itself: `actual op value` (with |actual - value| <= tol for ~).
 bool compare(ExpectOp op, double actual, double value, double tol);
+
+/// Whether reading `r` meets `spec`: an unknown value meets only "== unknown".
+bool satisfied(const ExpectSpec& spec, const FieldReading& r);
 
 /// "~ 2.0 +- 0.05", "< 0.5", "== TELEOP": what the line wanted, for messages.
 std::string describeWanted(const ExpectSpec& spec);

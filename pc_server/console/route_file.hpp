@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/control/wheel_profile.hpp"
 
 namespace inspect::server {

@@ -99,23 +99,31 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
     s += " | DISCONNECTED " + fmtFixed(snap->state_age_s, 1) + " s ago (" + snap->close_reason + ")";
   if (!snap->has_telemetry) return s + (snap->connected ? " | connected, no telemetry yet" : "");
   const auto& t = snap->telemetry;
+  // A field the robot left out is unknown (link protocol 2, "Presence"): shown so, never as 0.
+  const auto known = [](bool has, double v, std::string (*fmt)(double, int), int digits) {
+    return has ? fmt(v, digits) : std::string(kUnknown);
+  };
   s += " | " + modeName(t.mode());
-  s += " | v " + fmtSigned(t.v_m_s()) + " w " + fmtSigned(t.w_rad_s());
+  s += " | v " + known(t.has_v_m_s(), t.v_m_s(), fmtSigned, 2) + " w " + known(t.has_w_rad_s(), t.w_rad_s(), fmtSigned, 2);
   s += " | x " + fmtFixed(t.pose().x_m()) + " y " + fmtFixed(t.pose().y_m()) + " th " + fmtSigned(t.pose().theta_rad());
   if (t.mode() == v1::TRACKING)
-    s += " | " + t.track_controller() + " " + fmtFixed(100.0 * t.track_progress(), 0) + "% err " +
-         fmtFixed(t.position_error_m(), 3) + " m " + fmtFixed(t.angle_error_rad(), 3) + " rad kp " + fmtFixed(t.kp(), 1);
+    s += " | " + t.track_controller() + " " + known(t.has_track_progress(), 100.0 * t.track_progress(), fmtFixed, 0) +
+         "% err " + known(t.has_position_error_m(), t.position_error_m(), fmtFixed, 3) + " m " +
+         known(t.has_angle_error_rad(), t.angle_error_rad(), fmtFixed, 3) + " rad kp " +
+         known(t.has_kp(), t.kp(), fmtFixed, 1);
   if (t.mode() == v1::NAVIGATING) {
     char nav[96];
     std::snprintf(nav, sizeof nav, " goal %u/%u %s m sw %u", t.goal_index() + 1, t.goal_count(),
-                  fmtFixed(t.goal_distance_m()).c_str(), t.nav_switches());
+                  known(t.has_goal_distance_m(), t.goal_distance_m(), fmtFixed, 2).c_str(), t.nav_switches());
     s += " | nav " + t.nav_mode() + nav;
   }
-  if (t.nearest_person_m() >= 0) {
+  if (!t.has_nearest_person_m()) {
+    s += " | people unknown";
+  } else if (t.nearest_person_m() >= 0) {
     std::string pat = v1::HumanPattern_Name(t.pattern());
     for (auto& ch : pat) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
     s += " | person " + fmtFixed(t.nearest_person_m(), 1) + " m " + (t.pattern() == v1::PATTERN_NONE ? "?" : pat) +
-         " speed x" + fmtFixed(t.speed_factor(), 2);
+         " speed x" + known(t.has_speed_factor(), t.speed_factor(), fmtFixed, 2);
   }
   if (t.ultrasonic_m_size() > 0) {
     s += " | us";
@@ -145,7 +153,7 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
     if (!high.empty() || !low.empty()) s += " | ALARM" + high + low;
     if (!fault.empty()) s += " | SENSOR FAULT" + fault;
   }
-  if (t.battery_v() > 0) s += " | bat " + fmtFixed(t.battery_v(), 1) + " V";
+  s += " | bat " + known(t.has_battery_v(), t.battery_v(), fmtFixed, 1) + (t.has_battery_v() ? " V" : "");
   s += " | faults " + faultNames(t.faults());
   s += " | tlm " + fmtFixed(snap->telemetry_hz, 0) + " Hz";
   if (snap->connected && snap->telemetry_age_s > 0.5) s += " (stale " + fmtFixed(snap->telemetry_age_s, 1) + " s)";

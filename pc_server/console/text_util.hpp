@@ -24,6 +24,10 @@ bool splitKeyValue(const std::string& a, std::string& k, std::string& v);
 /// Every tracking gain as "kp=11.94 ki=11.5 ...".
 std::string gainsText(const control::GainSet& g);
 
+/// How the console shows a telemetry value the robot left out (link
+/// protocol 2, docs/link-protocol.md "Presence"): never as 0.
+inline constexpr const char* kUnknown = "unknown";
+
 using util::fmtFixed;
 using util::fmtShort;
 using util::fmtSigned;

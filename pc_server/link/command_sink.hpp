@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 
 namespace inspect::server {
 

@@ -3,7 +3,7 @@
 #include <optional>
 #include <string>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 
 namespace inspect::server {
 

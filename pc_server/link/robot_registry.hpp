@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "pc_server/link/wake_signal.hpp"
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 
 namespace inspect::server {
 

@@ -15,7 +15,7 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "pc_server/app/server_config.hpp"
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/tls.hpp"

@@ -27,7 +27,7 @@ int64_t fileBytes(const std::string& path) {
 }  // namespace
 
 std::string gainsJson(const v1::Telemetry& t) {
-  if (t.track_controller().empty()) return "{}";
+  if (t.track_controller().empty() || !t.has_kp()) return "{}";  // not tracking, or gains unknown
   char json[256];
   std::snprintf(json, sizeof json, R"({"controller":"%s","kp":%.6g,"ki":%.6g,"kd":%.6g})",
                 t.track_controller().c_str(), t.kp(), t.ki(), t.kd());

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "pc_server/recording/run_stats.hpp"
 #include "pc_server/scene/robot_scene.hpp"
 #include "pc_server/scene/site_maps.hpp"

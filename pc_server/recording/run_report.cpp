@@ -122,10 +122,10 @@ plot::Panel trajectoryPanel(const RunReportInput& in, const Samples& s, bool any
 std::vector<plot::Panel> speedPeoplePanels(const Samples& s) {
   plot::Panel speed = panel("robot speed", "t (s)", "v (m/s)");
   speed.series.push_back(overTime(s, {"measured", {}, {}, "lines", "#1f77b4", 2, false},
-                                  [](const v1::Telemetry& t) { return t.v_m_s(); }));
+                                  [](const v1::Telemetry& t) { return t.has_v_m_s() ? t.v_m_s() : kNaN; }));
   speed.series.push_back(overTime(s, {"commanded", {}, {}, "lines", "#ff7f0e", 2, true},
-                                  [](const v1::Telemetry& t) { return t.cmd_v_m_s(); }));
-  const bool anyone = std::any_of(s.msg.begin(), s.msg.end(), [](auto* t) { return t->nearest_person_m() >= 0; });
+                                  [](const v1::Telemetry& t) { return t.has_cmd_v_m_s() ? t.cmd_v_m_s() : kNaN; }));
+  const bool anyone = std::any_of(s.msg.begin(), s.msg.end(), [](auto* t) { return t->has_nearest_person_m() && t->nearest_person_m() >= 0; });
   plot::Panel people = panel(std::string("nearest person and the Eq 9 speed factor; zones: intimate < 0.45 m, "
                                          "personal < 1.2 m, social < 3.6 m") +
                                  (anyone ? "" : " (nobody seen)"),
@@ -135,25 +135,28 @@ std::vector<plot::Panel> speedPeoplePanels(const Samples& s) {
   for (const auto& b : people.bands) people.labels.push_back({s.t_s.front(), (b.y0 + b.y1) / 2 - 0.08, b.label, "#555555"});
   if (anyone)
     people.series.push_back(overTime(s, {"nearest person distance (m)", {}, {}, "lines", "#d62728", 2, false},
-                                     [](const v1::Telemetry& t) { return t.nearest_person_m() >= 0 ? t.nearest_person_m() : kNaN; }));
+                                     [](const v1::Telemetry& t) {
+                                       return t.has_nearest_person_m() && t.nearest_person_m() >= 0 ? t.nearest_person_m() : kNaN;
+                                     }));
   people.series.push_back(overTime(s, {"speed factor (Eq 9)", {}, {}, "lines", "#1f77b4", 2, true},
-                                   [](const v1::Telemetry& t) { return t.speed_factor(); }));
+                                   [](const v1::Telemetry& t) { return t.has_speed_factor() ? t.speed_factor() : kNaN; }));
   return {speed, people};
 }
 
 std::vector<plot::Panel> trackingPanels(const Samples& s, const RunFigures& f) {
-  auto onlyTracking = [](double (v1::Telemetry::*field)() const, double scale) {
-    return [=](const v1::Telemetry& t) { return tracking(t) ? (t.*field)() * scale : kNaN; };
+  // Unknown (left out, link protocol 2) is no sample, like not tracking.
+  auto onlyTracking = [](bool (v1::Telemetry::*has)() const, double (v1::Telemetry::*field)() const, double scale) {
+    return [=](const v1::Telemetry& t) { return tracking(t) && (t.*has)() ? (t.*field)() * scale : kNaN; };
   };
   plot::Panel pos = panel("tracking position error (Eq 10), max " + fmtFixed(f.max_position_error_m, 3) +
                               " m, rms " + fmtFixed(f.rms_position_error_m, 3) + " m",
                           "t (s)", "position error (m)", "[0:*]", "off");
   pos.series.push_back(overTime(s, {"|(x_e, y_e)|", {}, {}, "lines", "#1f77b4", 2, false},
-                                onlyTracking(&v1::Telemetry::position_error_m, 1.0)));
+                                onlyTracking(&v1::Telemetry::has_position_error_m, &v1::Telemetry::position_error_m, 1.0)));
   plot::Panel ang = panel("tracking angle error, max " + fmtFixed(f.max_angle_error_rad * kRadToDeg, 1) + " deg",
                           "t (s)", "angle error (deg)", "[0:*]", "off");
   ang.series.push_back(overTime(s, {"|theta_e|", {}, {}, "lines", "#ff7f0e", 2, false},
-                                onlyTracking(&v1::Telemetry::angle_error_rad, kRadToDeg)));
+                                onlyTracking(&v1::Telemetry::has_angle_error_rad, &v1::Telemetry::angle_error_rad, kRadToDeg)));
   return {pos, ang};
 }
 

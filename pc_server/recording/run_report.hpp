@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/geometry/segment.hpp"
 
 namespace inspect::server {

@@ -17,12 +17,14 @@ void RunStats::add(const v1::Telemetry& t) {
   have_pose_ = true;
   last_x_ = x;
   last_y_ = y;
-  if (t.nearest_person_m() >= 0 && (f_.min_person_m < 0 || t.nearest_person_m() < f_.min_person_m))
+  // Fields the robot left out (unknown, link protocol 2) count as no sample.
+  if (t.has_nearest_person_m() && t.nearest_person_m() >= 0 &&
+      (f_.min_person_m < 0 || t.nearest_person_m() < f_.min_person_m))
     f_.min_person_m = t.nearest_person_m();
-  if (t.mode() == v1::TRACKING) {
+  if (t.mode() == v1::TRACKING && t.has_position_error_m()) {
     ++f_.tracking_samples;
     f_.max_position_error_m = std::max(f_.max_position_error_m, t.position_error_m());
-    f_.max_angle_error_rad = std::max(f_.max_angle_error_rad, t.angle_error_rad());
+    if (t.has_angle_error_rad()) f_.max_angle_error_rad = std::max(f_.max_angle_error_rad, t.angle_error_rad());
     sq_sum_ += t.position_error_m() * t.position_error_m();
   }
   if (f_.gas.size() < static_cast<std::size_t>(t.gas_size())) {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 
 namespace inspect::server {
 

@@ -301,8 +301,8 @@ void RobotScene::onEvent(const v1::Event& e) {
   setColor(arrow->mutable_color(), 1, 1, 1, 1);
   std::string status = robot_ + " " + v1::Mode_Name(t.mode());
   if (!t.nav_mode().empty()) status += " " + t.nav_mode();
-  status += " " + fmt(t.v_m_s()) + " m/s";
-  if (t.speed_factor() < 0.999) status += " x" + fmt(t.speed_factor());
+  status += t.has_v_m_s() ? " " + fmt(t.v_m_s()) + " m/s" : " speed unknown";
+  if (t.has_speed_factor() && t.speed_factor() < 0.999) status += " x" + fmt(t.speed_factor());
   addText(body, status, 0, 0, g_.body_height_m + 0.35);
 
   // The four sonar beams to their ranges (no echo: a faint cone to the maximum range).

@@ -23,7 +23,7 @@
 #include "foxglove/Grid.pb.h"
 #include "foxglove/Log.pb.h"
 #include "foxglove/SceneUpdate.pb.h"
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/config/robot_config.hpp"
 #include "shared/gas/live_map.hpp"
 #include "shared/geometry/segment.hpp"

@@ -13,7 +13,7 @@
 
 #include <nlopt.hpp>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/config/config_node.hpp"
 #include "shared/record/mcap_reader.hpp"
 
@@ -445,7 +445,7 @@ RunWheelData readRunWheelSeries(const std::string& mcap_path) {
   v1::Telemetry tm;
   reader.forEach([&](const record::McapMessageView& m) {  // does the robot send its MCU clock?
     if (ids.count(m.channel_id) && tm.ParseFromArray(m.data.data(), static_cast<int>(m.data.size())) &&
-        tm.mcu_time_us() != 0)
+        tm.has_mcu_time_us())
       use_mcu = true;
     return !use_mcu;
   });
@@ -456,12 +456,15 @@ RunWheelData readRunWheelSeries(const std::string& mcap_path) {
       error = mcap_path + ": /telemetry message " + std::to_string(m.sequence) + " does not parse as " + type;
       return false;
     }
+    // A sample the robot measured nothing for (no sensor frame yet: the wheel
+    // speeds left out, link protocol 2) is not a sample.
+    if (!tm.has_wheel_left_rad_s() || !tm.has_wheel_right_rad_s()) return true;
     const double vals[4] = {tm.cmd_wheel_left_rad_s(), tm.wheel_left_rad_s(), tm.cmd_wheel_right_rad_s(),
                             tm.wheel_right_rad_s()};
     if (!std::all_of(std::begin(vals), std::end(vals), [](double v) { return std::isfinite(v); })) return true;
     // The sample clock: the MCU's (the time base of the wheel loop and of the
     // simulator at any --rate), else the robot's monotonic clock (older runs).
-    if (use_mcu && tm.mcu_time_us() == 0) return true;  // before the robot's first sensor frame
+    if (use_mcu && !tm.has_mcu_time_us()) return true;  // before the robot's first sensor frame
     const uint64_t now_us = use_mcu ? tm.mcu_time_us() : tm.robot_time_us();
     if (have_first && now_us <= last_us) return true;  // a repeat, out of order, or a clock restart
     if (!have_first) first_us = now_us;

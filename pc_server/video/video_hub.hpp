@@ -14,7 +14,7 @@
 
 #include <boost/asio/ip/udp.hpp>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "pc_server/link/command_sink.hpp"
 #include "pc_server/app/server_config.hpp"
 #include "shared/video/video_receiver.hpp"

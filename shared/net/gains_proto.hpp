@@ -1,6 +1,6 @@
 #pragma once
-// control::GainSet <-> the link's v1::Gains (proto/inspect/v1/link.proto).
-#include "inspect/v1/link.pb.h"
+// control::GainSet <-> the link's v1::Gains (proto/inspect_robot/v1/link.proto).
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/control/gain_set.hpp"
 
 namespace inspect::net {

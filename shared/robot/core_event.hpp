@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 
 namespace inspect::robot {
 

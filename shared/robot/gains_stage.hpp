@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/config/control_config.hpp"
 #include "shared/control/fuzzy_pid.hpp"
 #include "shared/control/gain_set.hpp"

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/control/diff_drive.hpp"
 #include "shared/gas/alarm_monitor.hpp"
 #include "shared/robot/core_event.hpp"

@@ -430,22 +430,25 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
   p->set_y_m(pose.y_m);
   p->set_theta_rad(pose.theta_rad);
   t.set_gains_version(gains_.version());
-  t.set_mcu_time_us(estimate_.clock().elapsed_us);
   t.set_wheel_test_progress(wheel_test_.progress());
-  t.set_wheel_left_rad_s(measured.left_rad_s);
-  t.set_wheel_right_rad_s(measured.right_rad_s);
   t.set_cmd_wheel_left_rad_s(cmd_wheels_.left_rad_s);
   t.set_cmd_wheel_right_rad_s(cmd_wheels_.right_rad_s);
-  const auto tw = control::twistFromWheels(measured, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
-  t.set_v_m_s(tw.v_m_s);
-  t.set_w_rad_s(tw.w_rad_s);
+  // What the MCU measures is unknown (left out) until its first frame.
+  if (estimate_.haveFrame()) {
+    t.set_mcu_time_us(estimate_.clock().elapsed_us);
+    t.set_wheel_left_rad_s(measured.left_rad_s);
+    t.set_wheel_right_rad_s(measured.right_rad_s);
+    const auto tw = control::twistFromWheels(measured, robot_.geometry.wheel_radius_m, robot_.geometry.track_m);
+    t.set_v_m_s(tw.v_m_s);
+    t.set_w_rad_s(tw.w_rad_s);
+    t.set_battery_v(frame.battery_mv * 1e-3);
+  }
   t.set_cmd_v_m_s(cmd_twist_.v_m_s);
   t.set_cmd_w_rad_s(cmd_twist_.w_rad_s);
   t.clear_ultrasonic_m();
   for (uint16_t mm : frame.ultrasonic_mm) t.add_ultrasonic_m(mm == serial::kNoEcho ? -1.0 : mm * 1e-3);
   t.set_grayscale(frame.grayscale);
   gas_.fillTelemetry(t, estimate_.clock().control_s, now_s);
-  t.set_battery_v(frame.battery_mv * 1e-3);
   t.set_mode(mode_);
   t.set_faults(faults_);
   t.set_mcu_faults(frame.faults);
@@ -487,8 +490,7 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
       p->set_pattern(is_nearest ? static_cast<v1::HumanPattern>(static_cast<int>(a.pattern)) : v1::PATTERN_NONE);
     }
   } else {
-    t.set_nearest_person_m(-1.0);
-    t.set_speed_factor(1.0);
+    t.set_speed_factor(1.0);  // no people tracking: nearest_person_m and people_tracked unknown (left out)
   }
 }
 

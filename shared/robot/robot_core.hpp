@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/behavior/human_awareness.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"

@@ -219,12 +219,15 @@ void RouteRunner::fillTelemetry(v1::Telemetry& t, bool navigating) const {
                  : dwell_left_s_ > 0 ? "DWELL"
                  : retreating_       ? "RETREAT"
                                      : navigation::toString(navigator_->output().mode));
-  t.set_dwell_remaining_s(nav ? dwell_left_s_ : 0.0);
+  // Unknown (left out) when not navigating. The message is reused tick after
+  // tick (robot_app): a field that becomes unknown is cleared.
+  if (nav) t.set_dwell_remaining_s(dwell_left_s_);
+  else t.clear_dwell_remaining_s();
   t.set_waypoint_label(!nav                              ? ""
                        : dwell_left_s_ > 0.0             ? dwell_label_  // the point it stands at
                        : goal_index_ < goal_info_.size() ? goal_info_[goal_index_].label
                                                          : "");
-  t.set_goal_distance_m(goal_distance_m_);
+  if (!goals_.empty()) t.set_goal_distance_m(goal_distance_m_);  // no route yet: unknown (left out)
   t.set_goal_index(static_cast<uint32_t>(goal_index_));
   t.set_goal_count(static_cast<uint32_t>(goals_.size()));
   t.set_nav_switches(switches_done_ + (navigator_ ? navigator_->output().switch_count : 0u));

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/config/robot_config.hpp"
 #include "shared/navigation/navigator.hpp"
 #include "shared/robot/core_event.hpp"

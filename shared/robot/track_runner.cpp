@@ -50,6 +50,7 @@ std::string TrackRunner::start(const v1::Track& t, uint64_t command_id, const co
   controller_ = control::toString(params.wheel_control);
   out_ = {};
   max_pos_m_ = max_ang_rad_ = 0.0;
+  ran_ = true;
   what = described + " with " + controller_;
   return "";
 }
@@ -70,6 +71,7 @@ void TrackRunner::setGains(const control::GainSet& gains,
 }
 
 void TrackRunner::fillTelemetry(v1::Telemetry& t) const {
+  if (!ran_) return;  // no run yet: reference, errors, progress and gains unknown
   auto* ref = t.mutable_reference();
   ref->set_x_m(out_.ref.pose.x_m);
   ref->set_y_m(out_.ref.pose.y_m);

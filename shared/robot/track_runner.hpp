@@ -7,7 +7,7 @@
 #include <memory>
 #include <string>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/control/gain_set.hpp"
@@ -49,6 +49,7 @@ class TrackRunner {
   double max_pos_m_ = 0.0;
   double max_ang_rad_ = 0.0;
   control::PidGains gains_;
+  bool ran_ = false;  // a run has started: until then the tracking fields are unknown (left out)
 };
 
 }  // namespace inspect::robot

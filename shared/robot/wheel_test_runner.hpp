@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/config/robot_config.hpp"
 #include "shared/control/wheel_profile.hpp"
 #include "shared/robot/core_event.hpp"

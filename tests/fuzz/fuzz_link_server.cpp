@@ -17,7 +17,7 @@
 
 #include <google/protobuf/stubs/logging.h>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "pc_server/link/hello_check.hpp"
 #include "pc_server/link/robot_registry.hpp"
 #include "pc_server/console/status_line.hpp"

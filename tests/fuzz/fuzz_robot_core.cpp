@@ -29,7 +29,7 @@
 
 #include <google/protobuf/stubs/logging.h>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "robot_client/client_config.hpp"
 #include "shared/robot/robot_core.hpp"
 #include "shared/world/robot_map.hpp"

@@ -19,7 +19,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "pc_server/console/route_file.hpp"
 #include "robot_client/client_config.hpp"
 #include "shared/robot/robot_core.hpp"

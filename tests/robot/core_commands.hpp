@@ -2,7 +2,7 @@
 // Commands for the decision core's tests, as pc_server would send them.
 #include <cstdint>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 
 namespace inspect::test {
 

@@ -300,7 +300,8 @@ TEST_F(ConsoleTest, RobotsTableAndStatusLine) {
   EXPECT_HAS(out, "TELEOP");
   std::tie(ok, out) = run("status");
   EXPECT_TRUE(ok);
-  EXPECT_HAS(out, "robot1 | TELEOP | v +0.00 w +0.00 | x 1.20 y 0.00 th +0.00");
+  // The test's telemetry carries no measured speeds: unknown, not 0 (link protocol 2).
+  EXPECT_HAS(out, "robot1 | TELEOP | v unknown w unknown | x 1.20 y 0.00 th +0.00");
   EXPECT_HAS(out, "faults SENSOR_STALE");
   std::tie(ok, out) = run("status ghost");
   EXPECT_EQ(out, "ghost | not connected yet\n");

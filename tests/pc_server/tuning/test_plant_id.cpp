@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "pc_server/tuning/plant_id.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/config/robot_config.hpp"

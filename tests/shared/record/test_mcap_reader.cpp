@@ -17,7 +17,7 @@
 #include <algorithm>
 
 #include "foxglove/CompressedVideo.pb.h"
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/record/csv_export.hpp"
 #include "shared/record/mcap_reader.hpp"
 #include "shared/record/mcap_writer.hpp"

@@ -30,7 +30,7 @@
 #include <gtest/gtest.h>
 
 #include "foxglove/CompressedVideo.pb.h"
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/record/mcap_writer.hpp"
 #include "tests/shared/record/mcap_test_files.hpp"
 

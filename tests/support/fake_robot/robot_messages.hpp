@@ -4,7 +4,7 @@
 // by step) and the fleet robot (many at once, the load generator).
 #include <string>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/net/link_version.hpp"
 
 namespace inspect::test {

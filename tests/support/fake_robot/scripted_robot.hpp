@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/link_version.hpp"
 #include "shared/net/robot_id.hpp"

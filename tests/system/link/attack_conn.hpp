@@ -8,7 +8,7 @@
 #include <span>
 #include <string>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/link_version.hpp"
 #include "tests/support/fake_robot/tls_socket.hpp"

@@ -14,7 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "inspect/v1/link.pb.h"
+#include "inspect_robot/v1/link.pb.h"
 #include "shared/record/mcap_reader.hpp"
 #include "tests/support/paths.hpp"
 
