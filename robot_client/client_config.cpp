@@ -50,6 +50,10 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
       sa.oneOf("gas_reaction", robot::gasReactionName(c.safety.gas_reaction), {"continue", "stop", "retreat"}));
   if (c.safety.obstacle_slow_m <= c.safety.obstacle_stop_m && c.safety.obstacle_slow_m > 0)
     sa.fail("obstacle_slow_m", "must be above obstacle_stop_m (or 0 to turn the obstacle stop off)");
+  const auto ev = root.optChild("events");
+  c.events.journal = ev.string("journal", c.events.journal);
+  c.events.max_pending = static_cast<int>(ev.integer("max_pending", c.events.max_pending, 16, 1000000));
+  c.events.sync_period_s = ev.number("sync_period_s", c.events.sync_period_s, 0, 10);
   c.map_file = root.string("map", c.map_file);
   const auto v = root.optChild("video");
   auto& vp = c.video;

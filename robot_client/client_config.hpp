@@ -37,6 +37,13 @@ struct TlsParams {
   std::string server_name;           // name the server's certificate must carry; "" = server.host
 };
 
+/// Store-and-forward of events and late acks (docs/store-and-forward.md).
+struct EventsParams {
+  std::string journal;               // append-only journal file; "" = memory only (lost with the process)
+  int max_pending = 10000;           // queue bound; when full the oldest non-alarm entry is dropped
+  double sync_period_s = 1.0;        // fdatasync at most this often: a power cut loses at most this long
+};
+
 struct ClientConfig {
   std::string robot_id = "robot1";
   std::string server_host = "127.0.0.1";
@@ -55,6 +62,7 @@ struct ClientConfig {
   robot::SafetyParams safety;
   VideoParams video;
   TlsParams tls;
+  EventsParams events;
   std::string map_file;  // world file whose walls people tracking ignores ("" = no map); --map overrides
 };
 

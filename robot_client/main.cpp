@@ -54,6 +54,8 @@ options:
                        (overrides tls.*; default certs; scripts/make_certs.sh makes them)
   --plaintext          no TLS: the link is neither encrypted nor authenticated
                        (isolated test benches only; the server needs --plaintext too)
+  --journal FILE       the event journal (store-and-forward; overrides events.journal;
+                       "" = memory only)
   --cmd-log FILE       write every wheel command sent to the MCU (CSV; for tests)
   --realtime-priority N  SCHED_FIFO priority of the control loop once started,
                        N in [0, 99], 0 = normal (overrides realtime_priority;
@@ -92,6 +94,7 @@ int main(int argc, char** argv) {
   std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
   std::string serial_dev, server, id, cmd_log, map_path, video_source;
   std::optional<int> video_port, realtime_priority;
+  std::optional<std::string> journal;
   std::optional<robot::GasReaction> gas_reaction;
   bool no_video = false, plaintext = false;
   std::string certs_dir;
@@ -112,6 +115,7 @@ int main(int argc, char** argv) {
       else if (a.is("--server")) server = a.path();
       else if (a.is("--id")) id = a.path();
       else if (a.is("--cmd-log")) cmd_log = a.path();
+      else if (a.is("--journal")) journal = a.text();
       else if (a.is("--map")) map_path = a.path();
       else if (a.is("--video-source")) video_source = a.path();
       else if (a.is("--video-port")) video_port = static_cast<int>(a.integer(1, 65535));
@@ -136,6 +140,7 @@ int main(int argc, char** argv) {
     if (!robot_path.empty()) robot = config::loadRobotConfigFile(robot_path);
     if (!serial_dev.empty()) cfg.serial_device = serial_dev;
     if (!map_path.empty()) cfg.map_file = map_path;
+    if (journal) cfg.events.journal = *journal;
     if (gas_reaction) cfg.safety.gas_reaction = *gas_reaction;
     if (!id.empty()) cfg.robot_id = id;
     if (!server.empty()) {

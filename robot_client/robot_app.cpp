@@ -52,9 +52,18 @@ RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::
                    const config::ControlConfig& control, std::shared_ptr<control::FuzzyGainScheduler> scheduler,
                    const std::string& cmd_log_path)
     : io_(io), cfg_(cfg), core_(robot, cfg.safety, control, std::move(scheduler)),
-      serial_(io, cfg.serial_device, cfg.baud, cfg.serial_reopen_period_s), link_(io, cfg), tick_timer_(io),
-      telemetry_timer_(io), mcu_hb_timer_(io), t0_ns_(monoNowNs()) {
+      serial_(io, cfg.serial_device, cfg.baud, cfg.serial_reopen_period_s), link_(io, cfg),
+      outbox_(cfg.events.journal, static_cast<std::size_t>(cfg.events.max_pending), cfg.events.sync_period_s),
+      tick_timer_(io), telemetry_timer_(io), mcu_hb_timer_(io), t0_ns_(monoNowNs()) {
   core_.setFisName(std::filesystem::path(control.fis_path).stem().string());
+  for (const auto& s : outbox_.skippedRecords()) log::warn("events", "journal ", cfg.events.journal, ": ", s);
+  if (cfg.events.journal.empty())
+    log::info("events", "no journal (events.journal \"\"): events of an outage are kept in memory only");
+  else if (!outbox_.hasJournal())
+    log::error("events", "journal: ", outbox_.journalError(), ": events of an outage are kept in memory only");
+  else
+    log::info("events", "journal ", cfg.events.journal, ": stream ", outbox_.stream(), ", ",
+              outbox_.counters().loaded, " entries pending from before");
   if (!cmd_log_path.empty()) {
     cmd_log_ = std::fopen(cmd_log_path.c_str(), "w");
     if (!cmd_log_) throw config::ConfigError("--cmd-log: cannot write " + cmd_log_path);
@@ -79,6 +88,8 @@ void RobotApp::start() {
                        core_.gasMonitor().config().inlet_y_m);
   // Each Hello (also after a reconnect) announces the gains in force then.
   link_.setHelloFiller([this](v1::Hello& h) {
+    h.set_wall_time_us(static_cast<uint64_t>(wallNowNs() / 1000));
+    h.set_event_stream(outbox_.stream());
     net::toProto(core_.gains(), *h.mutable_gains());
     h.set_gains_version(core_.gainsVersion());
     h.set_fis_name(core_.fisName());
@@ -89,10 +100,13 @@ void RobotApp::start() {
                   flushEvents();
                 });
   link_.start({[this] {
+                 // What the server has not filed yet goes first, in order (replayed), then what happens now.
+                 outbox_.linkUp();
                  core_.onLinkUp(now());
                  flushEvents();
                },
                [this](const std::string& why) {
+                 outbox_.linkDown();
                  core_.onLinkDown(now(), why);
                  // Stop at once rather than waiting for the next sensor frame.
                  sendWheels(core_.commandNow());
@@ -139,6 +153,7 @@ void RobotApp::onSerialMessage(const serial::Message& m) {
 void RobotApp::onServerMessage(const v1::Envelope& env) {
   switch (env.body_case()) {
     case v1::Envelope::kHeartbeat: core_.onLinkActivity(now()); break;
+    case v1::Envelope::kDelivered: outbox_.delivered(env.delivered().event_stream(), env.delivered().up_to_seq()); break;
     case v1::Envelope::kCommand: {
       v1::Envelope reply;
       if (env.command().has_video() || env.command().has_ptz()) {
@@ -227,11 +242,40 @@ void RobotApp::fillVideoStatus(v1::Telemetry& t) const {
   v->set_keyframe_requests(s.keyframe_requests);
 }
 
+void RobotApp::storeAndSend(v1::Envelope& env) {
+  outbox_.store(env, static_cast<uint64_t>(wallNowNs() / 1000));
+  pumpOutbox();
+}
+
+void RobotApp::pumpOutbox() {
+  // In order, behind what a reconnect has to replay; at most half the link's
+  // send queue at a time (telemetry and heartbeats keep their room).
+  const std::size_t room = link_.queued() < 128 ? 128 - link_.queued() : 0;
+  outbox_.sendNext([this](v1::Envelope& e) { link_.send(e); }, room);
+}
+
+void RobotApp::fillOutboxStatus(v1::Telemetry& t) const {
+  auto* o = t.mutable_outbox();
+  const auto& c = outbox_.counters();
+  o->set_pending(static_cast<uint32_t>(outbox_.pending()));
+  o->set_max_pending(static_cast<uint32_t>(outbox_.maxPending()));
+  o->set_stored(c.stored);
+  o->set_delivered(c.delivered);
+  o->set_dropped(c.dropped);
+  o->set_replayed(c.replayed);
+  o->set_loaded(c.loaded);
+  o->set_skipped(c.skipped);
+  o->set_journal_errors(c.journal_errors);
+  o->set_journal(outbox_.hasJournal());
+  o->set_journal_error(outbox_.journalError());
+}
+
 void RobotApp::flushEvents() {
+  // Late acks (COMPLETED, FAILED of a run) are stored and forwarded like events.
   for (auto& a : core_.takeAcks()) {
     v1::Envelope env;
     *env.mutable_ack() = a;
-    link_.send(env);
+    storeAndSend(env);
   }
   for (const auto& p : core_.takePtz()) {
     if (const std::string why = applyPtz(p); !why.empty()) log::warn("core", "inspection point camera preset: ", why);
@@ -249,13 +293,14 @@ void RobotApp::flushEvents() {
       ev->set_gains_version(e.gains_version);
     }
     ev->set_robot_time_us(static_cast<uint64_t>(now() * 1e6));
-    link_.send(env);
+    storeAndSend(env);
   }
+  pumpOutbox();
 }
 
 void RobotApp::tick10ms() {
   if (auto c = core_.onTimer(now())) sendWheels(*c);
-  flushEvents();
+  flushEvents();  // and the outbox's next batch
   tick_timer_.expires_after(std::chrono::milliseconds(10));
   tick_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (!ec) tick10ms();
@@ -267,6 +312,7 @@ void RobotApp::sendTelemetry() {
   if (link_.isUp()) {
     core_.fillTelemetry(*telemetry_env_.mutable_telemetry(), now());
     fillVideoStatus(*telemetry_env_.mutable_telemetry());
+    fillOutboxStatus(*telemetry_env_.mutable_telemetry());
     link_.send(telemetry_env_);
   }
   telemetry_timer_.expires_after(steadyDuration(1.0 / cfg_.telemetry_hz));

@@ -9,6 +9,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "robot_client/client_config.hpp"
+#include "robot_client/event_outbox.hpp"
 #include "shared/robot/robot_core.hpp"
 #include "robot_client/serial_link.hpp"
 #include "robot_client/server_link.hpp"
@@ -38,6 +39,11 @@ class RobotApp {
   void onServerMessage(const v1::Envelope& env);
   void sendWheels(const serial::WheelCommand& c);
   void flushEvents();
+  /// Numbers, journals and (link up) sends an Event or a late Ack.
+  void storeAndSend(v1::Envelope& env);
+  /// Sends what the outbox has for this connection (a budget at a time).
+  void pumpOutbox();
+  void fillOutboxStatus(v1::Telemetry& t) const;
   void tick10ms();
   void sendTelemetry();
   void mcuHeartbeat();
@@ -52,6 +58,7 @@ class RobotApp {
   robot::RobotCore core_;
   SerialLink serial_;
   ServerLink link_;
+  EventOutbox outbox_;
   boost::asio::steady_timer tick_timer_;
   boost::asio::steady_timer telemetry_timer_;
   boost::asio::steady_timer mcu_hb_timer_;

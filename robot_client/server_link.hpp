@@ -45,6 +45,8 @@ class ServerLink {
   void send(v1::Envelope& env);
 
   bool isUp() const { return up_; }
+  /// Envelopes waiting in the send queue.
+  std::size_t queued() const { return tx_queue_.size(); }
   uint64_t connects() const { return counts_.connects; }
   uint64_t dropped() const { return counts_.dropped; }
 

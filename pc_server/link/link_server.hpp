@@ -17,6 +17,7 @@
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/steady_timer.hpp>
 
+#include "pc_server/link/stored_events.hpp"
 #include "pc_server/link/command_sink.hpp"
 #include "shared/net/tls.hpp"
 #include "pc_server/app/server_config.hpp"
@@ -71,6 +72,9 @@ class LinkServer : public CommandSink {
     for (const auto& f : observers_) f(robot_id, address, env, inbound, time_us);
   }
 
+  /// Which stored events and acks of each robot were filed (store-and-forward).
+  StoredEvents& storedEvents() { return stored_events_; }
+
   /// A fresh command id: > 0 and increasing over the server's lifetime.
   uint64_t nextCommandId() { return next_command_id_.fetch_add(1); }
   /// Called by a session whose Hello was accepted; closes an older session of the same robot.
@@ -96,6 +100,7 @@ class LinkServer : public CommandSink {
   std::atomic<int64_t> console_alive_ns_{0};
 
   std::vector<EnvelopeObserver> observers_;
+  StoredEvents stored_events_;
 
   mutable std::mutex mu_;
   std::condition_variable all_closed_cv_;

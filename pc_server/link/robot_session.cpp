@@ -203,21 +203,39 @@ bool RobotSession::handleFrame(std::span<const uint8_t> frame) {
       registry_.onTelemetry(peer_.robot_id, serial_, env.telemetry(), monoNowNs());
       server_.observe(peer_.robot_id, address_, env, true, monoNowUs());
       return true;
-    case v1::Envelope::kEvent:
-      registry_.onEvent(peer_.robot_id, serial_, env.event(), monoNowNs());
-      server_.observe(peer_.robot_id, address_, env, true, monoNowUs());
+    case v1::Envelope::kEvent: {
+      uint64_t time_us = monoNowUs();
+      if (env.event().has_stored() && !fileStored(env.event().stored(), time_us)) return true;
+      const bool late = env.event().has_stored() && env.event().stored().replayed();
+      if (late) {
+        // The consoles see it as what it is: news from an outage.
+        v1::Event shown = env.event();
+        shown.set_text(shown.text() + " (stored by the robot, " +
+                       fmtShort(static_cast<double>(monoNowUs() - std::min(time_us, monoNowUs())) * 1e-6, 1) +
+                       " s ago)");
+        registry_.onEvent(peer_.robot_id, serial_, shown, monoNowNs());
+      } else {
+        registry_.onEvent(peer_.robot_id, serial_, env.event(), monoNowNs());
+      }
+      server_.observe(peer_.robot_id, address_, env, true, time_us);
       if (server_.logEvents())
-        log::info(log::tag::kLink, "[", peer_.robot_id, "] ", v1::Event::Kind_Name(env.event().kind()), ": ", env.event().text());
+        log::info(log::tag::kLink, "[", peer_.robot_id, "] ", v1::Event::Kind_Name(env.event().kind()), ": ",
+                  env.event().text(), late ? " (stored by the robot)" : "");
       return true;
-    case v1::Envelope::kAck:
+    }
+    case v1::Envelope::kAck: {
+      uint64_t time_us = monoNowUs();
+      if (env.ack().has_stored() && !fileStored(env.ack().stored(), time_us)) return true;
       registry_.onAck(peer_.robot_id, serial_, env.ack());
-      server_.observe(peer_.robot_id, address_, env, true, monoNowUs());
+      server_.observe(peer_.robot_id, address_, env, true, time_us);
       return true;
+    }
     case v1::Envelope::kHello:
       closeNow("protocol error: second Hello after the handshake", log::Level::kWarn);
       return false;
     case v1::Envelope::kHelloReply:
     case v1::Envelope::kCommand:
+    case v1::Envelope::kDelivered:
       closeNow(std::string("protocol error: robot sent a ") + bodyName(body) + ", which only the server sends",
                log::Level::kWarn);
       return false;
@@ -255,10 +273,33 @@ void RobotSession::rejectHello(const std::string& reason) {
   });
 }
 
+bool RobotSession::fileStored(const v1::Stored& s, uint64_t& time_us) {
+  if (peer_.event_stream == 0) return true;  // no stream announced: nothing to de-duplicate against
+  const bool fresh = server_.storedEvents().fileOnce(peer_.robot_id, peer_.event_stream, s.seq());
+  if (fresh && s.replayed() && peer_.wall_known && s.wall_time_us() > 0) {
+    // When it happened, on the server's clock: the robot's UTC time plus
+    // the offset measured at the Hello (error: the Hello's one-way delay).
+    const int64_t server_wall_us = static_cast<int64_t>(s.wall_time_us()) + peer_.wall_offset_us;
+    const int64_t age_us = static_cast<int64_t>(wallNowNs() / 1000) - server_wall_us;
+    const int64_t now_us = static_cast<int64_t>(time_us);
+    if (age_us > 0 && age_us < now_us) time_us = static_cast<uint64_t>(now_us - age_us);
+  }
+  v1::Envelope env;
+  auto* d = env.mutable_delivered();
+  d->set_event_stream(peer_.event_stream);
+  d->set_up_to_seq(server_.storedEvents().highest(peer_.robot_id, peer_.event_stream));
+  enqueue(env);
+  return fresh;
+}
+
 void RobotSession::acceptHello(const v1::Hello& hello) {
   handshake_timer_.cancel();
   peer_.accepted = true;
   peer_.robot_id = hello.robot_id();
+  peer_.event_stream = hello.event_stream();
+  peer_.wall_known = hello.wall_time_us() > 0;
+  if (peer_.wall_known)
+    peer_.wall_offset_us = static_cast<int64_t>(wallNowNs() / 1000) - static_cast<int64_t>(hello.wall_time_us());
   registry_.onConnected(peer_.robot_id, address_, serial_, hello, monoNowNs());
   std::string caps;
   for (const auto& c : hello.capabilities()) caps += (caps.empty() ? "" : ",") + c;

@@ -105,8 +105,15 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
     bool accepted = false;
     bool rejecting = false;     // HelloReply{accepted=false} queued; close once sent
     std::string reject_reason;
+    uint64_t event_stream = 0;  // Hello.event_stream: 0 = the robot stores and forwards nothing
+    int64_t wall_offset_us = 0; // server UTC - robot UTC at the Hello (0 = unknown): files stored entries
+    bool wall_known = false;
   } peer_;
   bool closed_ = false;
+  /// A stored Event or Ack (store-and-forward): false when it was filed
+  /// before (a resend: dropped). Sets `time_us` to when it happened (server
+  /// clock) and confirms it to the robot.
+  bool fileStored(const v1::Stored& s, uint64_t& time_us);
 
   struct Liveness {
     Clock::time_point last_rx;

@@ -66,6 +66,7 @@ struct Recorder::Run {
   uint64_t command_id = 0;   // the track/goto command that started it (ends it on COMPLETED/FAILED)
   std::string address;       // robot's link address, to notice reconnects
   uint64_t video_frames = 0;
+  uint64_t last_telemetry_ns = 0;  // log time of the latest telemetry, to mark gaps
   bool gains_known = false;  // gains_json names the tracking controller
   nlohmann::json gains = nlohmann::json::object();  // the run's gains_json
 
@@ -317,29 +318,62 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
       }
     }
   }
+  // When it happened: the receive time, or for an event or ack the robot
+  // stored during an outage its own time (store-and-forward).
+  const uint64_t log_ns = monoUsToWallNs(time_us);
+  const auto when = std::chrono::system_clock::time_point(
+      std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::nanoseconds(log_ns)));
+  // A stored entry from before the current run (or from a run that has
+  // ended) is filed in the catalog under the run recording then; that run's
+  // MCAP is closed and is not reopened (docs/store-and-forward.md).
+  std::string run_id = it == runs_.end() ? "" : it->second->info.id;
+  bool in_open_run = it != runs_.end();
+  if (inbound && it != runs_.end() && when < it->second->info.start) in_open_run = false;
+  if (inbound && !in_open_run && isLate(env)) run_id = runAt(robot, when);
+  else if (!in_open_run) run_id.clear();
   // Gas alarms go into the catalog during runs and outside them.
   if (inbound && env.has_event() && env.event().has_gas_alarm()) {
     const auto& a = env.event().gas_alarm();
     try {
-      catalog_->addAlarm(it == runs_.end() ? "" : it->second->info.id, robot, std::chrono::system_clock::now(),
-                         a.channel_name(), v1::GasAlarm::Level_Name(a.level()), a.active() ? "raised" : "cleared", a.value(),
-                         a.pose().x_m(), a.pose().y_m());
+      catalog_->addAlarm(run_id, robot, when, a.channel_name(), v1::GasAlarm::Level_Name(a.level()),
+                         a.active() ? "raised" : "cleared", a.value(), a.pose().x_m(), a.pose().y_m());
     } catch (const std::exception& e) {
       log::error(log::tag::kRecord, robot, ": alarm not in the catalog: ", e.what());
     }
   }
-  if (it == runs_.end()) return;
+  if (!in_open_run) {
+    if (inbound && env.has_event() && !run_id.empty()) {
+      try {
+        catalog_->addEvent(run_id, robot, when, v1::Event::Kind_Name(env.event().kind()),
+                           env.event().text() + " (stored by the robot; filed after the run's recording closed)");
+      } catch (const std::exception& e) {
+        log::error(log::tag::kRecord, robot, ": event not in the catalog: ", e.what());
+      }
+    }
+    return;
+  }
   Run& r = *it->second;
   if (r.address.empty()) r.address = address;
   if (address != r.address) {
     noteLocked(r, robot, "robot reconnected from " + address + " (was " + r.address + "); run continues");
     r.address = address;
   }
-  const uint64_t log_ns = monoUsToWallNs(time_us);
   const uint64_t publish_ns = env.send_time_us() * 1000;  // the sender's clock
   try {
     switch (env.body_case()) {
       case v1::Envelope::kTelemetry:
+        // A telemetry gap (the link was down, or the robot silent) is marked in the run.
+        if (r.last_telemetry_ns && log_ns > r.last_telemetry_ns + kTelemetryGapNs) {
+          const double gap_s = static_cast<double>(log_ns - r.last_telemetry_ns) * 1e-9;
+          const std::string text = "telemetry gap: " + fmtShort(gap_s, 2) + " s without telemetry from " + robot;
+          v1::Event e;
+          e.set_kind(v1::Event::INFO);
+          e.set_text(text);
+          e.set_robot_time_us(monoNowUs());
+          r.mcap.write(r.ch_server, log_ns, log_ns, e);
+          catalog_->addEvent(r.info.id, robot, when, "gap", text);
+        }
+        r.last_telemetry_ns = std::max(r.last_telemetry_ns, log_ns);
         r.stats.add(env.telemetry());
         // The gains in force, as soon as the robot tracks with them.
         if (!r.gains_known && env.telemetry().mode() == v1::TRACKING && !env.telemetry().track_controller().empty()) {
@@ -375,8 +409,7 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
           r.gains["changes_in_run"] = changes;
           catalog_->setGains(r.info.id, r.gains.dump());
         }
-        catalog_->addEvent(r.info.id, robot, std::chrono::system_clock::now(),
-                           v1::Event::Kind_Name(env.event().kind()), env.event().text());
+        catalog_->addEvent(r.info.id, robot, when, v1::Event::Kind_Name(env.event().kind()), env.event().text());
         break;
       default: break;
     }
@@ -389,6 +422,24 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
     if (st == v1::Ack::COMPLETED || st == v1::Ack::FAILED || st == v1::Ack::REJECTED)
       stopLocked(robot, st == v1::Ack::COMPLETED ? "completed" : "failed");
   }
+}
+
+bool Recorder::isLate(const v1::Envelope& env) {
+  return (env.has_event() && env.event().has_stored() && env.event().stored().replayed()) ||
+         (env.has_ack() && env.ack().has_stored() && env.ack().stored().replayed());
+}
+
+std::string Recorder::runAt(const std::string& robot, catalog::Time t) {
+  try {
+    catalog::RunFilter f;
+    f.robot = robot;
+    f.limit = 20;
+    for (const auto& run : catalog_->listRuns(f))
+      if (run.start <= t && (!run.end || t <= *run.end)) return run.id;
+  } catch (const std::exception& e) {
+    log::error(log::tag::kRecord, robot, ": catalog: ", e.what());
+  }
+  return "";
 }
 
 void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us) {

@@ -90,6 +90,12 @@ class Recorder {
                           uint64_t command_id);
   std::string stopLocked(const std::string& robot, const std::string& outcome);
   void noteLocked(Run& r, const std::string& robot, const std::string& text);
+  /// A stored event or ack the robot sent late (store-and-forward).
+  static bool isLate(const v1::Envelope& env);
+  /// The id of the robot's run recording at `t` (catalog), "" = none.
+  std::string runAt(const std::string& robot, catalog::Time t);
+  /// Telemetry absent this long within a run is marked as a gap.
+  static constexpr uint64_t kTelemetryGapNs = 1'000'000'000;
 
   RecordingConfig config_;
   std::string software_version_;

@@ -33,6 +33,8 @@ TEST(ClientConfig, Errors) {
   EXPECT_NE(clientConfigError("safety:\n  link_timeout_s: 0\n").find("safety.link_timeout_s"), std::string::npos);
   EXPECT_NE(clientConfigError("server:\n  prot: 1\n").find("server.prot: unknown key"), std::string::npos);
   EXPECT_NE(clientConfigError("server:\n  port: 7600.5\n").find("not a whole number"), std::string::npos);
+  EXPECT_NE(clientConfigError("events:\n  max_pending: 3\n").find("events.max_pending: 3 is out of range"),
+            std::string::npos);
 }
 
 TEST(ClientConfig, RobotIds) {

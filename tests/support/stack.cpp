@@ -165,7 +165,8 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
   r->truth = dir_ / (id + "-truth.csv");
   r->cmd_log = dir_ / (id + "-cmds.csv");
   const std::string sim_pty = dir_ / (id + "-mcu");
-  std::vector<std::string> sim_argv = {binPath("mcu_sim"), "--world", srcPath("config/worlds/" + world), "--robot",
+  const std::string world_path = world.starts_with("/") ? world : srcPath("config/worlds/" + world);
+  std::vector<std::string> sim_argv = {binPath("mcu_sim"), "--world", world_path, "--robot",
                                        srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
   sim_argv.insert(sim_argv.end(), {"--realtime-priority", kHardwarePriority});
@@ -201,8 +202,14 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
   client_argv.insert(client_argv.end(), client_args.begin(), client_args.end());
   client_argv.insert(client_argv.begin(), client_prefix_.begin(), client_prefix_.end());
   r->client = Process::spawn(client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
+  r->client_argv = std::move(client_argv);
   robots_.push_back(std::move(r));
   return *robots_.back();
+}
+
+void Stack::restartClient(const std::string& id) {
+  for (auto& r : robots_)
+    if (r->id == id) r->client = Process::spawn(r->client_argv, dir_ / (id + "-client.out"), dir_ / (id + "-client.err"));
 }
 
 std::string Stack::logs() const {

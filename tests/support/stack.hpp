@@ -75,6 +75,7 @@ struct RobotProcs {
   std::string pty;      // symlink to the pty robot_client opens
   std::string truth;    // mcu_sim's truth log
   std::string cmd_log;  // robot_client's sent wheel commands
+  std::vector<std::string> client_argv;  // how robot_client was started (restartClient)
   Process sim;
   Process client;
 };
@@ -119,12 +120,15 @@ class Stack {
   /// Starts pc_server on an ephemeral port running `script` (console commands).
   /// Returns false if it did not report its port within 10 s.
   bool startServer(const std::string& script, const std::vector<std::string>& extra = {});
-  /// Starts mcu_sim (world file under config/worlds) and a robot_client.
+  /// Starts mcu_sim (world file under config/worlds, or an absolute path) and a robot_client.
   /// `relay_args` non-empty puts tests' serial_relay between them.
   RobotProcs& startRobot(const std::string& id, const std::string& world = "square_room.yaml",
                          const std::vector<std::string>& relay_args = {},
                          const std::vector<std::string>& sim_args = {},
                          const std::vector<std::string>& client_args = {});
+  /// Starts robot `id`'s robot_client again as it was started (after the
+  /// test killed it), its output appended to the same files.
+  void restartClient(const std::string& id);
   Process& server() { return server_; }
   int port() const { return port_; }
   std::string serverOutput() const { return readFile(dir_ / "server.out"); }

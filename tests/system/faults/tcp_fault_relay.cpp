@@ -42,7 +42,10 @@ options:
                         stall up     robot -> server stops (telemetry, heartbeats, acks)
                         stall down   server -> robot stops (commands, heartbeats)
                         stall both
-                        flow         both directions flow again
+                        cut          the link goes down: every connection is closed
+                                     (bytes in flight lost) and new ones are refused
+                                     (accepted and closed) until `flow`
+                        flow         both directions flow again (and connections are taken)
                       each applied command is printed: "tcp_fault_relay: <command> at mono_ns=<ns>"
   --help
 )";
@@ -166,7 +169,7 @@ int main(int argc, char** argv) {
     std::rename(tmp.c_str(), port_file.c_str());
   }
 
-  bool stall_up = false, stall_down = false;
+  bool stall_up = false, stall_down = false, cut = false;
   std::string control_buf;
   std::vector<std::unique_ptr<Conn>> conns;
   uint64_t accepted = 0;
@@ -199,7 +202,11 @@ int main(int argc, char** argv) {
         if (cmd == "stall up") stall_up = true;
         else if (cmd == "stall down") stall_down = true;
         else if (cmd == "stall both") stall_up = stall_down = true;
-        else if (cmd == "flow") stall_up = stall_down = false;
+        else if (cmd == "flow") stall_up = stall_down = cut = false;
+        else if (cmd == "cut") {
+          cut = true;
+          for (auto& c : conns) c->closing = true;  // closed below, their bytes dropped
+        }
         else {
           std::fprintf(stderr, "tcp_fault_relay: unknown control command '%s'\n", cmd.c_str());
           continue;
@@ -210,6 +217,7 @@ int main(int argc, char** argv) {
     // Move data (only where poll said so; a stalled direction is not touched).
     for (std::size_t i = 0; i < conns.size(); ++i) {
       Conn& c = *conns[i];
+      if (c.closing) continue;  // cut
       const short ra = fds[2 + 2 * i].revents, rb = fds[3 + 2 * i].revents;
       bool ok = true;
       if (!stall_up && (ra & (POLLIN | POLLHUP | POLLERR))) ok = pull(c.a, c.up) && ok;
@@ -235,6 +243,11 @@ int main(int argc, char** argv) {
       for (;;) {
         const int a = ::accept(lfd, nullptr, nullptr);
         if (a < 0) break;
+        if (cut) {  // the link is down: nothing gets through
+          ::close(a);
+          say("connection refused (cut)");
+          continue;
+        }
         const int b = ::socket(AF_INET, SOCK_STREAM, 0);
         if (::connect(b, reinterpret_cast<const sockaddr*>(&target), sizeof target) != 0) {
           std::fprintf(stderr, "tcp_fault_relay: cannot connect to %s: %s\n", target_s.c_str(), std::strerror(errno));

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <random>
 #include <regex>
 #include <string>
 
@@ -20,20 +21,30 @@ using namespace inspect::test;
 
 namespace {
 
-/// A free UDP port on 127.0.0.1 (bound to port 0, read back, released) for a
-/// child process (the player) to bind.
-int freeUdpPort() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  int port = 0;
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0)
-    port = ntohs(a.sin_port);
-  ::close(fd);
-  return port;
+/// A free pair of UDP ports P, P + 1 on 127.0.0.1 for a child process (the
+/// player binds RTP on P and RTCP on P + 1). Below the kernel's ephemeral
+/// range (32768-60999 by default): a port released from that range is soon
+/// handed to another socket of the tests running beside this one (a load run
+/// saw the player's bind fail so), and P + 1 was never checked at all.
+int freeUdpPortPair() {
+  auto bindable = [](int port, int& fd) {
+    fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(static_cast<uint16_t>(port));
+    return fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  };
+  std::mt19937 rng(static_cast<unsigned>(::getpid()) ^ static_cast<unsigned>(nowNs()));
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const int port = 20000 + 2 * static_cast<int>(rng() % 6000);  // even, [20000, 32000)
+    int fd1 = -1, fd2 = -1;
+    const bool ok = bindable(port, fd1) && bindable(port + 1, fd2);
+    if (fd1 >= 0) ::close(fd1);
+    if (fd2 >= 0) ::close(fd2);
+    if (ok) return port;
+  }
+  return 0;
 }
 
 /// The numbers after `label` in the n-th (0-based) `video stats` block of the output.
@@ -58,7 +69,7 @@ bool haveFfmpeg() { return std::system("ffmpeg -version >/dev/null 2>&1") == 0; 
 TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   Stack s("video");
   s.enableVideo();
-  const int player_port = freeUdpPort();
+  const int player_port = freeUdpPortPair();
   ASSERT_GT(player_port, 0);
   // GOP 600 (20 s) and a burst of 40 lost packets ~1.5 s in (a UDP relay
   // between robot and server) with the robot's retransmission history cut

@@ -338,7 +338,9 @@ TEST_F(LinkAttackTest, ServerSurvivesAndGoodRobotsLoseNothing) {
   run("random bytes inside TLS after the Hello", kGarbageReasons, [&](AttackConn& c, Attack& a) {
     if (evilRobot(c, a)) c.sendTls(randomBytes(rng, 4096));
   });
-  run("random bytes under TLS (corrupt records) after the Hello", {"closed: read error"},
+  // Corrupt records break the session both ways: which of the server's
+  // reads or its next heartbeat write fails first is the scheduler's choice.
+  run("random bytes under TLS (corrupt records) after the Hello", {"closed: read error", "closed: write error"},
       [&](AttackConn& c, Attack& a) {
         if (evilRobot(c, a)) c.sendRaw(randomBytes(rng, 512));
       });

@@ -1,0 +1,305 @@
+// outage_check: nothing lost across outages (store-and-forward, issue 38,
+// docs/store-and-forward.md), through the real programs.
+//
+// pc_server records a run while robot_client (with its event journal)
+// reaches it through tcp_fault_relay. The robot stands in a world made for
+// the check: a CH4 leak beside it that pulses on and off and two gas sensors
+// that drop out on a schedule, so that alarms are raised and cleared all
+// along. The link is cut N times for 0.5-5 s (bytes in flight lost, new
+// connections refused), and K of those times robot_client is SIGKILLed in
+// the middle of the cut and started again on its journal. At the end every
+// alarm transition robot_client logged must be in the run's MCAP and in the
+// catalog exactly once, in order, at the robot's time (within 100 ms).
+//
+//   outage_check [--cuts N] [--kills K] [--min-cut S] [--max-cut S] [--seed N] [--json FILE]
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "inspect_robot/v1/link.pb.h"
+#include "shared/record/mcap_reader.hpp"
+#include "shared/util/cli_args.hpp"
+#include "tests/support/stack.hpp"
+
+using namespace inspect;
+using namespace inspect::test;
+
+namespace {
+
+struct Options {
+  int cuts = 100;
+  int kills = 10;
+  double min_cut_s = 0.5, max_cut_s = 5.0;
+  double min_up_s = 1.0, max_up_s = 3.0;
+  unsigned seed = 1;
+  std::string json;
+};
+
+struct Step {
+  double up_s, cut_s;
+  bool kill;
+};
+
+// The world: a closed room, the robot at rest; a CH4 leak beside its gas
+// inlet that leaks for 12 s of every 30 s; CO dropping out for 2 s of every
+// 7 s and H2S for 3 s of every 11 s (each a SENSOR_FAULT raised and cleared).
+std::string worldYaml(double duration_s) {
+  std::ostringstream w;
+  w << "name: gas_outages\n"
+       "description: outage_check's world (tests/system/faults/outage_check.cpp)\n"
+       "start: {x_m: 2.0, y_m: 2.0, theta_rad: 0.0}\n"
+       "walls:\n  - points_m: [0.0, 0.0, 6.0, 0.0, 6.0, 4.0, 0.0, 4.0]\n    closed: true\n"
+       "gas:\n  diffusivity_m2_s: 0.05\n  ventilation_per_s: 0.2\n  cell_m: 0.1\n  sources:\n";
+  for (double t = 2; t < duration_s; t += 30)
+    w << "    - {name: pulse" << static_cast<int>(t) << ", gas: CH4, x_m: 2.35, y_m: 2.0, rate: 20.0, start_s: " << t
+      << ", end_s: " << t + 12 << "}\n";
+  w << "  faults:\n";
+  for (double t = 5; t < duration_s; t += 7) w << "    - {channel: CO, kind: dropout, start_s: " << t << ", end_s: " << t + 2 << "}\n";
+  for (double t = 8; t < duration_s; t += 11) w << "    - {channel: H2S, kind: dropout, start_s: " << t << ", end_s: " << t + 3 << "}\n";
+  return w.str();
+}
+
+// One alarm transition as robot_client logged it ("HH:MM:SS.mmm I [core] ALARM_RAISED: text").
+struct Logged {
+  int64_t ms_of_day;
+  std::string kind, text;
+};
+
+std::vector<Logged> robotAlarms(const std::string& log_path) {
+  std::vector<Logged> out;
+  std::ifstream in(log_path);
+  for (std::string line; std::getline(in, line);) {
+    for (const char* kind : {"ALARM_RAISED", "ALARM_CLEARED"}) {
+      const std::string tag = std::string("[core] ") + kind + ": ";
+      const auto at = line.find(tag);
+      if (at == std::string::npos || line.size() < 12) continue;
+      const int64_t ms = ((std::stoll(line.substr(0, 2)) * 60 + std::stoll(line.substr(3, 2))) * 60 +
+                          std::stoll(line.substr(6, 2))) * 1000 + std::stoll(line.substr(9, 3));
+      out.push_back({ms, kind, line.substr(at + tag.size())});
+    }
+  }
+  return out;
+}
+
+int64_t msOfDayLocal(uint64_t unix_ns) {
+  const std::time_t s = static_cast<std::time_t>(unix_ns / 1'000'000'000ULL);
+  std::tm tm{};
+  localtime_r(&s, &tm);
+  return ((tm.tm_hour * 60 + tm.tm_min) * 60 + tm.tm_sec) * 1000LL + static_cast<int64_t>(unix_ns / 1'000'000ULL % 1000);
+}
+
+int64_t dayDiffMs(int64_t a, int64_t b) {
+  int64_t d = a - b;
+  if (d > 43'200'000) d -= 86'400'000;
+  if (d < -43'200'000) d += 86'400'000;
+  return d;
+}
+
+struct Recorded {
+  uint64_t log_ns;
+  std::string kind, text;
+  bool late;  // stored by the robot during an outage, sent after it
+};
+
+std::vector<Recorded> mcapAlarms(const std::string& path) {
+  std::vector<Recorded> out;
+  auto r = record::McapReader::open(path);
+  r.forEach([&](const record::McapMessageView& m) {
+    if (m.topic != "/event") return true;
+    v1::Event e;
+    if (!e.ParseFromArray(m.data.data(), static_cast<int>(m.data.size()))) return true;
+    if (e.kind() == v1::Event::ALARM_RAISED || e.kind() == v1::Event::ALARM_CLEARED)
+      out.push_back({m.log_time_ns, v1::Event::Kind_Name(e.kind()), e.text(), e.stored().replayed()});
+    return true;
+  });
+  std::stable_sort(out.begin(), out.end(), [](const Recorded& a, const Recorded& b) { return a.log_ns < b.log_ns; });
+  return out;
+}
+
+struct CatalogAlarm {
+  double time_unix;
+  std::string channel, level, state;
+};
+
+std::vector<CatalogAlarm> catalogAlarms(const std::string& db, const std::string& run_id) {
+  std::vector<CatalogAlarm> out;
+  sqlite3* h = nullptr;
+  if (sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) return out;
+  sqlite3_stmt* st = nullptr;
+  sqlite3_prepare_v2(h, "SELECT time_unix, channel, level, state FROM alarms WHERE run_id = ? ORDER BY time_unix, id", -1,
+                     &st, nullptr);
+  sqlite3_bind_text(st, 1, run_id.c_str(), -1, SQLITE_TRANSIENT);
+  while (sqlite3_step(st) == SQLITE_ROW)
+    out.push_back({sqlite3_column_double(st, 0), reinterpret_cast<const char*>(sqlite3_column_text(st, 1)),
+                   reinterpret_cast<const char*>(sqlite3_column_text(st, 2)),
+                   reinterpret_cast<const char*>(sqlite3_column_text(st, 3))});
+  sqlite3_finalize(st);
+  sqlite3_close(h);
+  return out;
+}
+
+void control(const std::string& fifo, const std::string& cmd) {
+  std::ofstream(fifo) << cmd << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  cli::readOrExit("outage_check", argc, argv, [&](cli::ArgReader& a) {
+    if (a.isHelp()) {
+      std::puts("usage: outage_check [--cuts N] [--kills K] [--min-cut S] [--max-cut S] [--seed N] [--json FILE]");
+      std::exit(0);
+    } else if (a.is("--cuts")) o.cuts = static_cast<int>(a.integer(1, 10000));
+    else if (a.is("--kills")) o.kills = static_cast<int>(a.integer(0, 1000));
+    else if (a.is("--min-cut")) o.min_cut_s = a.number(0.05, 600);
+    else if (a.is("--max-cut")) o.max_cut_s = a.number(0.05, 600);
+    else if (a.is("--seed")) o.seed = static_cast<unsigned>(a.integer(0, 1 << 30));
+    else if (a.is("--json")) o.json = a.path();
+    else a.unknown();
+  });
+  if (o.max_cut_s < o.min_cut_s) o.max_cut_s = o.min_cut_s;
+  o.kills = std::min(o.kills, o.cuts);
+
+  // The schedule, fixed by the seed: up, then cut (a SIGKILL in the middle of every cuts/kills-th).
+  std::mt19937 rng(o.seed);
+  std::uniform_real_distribution<double> up(o.min_up_s, o.max_up_s), cut(o.min_cut_s, o.max_cut_s);
+  std::vector<Step> plan;
+  double planned_s = 0;
+  for (int i = 0; i < o.cuts; ++i) {
+    const bool kill = o.kills > 0 && i % std::max(1, o.cuts / o.kills) == o.cuts / o.kills / 2 &&
+                      std::count_if(plan.begin(), plan.end(), [](const Step& s) { return s.kill; }) < o.kills;
+    plan.push_back({up(rng), cut(rng), kill});
+    planned_s += plan.back().up_s + plan.back().cut_s + (kill ? 1.0 : 0.0);
+  }
+
+  Stack s("outage");
+  writeFile(s.dir() / "gas_outages.yaml", worldYaml(planned_s + 120));
+  const std::string journal = s.dir() / "robot1-events.journal";
+  std::string script =
+      "expect robots >= 1 within 20\nexpect sensor_hz > 50 within 5\nrecord start outages\n"
+      "wait " + std::to_string(static_cast<int>(planned_s + 5)) + "\n"
+      "expect connected == 1 within 30\nwait 3\nrecord stop\nalarms all\n";
+  if (!s.startServer(script)) {
+    std::fprintf(stderr, "outage_check: pc_server did not start\n%s", s.logs().c_str());
+    return 1;
+  }
+  const std::string fifo = s.dir() / "relay.ctl";
+  Process relay = Process::spawn({binPath("tcp_fault_relay"), "--target", "127.0.0.1:" + std::to_string(s.port()),
+                                  "--control", fifo, "--port-file", s.dir() / "relay.port"},
+                                 s.dir() / "relay.out", s.dir() / "relay.err");
+  if (!waitUntil([&] { return exists(s.dir() / "relay.port"); }, 10)) {
+    std::fprintf(stderr, "outage_check: tcp_fault_relay did not start\n");
+    return 1;
+  }
+  const int relay_port = std::atoi(readFile(s.dir() / "relay.port").c_str());
+  auto& robot = s.startRobot("robot1", s.dir() / "gas_outages.yaml", {}, {},
+                             {"--server", "127.0.0.1:" + std::to_string(relay_port), "--journal", journal});
+  if (!waitUntil([&] { return s.serverOutput().find("robot1: recording run ") != std::string::npos; }, 40)) {
+    std::fprintf(stderr, "outage_check: the run did not start\n%s", s.logs().c_str());
+    return 1;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  std::printf("outage_check: %d cuts of %.1f-%.1f s, %d robot_client SIGKILLs mid-outage, ~%.0f s\n", o.cuts,
+              o.min_cut_s, o.max_cut_s, o.kills, planned_s);
+  std::fflush(stdout);
+  int kills_done = 0;
+  const auto sleepS = [](double sec) { std::this_thread::sleep_for(std::chrono::duration<double>(sec)); };
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    sleepS(plan[i].up_s);
+    control(fifo, "cut");
+    if (plan[i].kill) {
+      sleepS(plan[i].cut_s / 2);
+      robot.client.signal(SIGKILL);
+      robot.client.wait(5);
+      s.restartClient("robot1");
+      ++kills_done;
+      sleepS(plan[i].cut_s / 2 + 1.0);
+    } else {
+      sleepS(plan[i].cut_s);
+    }
+    control(fifo, "flow");
+    if ((i + 1) % 10 == 0) {
+      std::printf("  %zu cuts, %d kills, %.0f s\n", i + 1, kills_done,
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      std::fflush(stdout);
+    }
+  }
+  const auto rc = s.server().wait(planned_s + 120);
+  relay.terminate();
+  const std::string out = s.serverOutput();
+  const std::string tag = "robot1: recording run ";
+  const auto at = out.find(tag);
+  const std::string run_id = out.substr(at + tag.size(), out.find('\n', at) - at - tag.size());
+
+  // The robot's log (every process's, appended across the restarts) against the run.
+  const auto logged = robotAlarms(s.dir() / "robot1-client.err");
+  const std::string run_dir = s.dir() / ("runs/" + run_id);
+  std::vector<Recorded> recorded;
+  std::string mcap_error;
+  try {
+    recorded = mcapAlarms(run_dir + "/run.mcap");
+  } catch (const std::exception& e) {
+    mcap_error = e.what();
+  }
+  const auto cataloged = catalogAlarms(s.dir() / "runs/catalog.sqlite", run_id);
+
+  // Exactly once, in order: the i-th logged transition is the i-th recorded one.
+  std::size_t same = 0, time_ok = 0, cat_time_ok = 0;
+  int64_t worst_ms = 0, worst_cat_ms = 0;
+  for (std::size_t i = 0; i < std::min(logged.size(), recorded.size()); ++i) {
+    if (logged[i].kind != recorded[i].kind || logged[i].text != recorded[i].text) break;
+    ++same;
+    const int64_t d = std::abs(dayDiffMs(msOfDayLocal(recorded[i].log_ns), logged[i].ms_of_day));
+    worst_ms = std::max(worst_ms, d);
+    time_ok += d <= 100;
+  }
+  for (std::size_t i = 0; i < std::min(logged.size(), cataloged.size()); ++i) {
+    const int64_t d = std::abs(dayDiffMs(msOfDayLocal(static_cast<uint64_t>(cataloged[i].time_unix * 1e9)),
+                                         logged[i].ms_of_day));
+    worst_cat_ms = std::max(worst_cat_ms, d);
+    cat_time_ok += d <= 100;
+  }
+  const bool pass = rc && *rc == 0 && mcap_error.empty() && !logged.empty() && same == logged.size() &&
+                    recorded.size() == logged.size() && cataloged.size() == logged.size() &&
+                    time_ok == logged.size() && cat_time_ok == logged.size() && kills_done == o.kills;
+
+  std::printf("\n| | count |\n|---|---|\n");
+  std::printf("| link cuts | %d |\n| robot_client SIGKILLs mid-outage | %d |\n", o.cuts, kills_done);
+  std::printf("| alarm transitions robot_client logged | %zu |\n", logged.size());
+  std::printf("| in the run's MCAP (/event) | %zu (%zu in order and equal) |\n", recorded.size(), same);
+  const auto late = std::count_if(recorded.begin(), recorded.end(), [](const Recorded& r) { return r.late; });
+  std::printf("| of those, stored during an outage and filed after it | %zu |\n", static_cast<std::size_t>(late));
+  std::printf("| in the catalog (alarms of run %s) | %zu |\n", run_id.c_str(), cataloged.size());
+  std::printf("| MCAP time within 100 ms of the robot's | %zu (worst %lld ms) |\n", time_ok,
+              static_cast<long long>(worst_ms));
+  std::printf("| catalog time within 100 ms of the robot's | %zu (worst %lld ms) |\n", cat_time_ok,
+              static_cast<long long>(worst_cat_ms));
+  std::printf("| duration | %.0f s |\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (!mcap_error.empty()) std::printf("MCAP: %s\n", mcap_error.c_str());
+  if (!rc || *rc != 0) std::printf("pc_server's script: %s\n", rc ? "an expect failed" : "did not finish");
+  if (same < logged.size() && same < recorded.size())
+    std::printf("first difference at %zu: logged %s '%s', recorded %s '%s'\n", same, logged[same].kind.c_str(),
+                logged[same].text.c_str(), recorded[same].kind.c_str(), recorded[same].text.c_str());
+  std::printf("outage_check: %s\n", pass ? "PASS" : "FAIL");
+  if (!o.json.empty()) {
+    std::ofstream j(o.json);
+    const auto late_n = std::count_if(recorded.begin(), recorded.end(), [](const Recorded& r) { return r.late; });
+    j << "{\"cuts\": " << o.cuts << ", \"kills\": " << kills_done << ", \"logged\": " << logged.size()
+      << ", \"mcap\": " << recorded.size() << ", \"mcap_in_order\": " << same << ", \"late\": " << late_n << ", \"catalog\": " << cataloged.size()
+      << ", \"mcap_worst_ms\": " << worst_ms << ", \"catalog_worst_ms\": " << worst_cat_ms
+      << ", \"pass\": " << (pass ? "true" : "false") << "}\n";
+  }
+  if (!pass) std::fprintf(stderr, "%s", s.logs().c_str());
+  return pass ? 0 : 1;
+}
