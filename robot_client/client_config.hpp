@@ -48,8 +48,8 @@ struct ClientConfig {
   std::string robot_id = "robot1";
   std::string server_host = "127.0.0.1";
   int server_port = 7600;
-  double reconnect_min_s = 0.2;
-  double reconnect_max_s = 3.0;
+  double reconnect_min_s = 0.1;
+  double reconnect_max_s = 0.4;
   double handshake_timeout_s = 3.0;
   double server_heartbeat_period_s = 0.1;
   double telemetry_hz = 50.0;

@@ -249,9 +249,14 @@ void RobotApp::storeAndSend(v1::Envelope& env) {
 
 void RobotApp::pumpOutbox() {
   // In order, behind what a reconnect has to replay; at most half the link's
-  // send queue at a time (telemetry and heartbeats keep their room).
+  // send queue at a time (telemetry and heartbeats keep their room), and at
+  // most 800 a second (64 at once): well inside the server's per-robot
+  // limits (2000 messages/s, docs/load.md), which would drop the excess.
   const std::size_t room = link_.queued() < 128 ? 128 - link_.queued() : 0;
-  outbox_.sendNext([this](v1::Envelope& e) { link_.send(e); }, room);
+  const double now_s = now();
+  const auto budget = std::min(room, static_cast<std::size_t>(outbox_budget_.tokens(now_s)));
+  const std::size_t sent = outbox_.sendNext([this](v1::Envelope& e) { link_.send(e); }, budget);
+  if (sent) outbox_budget_.take(static_cast<double>(sent), now_s);
 }
 
 void RobotApp::fillOutboxStatus(v1::Telemetry& t) const {

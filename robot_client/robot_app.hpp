@@ -16,6 +16,7 @@
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/util/latency_histogram.hpp"
+#include "shared/util/token_bucket.hpp"
 #include "shared/video/video_sender.hpp"
 
 namespace inspect::client {
@@ -59,6 +60,7 @@ class RobotApp {
   SerialLink serial_;
   ServerLink link_;
   EventOutbox outbox_;
+  util::TokenBucket outbox_budget_{800.0, 64.0};  // stored events sent per second
   boost::asio::steady_timer tick_timer_;
   boost::asio::steady_timer telemetry_timer_;
   boost::asio::steady_timer mcu_hb_timer_;

@@ -115,7 +115,7 @@ void ServerLink::onConnected() {
 void ServerLink::scheduleReconnect() {
   if (stopped_) return;
   retry_timer_.expires_after(steadyDuration(backoff_s_));
-  backoff_s_ = std::min(backoff_s_ * 2.0, cfg_.reconnect_max_s);
+  backoff_s_ = std::clamp(backoff_s_ * 2.0, cfg_.reconnect_min_s, cfg_.reconnect_max_s);
   retry_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (!ec) connect();
   });
@@ -133,6 +133,9 @@ void ServerLink::close(const std::string& why) {
   if (was_up || why != last_error_) log::warn("link", why);
   last_error_ = why;
   if (was_up && h_.on_down) h_.on_down(why);
+  // A link that was up is retried at once (a server restart, a blip), then
+  // with backoff from reconnect_min_s up to reconnect_max_s.
+  if (was_up) backoff_s_ = 0.0;
   scheduleReconnect();
 }
 

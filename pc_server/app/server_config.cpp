@@ -29,6 +29,11 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   c.teleop_resend_hz = root.number("teleop_resend_hz", c.teleop_resend_hz, 10, 100);
   c.max_frame_bytes = static_cast<std::size_t>(root.integer("max_frame_bytes", static_cast<long>(c.max_frame_bytes),
                                                             1024, 64L * 1024 * 1024));
+  const auto lim = root.optChild("robot_limits");
+  c.robot_limits.messages_per_s = lim.number("messages_per_s", c.robot_limits.messages_per_s, 10, 1e7);
+  c.robot_limits.bytes_per_s = lim.number("bytes_per_s", c.robot_limits.bytes_per_s, 1e3, 1e10);
+  c.robot_limits.burst_s = lim.number("burst_s", c.robot_limits.burst_s, 0.05, 60);
+  c.robot_limits.close_after_s = lim.number("close_after_s", c.robot_limits.close_after_s, 0.5, 600);
   c.status_refresh_hz = root.number("status_refresh_hz", c.status_refresh_hz, 0.5, 30);
   const auto v = root.optChild("video");
   auto& vc = c.video;

@@ -54,6 +54,15 @@ struct FoxgloveServerConfig {
   int max_clients = 32;
 };
 
+/// Per robot session (token buckets, docs/load.md): what a robot may send.
+/// A 100 Hz robot sends ~170 messages and ~60 kB a second.
+struct RobotLimits {
+  double messages_per_s = 2000;
+  double bytes_per_s = 4e6;
+  double burst_s = 1.0;          // bucket depth, in seconds of the rate
+  double close_after_s = 5.0;    // over the limit this long without a pause of 1 s: disconnected
+};
+
 /// Link and console settings; defaults are those documented in config/server.yaml.
 struct ServerConfig {
   std::string bind_address = "0.0.0.0";  // all interfaces: robots connect from the network
@@ -65,6 +74,7 @@ struct ServerConfig {
   double handshake_timeout_s = 5.0;
   double teleop_resend_hz = 20.0;
   std::size_t max_frame_bytes = 1u << 20;
+  RobotLimits robot_limits;
   double status_refresh_hz = 5.0;
   VideoServerConfig video;
   RecordingServerConfig recording;

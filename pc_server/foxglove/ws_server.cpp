@@ -15,6 +15,7 @@
 #include <boost/beast/websocket/ssl.hpp>
 
 #include "pc_server/app/startup_error.hpp"
+#include "shared/util/token_bucket.hpp"
 #include "shared/util/log.hpp"
 
 namespace inspect::server::foxglove {
@@ -63,10 +64,12 @@ bool sameSecret(const std::string& a, const std::string& b) {
 class ClientSession : public std::enable_shared_from_this<ClientSession> {
  public:
   ClientSession(WsServer& server, uint64_t id, std::string peer)
-      : server_(server), id_(id), peer_(std::move(peer)), since_(Clock::now()), queue_(server.options().limits) {
-    const double rate = server.options().requests_per_s;
-    tokens_ = rate * 2;
-  }
+      : server_(server),
+        id_(id),
+        peer_(std::move(peer)),
+        since_(Clock::now()),
+        queue_(server.options().limits),
+        rate_(server.options().requests_per_s, server.options().requests_per_s * 2) {}
   virtual ~ClientSession() { endHandshake(); }
   uint64_t id() const { return id_; }
   /// The connection is past its upgrade (served or refused): it no longer counts as setting up.
@@ -215,12 +218,7 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
   bool withinRate() {
     const double rate = server_.options().requests_per_s;
     const auto now = Clock::now();
-    tokens_ = std::min(rate * 2, tokens_ + rate * std::chrono::duration<double>(now - last_refill_).count());
-    last_refill_ = now;
-    if (tokens_ >= 1) {
-      tokens_ -= 1;
-      return true;
-    }
+    if (rate_.take(1, std::chrono::duration<double>(now.time_since_epoch()).count())) return true;
     if (now - last_rate_warning_ > std::chrono::seconds(1)) {
       last_rate_warning_ = now;
       refuse("too many requests: more than " + std::to_string(static_cast<int>(rate)) +
@@ -373,8 +371,7 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
   uint64_t warned_drops_ = 0;
   Clock::time_point last_drop_warning_{};
   // the rate limit (strand only)
-  double tokens_ = 0;
-  Clock::time_point last_refill_ = Clock::now();
+  util::TokenBucket rate_;
   Clock::time_point last_rate_warning_{};
 };
 

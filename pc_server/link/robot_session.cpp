@@ -50,11 +50,57 @@ RobotSession::RobotSession(Strand strand, asio::ip::tcp::socket socket,
       heartbeat_timer_(strand_),
       teleop_timer_(strand_),
       stale_timer_(strand_),
+      throttle_{{config.robot_limits.messages_per_s, config.robot_limits.messages_per_s * config.robot_limits.burst_s},
+                {config.robot_limits.bytes_per_s, config.robot_limits.bytes_per_s * config.robot_limits.burst_s}},
       decoder_(config.max_frame_bytes) {
   error_code ec;
   const auto ep = stream_.socket().remote_endpoint(ec);
   address_ = ec ? std::string("?") : ep.address().to_string() + ":" + std::to_string(ep.port());
   stream_.socket().set_option(asio::ip::tcp::no_delay(true), ec);  // small frames, latency matters
+}
+
+bool RobotSession::withinLimits(std::size_t bytes) {
+  const double now_s = static_cast<double>(monoNowNs()) * 1e-9;
+  auto& t = throttle_;
+  const auto& lim = config_.robot_limits;
+  if (t.messages.take(1, now_s) && t.bytes.take(static_cast<double>(bytes), now_s)) {
+    if (t.active && now_s - t.last_drop_s >= 1.0) {
+      t.active = false;
+      const std::string text = "server: no longer throttled, " + std::to_string(t.dropped) + " messages dropped in " +
+                               fmtShort(t.last_drop_s - t.since_s, 1) + " s";
+      log::info(log::tag::kLink, who(), ": ", text.substr(8));
+      serverEvent(v1::Event::FAULT_CLEARED, text);
+    }
+    return true;
+  }
+  if (!t.active) {
+    t.active = true;
+    t.since_s = now_s;
+    t.dropped = 0;
+    ++t.episodes;
+    const std::string text = "server: throttled: over " + fmtShort(lim.messages_per_s, 0) + " messages/s or " +
+                             fmtShort(lim.bytes_per_s, 0) + " bytes/s; its messages are dropped until it slows down";
+    log::warn(log::tag::kLink, who(), ": ", text.substr(8));
+    serverEvent(v1::Event::FAULT_RAISED, text);
+  }
+  ++t.dropped;
+  t.last_drop_s = now_s;
+  if (now_s - t.since_s >= lim.close_after_s)
+    closeNow("flooding: over the limits (robot_limits) for " + fmtShort(now_s - t.since_s, 1) + " s, " +
+                 std::to_string(t.dropped) + " messages dropped",
+             log::Level::kWarn);
+  return false;
+}
+
+void RobotSession::serverEvent(v1::Event::Kind kind, const std::string& text) {
+  v1::Envelope env;
+  auto* ev = env.mutable_event();
+  ev->set_kind(kind);
+  ev->set_text(text);
+  ev->set_robot_time_us(monoNowUs());
+  if (peer_.robot_id.empty()) return;  // before the Hello: the log says it
+  registry_.onEvent(peer_.robot_id, serial_, *ev, monoNowNs());
+  server_.observe(peer_.robot_id, address_, env, true, monoNowUs());
 }
 
 std::string RobotSession::who() const { return peer_.robot_id.empty() ? address_ : peer_.robot_id + " (" + address_ + ")"; }
@@ -167,6 +213,10 @@ void RobotSession::onRead(const error_code& ec, std::size_t n) {
     if (st == net::DelimitedDecoder::Status::kInvalid) {
       closeNow("framing error: " + decoder_.error(), log::Level::kWarn);
       return;
+    }
+    if (!withinLimits(frame.size())) {
+      if (closed_) return;
+      continue;  // dropped
     }
     if (!handleFrame(frame)) return;
     if (peer_.rejecting) break;

@@ -17,6 +17,7 @@
 
 #include "inspect_robot/v1/link.pb.h"
 #include "pc_server/app/server_config.hpp"
+#include "shared/util/token_bucket.hpp"
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/tls.hpp"
 #include "shared/util/log.hpp"
@@ -75,6 +76,11 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   void armTeleop(uint64_t generation);
   void sendTeleopNow(uint64_t id);
   void closeNow(const std::string& reason, log::Level level);
+  /// The per-robot limits (robot_limits): false = drop this frame of `bytes`
+  /// (throttled); closes a session that keeps on (then closed_).
+  bool withinLimits(std::size_t bytes);
+  /// A server event about this robot: on every console and in its run.
+  void serverEvent(v1::Event::Kind kind, const std::string& text);
   std::string who() const;
 
   Strand strand_;
@@ -90,6 +96,15 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   boost::asio::steady_timer heartbeat_timer_;
   boost::asio::steady_timer teleop_timer_;
   boost::asio::steady_timer stale_timer_;
+
+  struct Throttle {
+    util::TokenBucket messages, bytes;
+    bool active = false;         // messages are being dropped
+    double since_s = 0;          // the episode began (monotonic s)
+    double last_drop_s = 0;
+    uint64_t dropped = 0;        // in this episode
+    uint64_t episodes = 0;
+  } throttle_;
 
   net::DelimitedDecoder decoder_;
   std::array<char, 16 * 1024> rx_buf_{};

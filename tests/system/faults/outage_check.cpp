@@ -148,6 +148,27 @@ std::vector<CatalogAlarm> catalogAlarms(const std::string& db, const std::string
   return out;
 }
 
+// From each `flow` of the relay to the next connection it accepted (the
+// robot's reconnect after the outage), ms; from its output lines
+// "tcp_fault_relay: <what> at mono_ns=<ns>".
+std::vector<double> reconnectMs(const std::string& relay_out) {
+  std::vector<double> out;
+  std::istringstream in(relay_out);
+  int64_t flow_ns = -1;
+  for (std::string line; std::getline(in, line);) {
+    const auto at = line.find(" at mono_ns=");
+    if (at == std::string::npos) continue;
+    const int64_t ns = std::stoll(line.substr(at + 12));
+    if (line.find(": flow at") != std::string::npos) flow_ns = ns;
+    else if (flow_ns >= 0 && line.find(" accepted at") != std::string::npos) {
+      out.push_back(static_cast<double>(ns - flow_ns) * 1e-6);
+      flow_ns = -1;
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 void control(const std::string& fifo, const std::string& cmd) {
   std::ofstream(fifo) << cmd << "\n";
 }
@@ -285,6 +306,10 @@ int main(int argc, char** argv) {
               static_cast<long long>(worst_ms));
   std::printf("| catalog time within 100 ms of the robot's | %zu (worst %lld ms) |\n", cat_time_ok,
               static_cast<long long>(worst_cat_ms));
+  const auto rec_ms = reconnectMs(readFile(s.dir() / "relay.out"));
+  if (!rec_ms.empty())
+    std::printf("| reconnect after the link came back, ms (p50 / max of %zu) | %.0f / %.0f |\n", rec_ms.size(),
+                rec_ms[rec_ms.size() / 2], rec_ms.back());
   std::printf("| duration | %.0f s |\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (!mcap_error.empty()) std::printf("MCAP: %s\n", mcap_error.c_str());
   if (!rc || *rc != 0) std::printf("pc_server's script: %s\n", rc ? "an expect failed" : "did not finish");
