@@ -15,6 +15,8 @@
 
 #include <boost/crc.hpp>
 
+#include "shared/util/file_util.hpp"
+
 namespace inspect::client {
 
 namespace {
@@ -79,14 +81,14 @@ std::string why(const unsigned char* p, std::size_t left) {
   return "checksum mismatch (seq " + std::to_string(getLe(p + 8, 8)) + ")";
 }
 
-uint64_t newStreamId() {
+}  // namespace
+
+uint64_t EventJournal::newStreamId() {
   std::random_device rd;
   uint64_t v = 0;
   while (v == 0) v = (static_cast<uint64_t>(rd()) << 32) ^ rd();
   return v;
 }
-
-}  // namespace
 
 EventJournal::Loaded EventJournal::read(const std::string& path) {
   Loaded out;
@@ -188,44 +190,11 @@ bool EventJournal::rewrite(const std::vector<Entry>& pending, uint64_t next_seq)
   putLe(head, next_seq, 8);
   data += encode('H', 0, head);
   for (const auto& e : pending) data += encode('E', e.seq, e.payload);
-  const std::string tmp = path_ + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
-  if (fd < 0) {
+  if (const std::string why = writeFileAtomically(path_, data, /*durable=*/true); !why.empty()) {
     std::lock_guard lk(mu_);
-    error_ = "cannot write " + tmp + ": " + std::strerror(errno);
+    error_ = why;
     ++write_errors_;
     return false;
-  }
-  std::size_t done = 0;
-  while (done < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int err = errno;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      std::lock_guard lk(mu_);
-      error_ = "cannot write " + tmp + ": " + std::strerror(err);
-      ++write_errors_;
-      return false;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0 || ::rename(tmp.c_str(), path_.c_str()) != 0) {
-    const int err = errno;
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    std::lock_guard lk(mu_);
-    error_ = "cannot replace " + path_ + ": " + std::strerror(err);
-    ++write_errors_;
-    return false;
-  }
-  ::close(fd);
-  // The rename itself reaches the disk with the folder.
-  const std::string dir = std::filesystem::path(path_).parent_path().string();
-  if (const int dfd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
   }
   const int nfd = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
   if (nfd < 0) {

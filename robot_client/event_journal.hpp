@@ -16,8 +16,9 @@
 // most once a second, so a power cut loses at most the last second. Reading
 // back skips a torn or corrupt record (bad magic, length, CRC; a torn tail)
 // with a logged reason and resynchronises on the next valid record; then the
-// file is rewritten with only what is still pending (temporary file, fsync,
-// rename), so a damaged file never grows. A write that fails (disk full, I/O
+// file is rewritten with only what is still pending (writeFileAtomically,
+// durable: temporary file, fsync, rename, fsync of the folder), so a damaged
+// file never grows. A write that fails (disk full, I/O
 // error) is reported (error()) and retried with the next record: the entries
 // stay in memory, nothing stops.
 #include <condition_variable>
@@ -73,6 +74,8 @@ class EventJournal {
 
   /// Reads a journal file (no side effects): for tests and `open`.
   static Loaded read(const std::string& path);
+  /// A random event stream id, never 0.
+  static uint64_t newStreamId();
 
  private:
   bool writeRecord(char type, uint64_t seq, const std::string& payload);

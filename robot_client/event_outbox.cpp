@@ -1,6 +1,5 @@
 #include "robot_client/event_outbox.hpp"
 
-#include <random>
 #include <stdexcept>
 
 namespace inspect::client {
@@ -29,7 +28,7 @@ EventOutbox::EventOutbox(const std::string& journal_path, std::size_t max_pendin
   }
   if (!journal_) {
     // Memory only: a stream of its own for this process.
-    stream_ = (static_cast<uint64_t>(std::random_device{}()) << 32) | std::random_device{}() | 1u;
+    stream_ = EventJournal::newStreamId();
     return;
   }
   auto& l = journal_->loaded();

@@ -242,11 +242,6 @@ void RobotApp::fillVideoStatus(v1::Telemetry& t) const {
   v->set_keyframe_requests(s.keyframe_requests);
 }
 
-void RobotApp::storeAndSend(v1::Envelope& env) {
-  outbox_.store(env, static_cast<uint64_t>(wallNowNs() / 1000));
-  pumpOutbox();
-}
-
 void RobotApp::pumpOutbox() {
   // In order, behind what a reconnect has to replay; at most half the link's
   // send queue at a time (telemetry and heartbeats keep their room), and at
@@ -280,7 +275,7 @@ void RobotApp::flushEvents() {
   for (auto& a : core_.takeAcks()) {
     v1::Envelope env;
     *env.mutable_ack() = a;
-    storeAndSend(env);
+    outbox_.store(env, wallNowNs() / 1000);
   }
   for (const auto& p : core_.takePtz()) {
     if (const std::string why = applyPtz(p); !why.empty()) log::warn("core", "inspection point camera preset: ", why);
@@ -298,9 +293,9 @@ void RobotApp::flushEvents() {
       ev->set_gains_version(e.gains_version);
     }
     ev->set_robot_time_us(static_cast<uint64_t>(now() * 1e6));
-    storeAndSend(env);
+    outbox_.store(env, wallNowNs() / 1000);
   }
-  pumpOutbox();
+  pumpOutbox();  // what was stored, in order behind anything a reconnect replays
 }
 
 void RobotApp::tick10ms() {

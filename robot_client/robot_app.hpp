@@ -40,8 +40,6 @@ class RobotApp {
   void onServerMessage(const v1::Envelope& env);
   void sendWheels(const serial::WheelCommand& c);
   void flushEvents();
-  /// Numbers, journals and (link up) sends an Event or a late Ack.
-  void storeAndSend(v1::Envelope& env);
   /// Sends what the outbox has for this connection (a budget at a time).
   void pumpOutbox();
   void fillOutboxStatus(v1::Telemetry& t) const;

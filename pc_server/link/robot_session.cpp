@@ -26,6 +26,7 @@ const char* bodyName(v1::Envelope::BodyCase c) {
     case v1::Envelope::kAck: return "Ack";
     case v1::Envelope::kTelemetry: return "Telemetry";
     case v1::Envelope::kEvent: return "Event";
+    case v1::Envelope::kDelivered: return "Delivered";
     case v1::Envelope::BODY_NOT_SET: break;
   }
   return "an Envelope without a body";

@@ -286,14 +286,18 @@ std::string Recorder::stopLocked(const std::string& robot, const std::string& ou
   return r.info.id;
 }
 
-void Recorder::noteLocked(Run& r, const std::string& robot, const std::string& text) {
+void Recorder::noteLocked(Run& r, const std::string& robot, const std::string& text, const std::string& kind,
+                          uint64_t wall_ns) {
   v1::Event e;
   e.set_kind(v1::Event::INFO);
   e.set_text(text);
   e.set_robot_time_us(monoNowUs());
-  const uint64_t now = wallNowNs();
-  r.mcap.write(r.ch_server, now, now, e);
-  catalog_->addEvent(r.info.id, robot, std::chrono::system_clock::now(), "server", text);
+  const uint64_t t = wall_ns ? wall_ns : wallNowNs();
+  r.mcap.write(r.ch_server, t, t, e);
+  catalog_->addEvent(r.info.id, robot,
+                     std::chrono::system_clock::time_point(
+                         std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::nanoseconds(t))),
+                     kind, text);
 }
 
 void Recorder::onEnvelope(const std::string& robot, const std::string& address, const v1::Envelope& env,
@@ -326,11 +330,10 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
   // A stored entry from before the current run (or from a run that has
   // ended) is filed in the catalog under the run recording then; that run's
   // MCAP is closed and is not reopened (docs/store-and-forward.md).
-  std::string run_id = it == runs_.end() ? "" : it->second->info.id;
-  bool in_open_run = it != runs_.end();
-  if (inbound && it != runs_.end() && when < it->second->info.start) in_open_run = false;
-  if (inbound && !in_open_run && isLate(env)) run_id = runAt(robot, when);
-  else if (!in_open_run) run_id.clear();
+  const bool in_open_run = it != runs_.end() && !(inbound && when < it->second->info.start);
+  const std::string run_id = in_open_run             ? it->second->info.id
+                             : inbound && isLate(env) ? runAt(robot, when)
+                                                      : std::string();
   // Gas alarms go into the catalog during runs and outside them.
   if (inbound && env.has_event() && env.event().has_gas_alarm()) {
     const auto& a = env.event().gas_alarm();
@@ -365,13 +368,8 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
         // A telemetry gap (the link was down, or the robot silent) is marked in the run.
         if (r.last_telemetry_ns && log_ns > r.last_telemetry_ns + kTelemetryGapNs) {
           const double gap_s = static_cast<double>(log_ns - r.last_telemetry_ns) * 1e-9;
-          const std::string text = "telemetry gap: " + fmtShort(gap_s, 2) + " s without telemetry from " + robot;
-          v1::Event e;
-          e.set_kind(v1::Event::INFO);
-          e.set_text(text);
-          e.set_robot_time_us(monoNowUs());
-          r.mcap.write(r.ch_server, log_ns, log_ns, e);
-          catalog_->addEvent(r.info.id, robot, when, "gap", text);
+          noteLocked(r, robot, "telemetry gap: " + fmtShort(gap_s, 2) + " s without telemetry from " + robot, "gap",
+                     log_ns);
         }
         r.last_telemetry_ns = std::max(r.last_telemetry_ns, log_ns);
         r.stats.add(env.telemetry());

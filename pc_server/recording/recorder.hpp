@@ -89,7 +89,10 @@ class Recorder {
   std::string startLocked(const std::string& robot, const std::string& name, const std::string& route,
                           uint64_t command_id);
   std::string stopLocked(const std::string& robot, const std::string& outcome);
-  void noteLocked(Run& r, const std::string& robot, const std::string& text);
+  /// A server note in the run: /server_event and the catalog (`kind`), at
+  /// `wall_ns` (0 = now).
+  void noteLocked(Run& r, const std::string& robot, const std::string& text, const std::string& kind = "server",
+                  uint64_t wall_ns = 0);
   /// A stored event or ack the robot sent late (store-and-forward).
   static bool isLate(const v1::Envelope& env);
   /// The id of the robot's run recording at `t` (catalog), "" = none.
