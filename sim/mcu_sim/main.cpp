@@ -81,7 +81,11 @@ int main(int argc, char** argv) {
     std::printf("mcu_sim: %s\n", stats.c_str());
     if (camera) std::printf("mcu_sim: %s\n", camera->summary().c_str());
     std::fflush(stdout);
-    if (truth) truth->comment(stats);
+    if (truth) {
+      truth->comment(stats);
+      std::printf("mcu_sim: %s\n", truth->writerSummary().c_str());
+      std::fflush(stdout);
+    }
     return 0;
   } catch (const config::ConfigError& e) {
     std::fprintf(stderr, "mcu_sim: %s\n", e.what());

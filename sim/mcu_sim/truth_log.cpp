@@ -2,18 +2,16 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
-#include <stdexcept>
 
 #include "shared/serial/cobs.hpp"
 #include "shared/util/clock.hpp"
 
 namespace inspect::sim {
 
-TruthLog::TruthLog(const std::string& path) : file_(std::fopen(path.c_str(), "w")) {
-  if (!file_) throw std::runtime_error("--truth " + path + ": cannot open for writing: " + std::strerror(errno));
+TruthLog::TruthLog(const std::string& path) : file_(std::make_unique<BackgroundFile>(path, "--truth")) {
   comment("mcu_sim ground truth; format: docs/simulator.md");
   comment("T,mono_ns,sim_t_s,x_m,y_m,theta_rad,wheel_l_rad_s,wheel_r_rad_s,setpoint_l_rad_s,setpoint_r_rad_s,fault_flags");
   comment("C,mono_ns,sim_t_s,seq,left_mrad_s,right_mrad_s,flags");
@@ -23,19 +21,22 @@ TruthLog::TruthLog(const std::string& path) : file_(std::fopen(path.c_str(), "w"
           "see the gas_channels event; read NaN = no data)");
 }
 
-TruthLog::~TruthLog() {
-  if (file_) std::fclose(file_);
-  if (frames_) std::fclose(frames_);
-}
+TruthLog::~TruthLog() = default;
 
 void TruthLog::openFrameLog(const std::string& path) {
-  if (frames_) std::fclose(frames_);
-  frames_ = std::fopen(path.c_str(), "w");
-  if (!frames_) throw std::runtime_error("--frame-log " + path + ": cannot open for writing: " + std::strerror(errno));
-  std::fputs("# mcu_sim sensor frames sent; format: docs/failsafes.md\n"
-             "# F,mono_ns,sim_t_s,msg_id,seq,crc16,mcu_time_ms\n",
-             frames_);
-  std::fflush(frames_);
+  frames_.reset();
+  frames_ = std::make_unique<BackgroundFile>(path, "--frame-log");
+  frames_->append(
+      "# mcu_sim sensor frames sent; format: docs/failsafes.md\n"
+      "# F,mono_ns,sim_t_s,msg_id,seq,crc16,mcu_time_ms\n");
+}
+
+std::string TruthLog::writerSummary() const {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "truth log: longest write-out %.0f ms, dropped %llu bytes",
+                std::max(file_->maxWriteMs(), frames_ ? frames_->maxWriteMs() : 0.0),
+                static_cast<unsigned long long>(file_->droppedBytes() + (frames_ ? frames_->droppedBytes() : 0)));
+  return buf;
 }
 
 void TruthLog::onFrameSent(double sim_t_s, std::span<const uint8_t> wire, uint32_t mcu_time_ms) {
@@ -45,17 +46,18 @@ void TruthLog::onFrameSent(double sim_t_s, std::span<const uint8_t> wire, uint32
   const auto n = serial::cobsDecode(wire.first(wire.size() - 1), raw);
   if (!n || *n < 4) return;
   const unsigned crc = raw[*n - 2] | (static_cast<unsigned>(raw[*n - 1]) << 8);
-  std::fprintf(frames_, "F,%lld,%.3f,%u,%u,%u,%u\n", static_cast<long long>(monoNowNs()), sim_t_s,
-               static_cast<unsigned>(raw[0]), static_cast<unsigned>(raw[1]), crc, static_cast<unsigned>(mcu_time_ms));
-  // Buffered (unlike the truth lines): 100 lines a second, read once mcu_sim has exited.
+  char buf[128];
+  const int len = std::snprintf(buf, sizeof buf, "F,%lld,%.3f,%u,%u,%u,%u\n", static_cast<long long>(monoNowNs()),
+                                sim_t_s, static_cast<unsigned>(raw[0]), static_cast<unsigned>(raw[1]), crc,
+                                static_cast<unsigned>(mcu_time_ms));
+  if (len > 0) frames_->append({buf, std::min<std::size_t>(static_cast<std::size_t>(len), sizeof buf - 1)});
 }
 
 void TruthLog::line(const char* text, int n) {
   if (n <= 0) return;
   // snprintf returns the untruncated length; the callers' buffers end with '\n' only when it fit.
   n = std::min(n, static_cast<int>(std::strlen(text)));
-  std::fwrite(text, 1, static_cast<std::size_t>(n), file_);
-  std::fflush(file_);
+  file_->append({text, static_cast<std::size_t>(n)});
 }
 
 void TruthLog::onSample(const TruthSample& s) {

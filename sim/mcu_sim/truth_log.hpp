@@ -1,13 +1,15 @@
 #pragma once
 // Ground-truth CSV log (--truth FILE): T (state per frame), C (accepted wheel
 // commands), E (events), P (pedestrians, 10 Hz), G (gas at the inlet, 10 Hz) lines,
-// '#' comments; every line flushed at once because tests read the file while the
-// simulator runs. Format: docs/simulator.md.
-#include <cstdio>
+// '#' comments. Tests read the file while the simulator runs: a thread of its
+// own writes the lines out every 20 ms (BackgroundFile), so the real-time loop
+// never waits on the disk. Format: docs/simulator.md.
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
 
+#include "sim/mcu_sim/background_file.hpp"
 #include "sim/sim_observer.hpp"
 
 namespace inspect::sim {
@@ -30,11 +32,13 @@ class TruthLog : public SimObserver {
   void openFrameLog(const std::string& path);
   /// Writes "# <text>".
   void comment(std::string_view text);
+  /// "truth log: longest write-out N ms, dropped N bytes" (dropped only when the disk stalled for minutes).
+  std::string writerSummary() const;
 
  private:
   void line(const char* text, int n);
-  std::FILE* file_ = nullptr;
-  std::FILE* frames_ = nullptr;
+  std::unique_ptr<BackgroundFile> file_;
+  std::unique_ptr<BackgroundFile> frames_;
 };
 
 }  // namespace inspect::sim
