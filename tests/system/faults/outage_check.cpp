@@ -12,8 +12,6 @@
 // catalog exactly once, in order, at the robot's time (within 100 ms).
 //
 //   outage_check [--cuts N] [--kills K] [--min-cut S] [--max-cut S] [--seed N] [--json FILE]
-#include <sqlite3.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,10 +24,9 @@
 #include <thread>
 #include <vector>
 
-#include "inspect_robot/v1/link.pb.h"
-#include "shared/record/mcap_reader.hpp"
 #include "shared/util/cli_args.hpp"
 #include "tests/support/stack.hpp"
+#include "tests/system/faults/gas_outage_world.hpp"
 
 using namespace inspect;
 using namespace inspect::test;
@@ -49,104 +46,6 @@ struct Step {
   double up_s, cut_s;
   bool kill;
 };
-
-// The world: a closed room, the robot at rest; a CH4 leak beside its gas
-// inlet that leaks for 12 s of every 30 s; CO dropping out for 2 s of every
-// 7 s and H2S for 3 s of every 11 s (each a SENSOR_FAULT raised and cleared).
-std::string worldYaml(double duration_s) {
-  std::ostringstream w;
-  w << "name: gas_outages\n"
-       "description: outage_check's world (tests/system/faults/outage_check.cpp)\n"
-       "start: {x_m: 2.0, y_m: 2.0, theta_rad: 0.0}\n"
-       "walls:\n  - points_m: [0.0, 0.0, 6.0, 0.0, 6.0, 4.0, 0.0, 4.0]\n    closed: true\n"
-       "gas:\n  diffusivity_m2_s: 0.05\n  ventilation_per_s: 0.2\n  cell_m: 0.1\n  sources:\n";
-  for (double t = 2; t < duration_s; t += 30)
-    w << "    - {name: pulse" << static_cast<int>(t) << ", gas: CH4, x_m: 2.35, y_m: 2.0, rate: 20.0, start_s: " << t
-      << ", end_s: " << t + 12 << "}\n";
-  w << "  faults:\n";
-  for (double t = 5; t < duration_s; t += 7) w << "    - {channel: CO, kind: dropout, start_s: " << t << ", end_s: " << t + 2 << "}\n";
-  for (double t = 8; t < duration_s; t += 11) w << "    - {channel: H2S, kind: dropout, start_s: " << t << ", end_s: " << t + 3 << "}\n";
-  return w.str();
-}
-
-// One alarm transition as robot_client logged it ("HH:MM:SS.mmm I [core] ALARM_RAISED: text").
-struct Logged {
-  int64_t ms_of_day;
-  std::string kind, text;
-};
-
-std::vector<Logged> robotAlarms(const std::string& log_path) {
-  std::vector<Logged> out;
-  std::ifstream in(log_path);
-  for (std::string line; std::getline(in, line);) {
-    for (const char* kind : {"ALARM_RAISED", "ALARM_CLEARED"}) {
-      const std::string tag = std::string("[core] ") + kind + ": ";
-      const auto at = line.find(tag);
-      if (at == std::string::npos || line.size() < 12) continue;
-      const int64_t ms = ((std::stoll(line.substr(0, 2)) * 60 + std::stoll(line.substr(3, 2))) * 60 +
-                          std::stoll(line.substr(6, 2))) * 1000 + std::stoll(line.substr(9, 3));
-      out.push_back({ms, kind, line.substr(at + tag.size())});
-    }
-  }
-  return out;
-}
-
-int64_t msOfDayLocal(uint64_t unix_ns) {
-  const std::time_t s = static_cast<std::time_t>(unix_ns / 1'000'000'000ULL);
-  std::tm tm{};
-  localtime_r(&s, &tm);
-  return ((tm.tm_hour * 60 + tm.tm_min) * 60 + tm.tm_sec) * 1000LL + static_cast<int64_t>(unix_ns / 1'000'000ULL % 1000);
-}
-
-int64_t dayDiffMs(int64_t a, int64_t b) {
-  int64_t d = a - b;
-  if (d > 43'200'000) d -= 86'400'000;
-  if (d < -43'200'000) d += 86'400'000;
-  return d;
-}
-
-struct Recorded {
-  uint64_t log_ns;
-  std::string kind, text;
-  bool late;  // stored by the robot during an outage, sent after it
-};
-
-std::vector<Recorded> mcapAlarms(const std::string& path) {
-  std::vector<Recorded> out;
-  auto r = record::McapReader::open(path);
-  r.forEach([&](const record::McapMessageView& m) {
-    if (m.topic != "/event") return true;
-    v1::Event e;
-    if (!e.ParseFromArray(m.data.data(), static_cast<int>(m.data.size()))) return true;
-    if (e.kind() == v1::Event::ALARM_RAISED || e.kind() == v1::Event::ALARM_CLEARED)
-      out.push_back({m.log_time_ns, v1::Event::Kind_Name(e.kind()), e.text(), e.stored().replayed()});
-    return true;
-  });
-  std::stable_sort(out.begin(), out.end(), [](const Recorded& a, const Recorded& b) { return a.log_ns < b.log_ns; });
-  return out;
-}
-
-struct CatalogAlarm {
-  double time_unix;
-  std::string channel, level, state;
-};
-
-std::vector<CatalogAlarm> catalogAlarms(const std::string& db, const std::string& run_id) {
-  std::vector<CatalogAlarm> out;
-  sqlite3* h = nullptr;
-  if (sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) return out;
-  sqlite3_stmt* st = nullptr;
-  sqlite3_prepare_v2(h, "SELECT time_unix, channel, level, state FROM alarms WHERE run_id = ? ORDER BY time_unix, id", -1,
-                     &st, nullptr);
-  sqlite3_bind_text(st, 1, run_id.c_str(), -1, SQLITE_TRANSIENT);
-  while (sqlite3_step(st) == SQLITE_ROW)
-    out.push_back({sqlite3_column_double(st, 0), reinterpret_cast<const char*>(sqlite3_column_text(st, 1)),
-                   reinterpret_cast<const char*>(sqlite3_column_text(st, 2)),
-                   reinterpret_cast<const char*>(sqlite3_column_text(st, 3))});
-  sqlite3_finalize(st);
-  sqlite3_close(h);
-  return out;
-}
 
 // From each `flow` of the relay to the next connection it accepted (the
 // robot's reconnect after the outage), ms; from its output lines
@@ -205,7 +104,7 @@ int main(int argc, char** argv) {
   }
 
   Stack s("outage");
-  writeFile(s.dir() / "gas_outages.yaml", worldYaml(planned_s + 120));
+  writeFile(s.dir() / "gas_outages.yaml", gasOutageWorldYaml(planned_s + 120));
   const std::string journal = s.dir() / "robot1-events.journal";
   std::string script =
       "expect robots >= 1 within 20\nexpect sensor_hz > 50 within 5\nrecord start outages\n"
@@ -264,16 +163,16 @@ int main(int argc, char** argv) {
   const std::string run_id = out.substr(at + tag.size(), out.find('\n', at) - at - tag.size());
 
   // The robot's log (every process's, appended across the restarts) against the run.
-  const auto logged = robotAlarms(s.dir() / "robot1-client.err");
+  const auto logged = robotLoggedAlarms(s.dir() / "robot1-client.err");
   const std::string run_dir = s.dir() / ("runs/" + run_id);
-  std::vector<Recorded> recorded;
+  std::vector<RecordedAlarm> recorded;
   std::string mcap_error;
   try {
     recorded = mcapAlarms(run_dir + "/run.mcap");
   } catch (const std::exception& e) {
     mcap_error = e.what();
   }
-  const auto cataloged = catalogAlarms(s.dir() / "runs/catalog.sqlite", run_id);
+  const auto cataloged = catalogAlarms(s.dir() / "runs/catalog.sqlite", "run_id", run_id);
 
   // Exactly once, in order: the i-th logged transition is the i-th recorded one.
   std::size_t same = 0, time_ok = 0, cat_time_ok = 0;
@@ -299,7 +198,7 @@ int main(int argc, char** argv) {
   std::printf("| link cuts | %d |\n| robot_client SIGKILLs mid-outage | %d |\n", o.cuts, kills_done);
   std::printf("| alarm transitions robot_client logged | %zu |\n", logged.size());
   std::printf("| in the run's MCAP (/event) | %zu (%zu in order and equal) |\n", recorded.size(), same);
-  const auto late = std::count_if(recorded.begin(), recorded.end(), [](const Recorded& r) { return r.late; });
+  const auto late = std::count_if(recorded.begin(), recorded.end(), [](const RecordedAlarm& r) { return r.late; });
   std::printf("| of those, stored during an outage and filed after it | %zu |\n", static_cast<std::size_t>(late));
   std::printf("| in the catalog (alarms of run %s) | %zu |\n", run_id.c_str(), cataloged.size());
   std::printf("| MCAP time within 100 ms of the robot's | %zu (worst %lld ms) |\n", time_ok,
@@ -319,7 +218,7 @@ int main(int argc, char** argv) {
   std::printf("outage_check: %s\n", pass ? "PASS" : "FAIL");
   if (!o.json.empty()) {
     std::ofstream j(o.json);
-    const auto late_n = std::count_if(recorded.begin(), recorded.end(), [](const Recorded& r) { return r.late; });
+    const auto late_n = std::count_if(recorded.begin(), recorded.end(), [](const RecordedAlarm& r) { return r.late; });
     j << "{\"cuts\": " << o.cuts << ", \"kills\": " << kills_done << ", \"logged\": " << logged.size()
       << ", \"mcap\": " << recorded.size() << ", \"mcap_in_order\": " << same << ", \"late\": " << late_n << ", \"catalog\": " << cataloged.size()
       << ", \"mcap_worst_ms\": " << worst_ms << ", \"catalog_worst_ms\": " << worst_cat_ms
