@@ -275,7 +275,7 @@ TEST(Program, SigintDuringTuneCancelsItKeepingTheBestAndTheScriptGoesOn) {
 TEST(Program, AttachedOperatorObservesAndIsRefusedMotionWhileTheConsoleControls) {
   Program p("attach");
   const auto script = p.file("s.txt",
-                             "expect robots >= 1 within 5\n"
+                             "expect robots >= 1 within 15\n"
                              "drive 0.2 0\n"
                              "wait 3\n"
                              "stop\n");
@@ -295,9 +295,11 @@ TEST(Program, AttachedOperatorObservesAndIsRefusedMotionWhileTheConsoleControls)
       if (m.env.has_command() && m.env.command().has_teleop() && m.env.command().teleop().v_m_s() == 0.2) return true;
     return false;
   };
-  const auto deadline = Clock::now() + 5s;
+  // A bound on the wait, not a judgement of speed: under the unit phase's full load (ctest -j
+  // 3 x cores) the server, the robot's Hello and the script's first drive took over 5 s once.
+  const auto deadline = Clock::now() + 15s;
   while (!driving() && Clock::now() < deadline) std::this_thread::sleep_for(20ms);
-  ASSERT_TRUE(driving());
+  ASSERT_TRUE(driving()) << p.out() << p.err();
   const auto input = p.file("attach_in.txt", "control\ndrive 0.1 0\n" + std::string(5000, 'x') + "\nstatus\nstop\nquit\n");
   const std::string cmd =
       "timeout 10 " + kBinary + " --attach " + sock.string() + " < " + input.string() + " 2>&1";
