@@ -77,8 +77,8 @@ TEST(TuningStack, IdentifyTunePushAndTheCircleIsTrackedBetter) {
          << "expect max_pos_err > 0\nexpect max_ang_err > 0\n"
          // 600 evaluations, not 400: offline, on 12 plants within +-3e-6 of one this test identified,
          // 400 left the seeded global search (GN_CRS2_LM, then LN_SBPLX) in a poor optimum for 2
-         // (cost 84.8 and 240.5 against ~10; the tuned circle then tracked worse), 600 for none
-         // (those two: 15.2 and 12.1). About 5 s more; the tuner's own default is 1000.
+         // (cost 84.8 and 240.5 against ~10; the tuned circle then tracked worse), 600 for none of
+         // the 11 that finished (those two: 15.2 and 12.1). About 5 s more; the tuner's own default is 1000.
          << "tune evals=600\n"
          << "gains push\nexpect gains_version == 1 within 2\n"
          << "track circle 3.5 0.5 1 fuzzy_pid\nexpect mode == TRACKING within 2\nexpect mode == IDLE within 40\n"
