@@ -11,6 +11,18 @@ constexpr uint16_t kExtProfile = 0xBEDE;   // RFC 8285 one-byte header
 constexpr std::size_t kExtBytes = 4 + 12;  // profile + length, then 1 + 8 bytes padded to 12
 constexpr uint8_t kStartCode[4] = {0, 0, 0, 1};
 
+// H.264 7.4.1: no byte-aligned 0x000000, 0x000001 or 0x000002 inside a NAL
+// unit (the encoder's emulation prevention keeps start codes out) and no
+// 0x00 as its last byte. A unit that breaks this would be cut into other
+// units by an Annex B reader (the decoder) than the ones it came in: the
+// frame's keyframe and parameter-set flags would be wrong.
+bool wellFormedNal(std::span<const uint8_t> nal) {
+  if (nal.empty() || nal.back() == 0) return false;
+  for (std::size_t i = 0; i + 2 < nal.size(); ++i)
+    if (nal[i] == 0 && nal[i + 1] == 0 && nal[i + 2] <= 2) return false;
+  return true;
+}
+
 }  // namespace
 
 const char* toString(RtpError e) {
@@ -208,6 +220,11 @@ void H264Depacketizer::noteType(uint8_t type) {
 
 void H264Depacketizer::appendNal(std::span<const uint8_t> nal) {
   if (nal.empty()) return;
+  if (!wellFormedNal(nal)) {
+    ++c_.bad_payload;
+    cur_broken_ = true;
+    return;
+  }
   noteType(nalType(nal[0]));
   cur_.annexb.insert(cur_.annexb.end(), kStartCode, kStartCode + 4);
   cur_.annexb.insert(cur_.annexb.end(), nal.begin(), nal.end());
@@ -287,11 +304,16 @@ std::optional<Frame> H264Depacketizer::push(const RtpPacket& p, uint32_t skipped
         const uint8_t hdr = static_cast<uint8_t>((pl[0] & 0xE0) | nalType(pl[1]));
         noteType(nalType(pl[1]));
         cur_.annexb.insert(cur_.annexb.end(), kStartCode, kStartCode + 4);
+        fu_start_ = cur_.annexb.size();
         cur_.annexb.push_back(hdr);
       } else if (!in_fu_) {
         cur_broken_ = true;  // its start was lost
       }
       if (in_fu_) cur_.annexb.insert(cur_.annexb.end(), pl.begin() + 2, pl.end());
+      if (end && in_fu_ && !wellFormedNal(std::span(cur_.annexb).subspan(fu_start_))) {
+        ++c_.bad_payload;
+        cur_broken_ = true;
+      }
       if (end) in_fu_ = false;
     } else {
       ++c_.bad_payload;  // STAP-B, MTAP, FU-B, reserved: not sent by mode-1 senders

@@ -128,7 +128,7 @@ struct DepacketizerCounters {
   uint64_t frames = 0;
   uint64_t frames_dropped = 0;    // incomplete (a packet lost) or corrupt
   uint64_t lost_packets = 0;      // sequence numbers never seen
-  uint64_t bad_payload = 0;       // unknown NAL type, malformed FU-A/STAP-A
+  uint64_t bad_payload = 0;       // unknown NAL type, malformed FU-A/STAP-A, a start code inside a NAL unit
 };
 
 /// Rebuilds access units from in-order packets (ReorderBuffer output).
@@ -156,6 +156,7 @@ class H264Depacketizer {
   bool cur_sps_ = false, cur_pps_ = false;
   bool cur_broken_ = false;
   bool in_fu_ = false;
+  std::size_t fu_start_ = 0;  // where the FU-A's NAL unit begins in cur_.annexb
   bool need_keyframe_ = true;  // nothing decodable before the first keyframe
 };
 

@@ -218,6 +218,46 @@ TEST(RtpH264, StapAIsUnderstoodOnReceive) {
   EXPECT_EQ(f->annexb, annexB({sps, pps, idr}));
 }
 
+TEST(RtpH264, AStartCodeInsideANalUnitDropsItsFrame) {
+  // H.264 7.4.1 forbids 00 00 00/01/02 inside a NAL unit and a last byte 00:
+  // a decoder would cut such a unit into others than the depacketizer saw (a
+  // P slice carrying "00 00 01 65" would decode as an IDR). Found by fuzz_rtp_h264.
+  auto packet = [](uint16_t seq, std::vector<uint8_t> payload, bool marker) {
+    std::vector<uint8_t> d = {0x80, static_cast<uint8_t>((marker ? 0x80 : 0) | kPayloadType), 0,
+                              static_cast<uint8_t>(seq), 0, 0, 0, 50, 0, 0, 0, 5};
+    d.insert(d.end(), payload.begin(), payload.end());
+    return d;
+  };
+  const std::vector<std::vector<uint8_t>> bad = {
+      {0x41, 0xFF, 0, 0, 1, 0x65, 0x88},  // a start code, then an IDR header
+      {0x41, 7, 0, 0, 0, 9},              // 00 00 00
+      {0x41, 7, 0, 0, 2, 9},              // 00 00 02
+      {0x41, 7, 9, 0},                    // last byte 00
+  };
+  for (const auto& b : bad) {
+    H264Depacketizer dp;
+    RtpPacket p;
+    const auto d = packet(1, b, true);
+    ASSERT_EQ(parseRtp(d, p), RtpError::kNone);
+    EXPECT_FALSE(dp.push(p, 0).has_value());
+    EXPECT_EQ(dp.counters().bad_payload, 1u);
+    EXPECT_EQ(dp.counters().frames_dropped, 1u);
+  }
+  // Emulation prevention (00 00 03) is fine; a start code split across two FU-A fragments is not.
+  H264Depacketizer dp;
+  RtpPacket p;
+  auto d = packet(1, {0x41, 7, 0, 0, 3, 1, 9}, true);
+  ASSERT_EQ(parseRtp(d, p), RtpError::kNone);
+  EXPECT_TRUE(dp.push(p, 0).has_value());
+  const auto a = packet(2, {0x7C, 0x81, 7, 0}, false), b = packet(3, {0x7C, 0x41, 0, 1, 0x65, 9}, true);
+  ASSERT_EQ(parseRtp(a, p), RtpError::kNone);
+  EXPECT_FALSE(dp.push(p, 0).has_value());
+  ASSERT_EQ(parseRtp(b, p), RtpError::kNone);
+  EXPECT_FALSE(dp.push(p, 0).has_value());
+  EXPECT_EQ(dp.counters().bad_payload, 1u);
+  EXPECT_EQ(dp.counters().frames, 1u);
+}
+
 TEST(RtpH264, BadHeadersAreNamed) {
   RtpPacket p;
   EXPECT_EQ(parseRtp(std::vector<uint8_t>(5, 0x80), p), RtpError::kTooShort);
