@@ -58,6 +58,7 @@
 #include "shared/video/video_sender.hpp"
 
 #include "experiments/bench/video_bench.hpp"
+#include "tests/support/udp_relay.hpp"
 
 namespace inspect::bench_video {
 namespace {
@@ -65,6 +66,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: bench_video [--seconds N] [--sizes WxH,...] [--fps F] [--bitrate-kbps K]\n"
     "                   [--warmup S] [--gst-threads LIST] [--json FILE]\n"
+    "       bench_video --loss [--loss-pcts LIST] [--delays-ms LIST] [--no-burst] [--seed N] [same options]\n"
     "Glass-to-glass latency (capture -> decoded picture, read from the time code in the\n"
     "picture) and CPU of (a) this system's VideoSender/VideoReceiver in two processes,\n"
     "(b) the same frames through GStreamer x264enc/rtph264pay/udpsink -> udpsrc/rtph264depay/\n"
@@ -75,7 +77,10 @@ constexpr const char* kUsage =
     "--fps 30, --bitrate-kbps 2000, --gst-threads default (avdec_h264 variants, e.g. default,1:\n"
     "'default' is the plain pipeline, a number N adds max-threads=N).\n"
     "Exit status: 0, 1 when a case failed (the others still run), 2 on bad arguments.\n"
-    "Internal: --role sender|receiver [--port P] [--max-seconds S]: the two processes of (a).\n";
+    "--loss: the loss sweep instead (docs/video.md): (a) and (a0) (repair off, keyframe requests only)\n"
+    "through a seeded UDP relay, both ways, at each --loss-pcts (default 0,1,5,10,20) and a burst case\n"
+    "(--no-burst: without), at each --delays-ms one way (default 10,50); --seed N; first size only.\n"
+    "Internal: --role sender|receiver [--port P] [--max-seconds S] [--nack 0|1]: the two processes of (a).\n";
 
 // ---------------------------------------------------------------- (a) this system
 
@@ -98,7 +103,7 @@ void printLine(const Json& j) {
 /// --role receiver: VideoReceiver on a free port of 127.0.0.1; prints {"port"},
 /// records every decoded picture until stdin closes, then prints the records.
 int receiverRole(const Options& o) {
-  VideoReceiver rx(ReceiverSettings{.bind = "127.0.0.1", .port = 0});
+  VideoReceiver rx(ReceiverSettings{.bind = "127.0.0.1", .port = 0, .nack = o.nack});
   std::mutex mu;
   std::vector<FrameRecord> recs;
   rx.setStream("bench", kSsrc, boost::asio::ip::address(), 0);
@@ -123,7 +128,10 @@ int receiverRole(const Options& o) {
   if (const auto st = rx.stats("bench"))
     stats = Json{{"decoded", st->decoded}, {"frames", st->frames}, {"frames_dropped", st->frames_dropped},
                  {"frames_skipped", st->frames_skipped}, {"lost_packets", st->lost_packets},
-                 {"decode_errors", st->decode_errors}, {"late", st->late}, {"packets", st->packets}};
+                 {"decode_errors", st->decode_errors}, {"late", st->late}, {"packets", st->packets},
+                 {"keyframe_requests", st->keyframe_requests}, {"nacks_sent", st->nacks_sent},
+                 {"nacked_packets", st->nacked_packets}, {"retransmissions", st->retransmissions},
+                 {"rtx_unneeded", st->rtx_unneeded}, {"tail_probes", st->tail_probes}, {"plis_sent", st->plis_sent}, {"rtt_ms", st->rtt_ms}};
   printLine(Json{{"frames", frames}, {"stats", stats}});
   return 0;
 }
@@ -147,7 +155,9 @@ int senderRole(const Options& o) {
   tx.stop();
   printLine(Json{{"encoder", st.encoder}, {"captured", st.captured}, {"encoded", st.encoded}, {"dropped", st.dropped},
                  {"keyframes", st.keyframes}, {"packets", st.packets}, {"bytes", st.bytes},
-                 {"send_errors", st.send_errors}, {"encode_ms", st.encode_ms}, {"error", st.error}});
+                 {"send_errors", st.send_errors}, {"encode_ms", st.encode_ms}, {"nacked_packets", st.nacked_packets},
+                 {"retransmitted", st.retransmitted}, {"not_in_history", st.not_in_history},
+                 {"repeat_nacks", st.repeat_nacks}, {"plis", st.plis}, {"error", st.error}});
   return 0;
 }
 
@@ -157,11 +167,16 @@ std::vector<std::string> roleArgs(const std::string& self, const std::string& ro
           std::to_string(o.bitrate_kbps), "--max-seconds", std::to_string(o.warmup + o.seconds + 60)};
 }
 
-CaseResult runThisSystem(const Options& o, cv::Size sz, const std::string& self) {
+}  // namespace
+
+CaseResult runThisSystem(const Options& o, cv::Size sz, const std::string& self, const RelayCase* relay,
+                         PairRun* run) {
   CaseResult r{"this_system", "(a)", "(a) this system"};
   Child rx, tx;
   std::string rx_pending, tx_pending, line;
-  if (auto e = rx.start(roleArgs(self, "receiver", o, sz), true, true); !e.empty()) return failed(r, e);
+  auto rx_args = roleArgs(self, "receiver", o, sz);
+  if (relay) rx_args.insert(rx_args.end(), {"--nack", relay->nack ? "1" : "0"});
+  if (auto e = rx.start(rx_args, true, true); !e.empty()) return failed(r, e);
   if (!readLine(rx.out(), rx_pending, line, Clock::now() + toDuration(kStartTimeoutS)))
     return failed(r, "receiver did not start: " + rx.errorText());
   uint16_t port = 0;
@@ -170,10 +185,30 @@ CaseResult runThisSystem(const Options& o, cv::Size sz, const std::string& self)
   } catch (const nlohmann::json::exception& e) {
     return failed(r, "receiver said '" + line + "': " + e.what());
   }
+  // The lossy link: a seeded UdpRelay in this process, both ways.
+  std::optional<test::UdpRelay> link;
+  if (relay) {
+    test::UdpRelayParams lp;
+    lp.drop = relay->drop;
+    lp.delay_ms = relay->delay_ms;
+    lp.burst_every_ms = relay->burst_every_ms;
+    lp.burst_ms = relay->burst_ms;
+    lp.burst_drop = relay->burst_drop;
+    lp.seed = relay->seed;
+    try {
+      link.emplace(port, lp);
+    } catch (const std::exception& e) {
+      return failed(r, e.what());
+    }
+    port = link->port();
+  }
   auto args = roleArgs(self, "sender", o, sz);
   args.insert(args.end(), {"--port", std::to_string(port)});
   if (auto e = tx.start(args, true, true); !e.empty()) return failed(r, e);
-  const Window w = measureWindow(o, {&rx, &tx}, {tx.cpu(), rx.cpu()});
+  // The relay's forwarded bytes ride on the probes (the window's rate of a probe x 100).
+  std::vector<std::function<double()>> probes{tx.cpu(), rx.cpu()};
+  if (link) probes.push_back([&link] { return static_cast<double>(link->counters().bytes_sent.load()); });
+  const Window w = measureWindow(o, {&rx, &tx}, probes);
   if (!w.error.empty()) return failed(r, w.error);
   tx.closeIn();
   if (!readLine(tx.out(), tx_pending, line, Clock::now() + toDuration(kStartTimeoutS)))
@@ -195,6 +230,14 @@ CaseResult runThisSystem(const Options& o, cv::Size sz, const std::string& self)
   }
   tx.stop(2);
   rx.stop(2);
+  if (run) {
+    run->recs = recs;
+    run->t0_us = w.t0_us;
+    run->t1_us = w.t1_us;
+    if (link) run->wire_kbps = w.cpu_pct.at(2) / 100.0 * 8.0 / 1000.0;
+    run->receiver = receiver["stats"];
+    run->sender = sender;
+  }
   r.lat = summarize(recs, w.t0_us, w.t1_us);
   const Latency ext = summarize(recs, w.t0_us, w.t1_us, true);
   r.cpu_send = w.cpu_pct[0];
@@ -214,6 +257,8 @@ CaseResult runThisSystem(const Options& o, cv::Size sz, const std::string& self)
   r.detail = Json{{"rtp_extension_latency", toJson(ext)}, {"sender", sender}, {"receiver", receiver["stats"]}};
   return r;
 }
+
+namespace {
 
 // ---------------------------------------------------------------- report
 
@@ -312,6 +357,19 @@ std::vector<int> parseThreads(cli::ArgReader& a) {
   return out;
 }
 
+/// A comma-separated list of numbers in [lo, hi].
+std::vector<double> parseNumbers(cli::ArgReader& a, double lo, double hi) {
+  std::vector<double> out;
+  for (const auto& t : a.list()) {
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (t.empty() || *end || !std::isfinite(v) || v < lo || v > hi)
+      a.fail("'" + t + "' is not a number in [" + cell(lo, "%g") + ", " + cell(hi, "%g") + "]");
+    out.push_back(v);
+  }
+  return out;
+}
+
 void parseArgs(int argc, char** argv, Options& o) {
   cli::readOrExit("bench_video", argc, argv, [&](cli::ArgReader& a) {
     if (a.isHelp()) {
@@ -327,8 +385,28 @@ void parseArgs(int argc, char** argv, Options& o) {
     else if (a.is("--gst-threads")) o.gst_threads = parseThreads(a);
     else if (a.is("--json")) o.json_path = a.path();
     else if (a.is("--role")) o.role = a.choice({"sender", "receiver"});
+    else if (a.is("--nack")) o.nack = a.integer(0, 1) == 1;
+    else if (a.is("--loss")) o.loss = true;
+    else if (a.is("--loss-pcts")) o.loss_pcts = parseNumbers(a, 0, 100);
+    else if (a.is("--delays-ms")) o.delays_ms = parseNumbers(a, 0, 1000);
+    else if (a.is("--no-burst")) o.burst = false;
+    else if (a.is("--seed")) o.seed = static_cast<uint32_t>(a.unsignedInteger(UINT32_MAX));
     else a.unknown();
   });
+}
+
+/// Writes `out` to --json when asked; the exit status.
+int finish(const Options& o, const Json& out, bool ok) {
+  std::fflush(stdout);
+  if (!o.json_path.empty()) {
+    std::ofstream f(o.json_path);
+    f << out.dump(2) << "\n";
+    if (!f) {
+      std::fprintf(stderr, "bench_video: cannot write %s\n", o.json_path.c_str());
+      return 1;
+    }
+  }
+  return ok ? 0 : 1;
 }
 
 }  // namespace
@@ -348,6 +426,11 @@ int main(int argc, char** argv) {
 
   signal(SIGPIPE, SIG_IGN);  // a pipeline that died shows as a write error
   const std::string self = selfPath(), gst = findOnPath("gst-launch-1.0");
+  if (o.loss) {
+    Json out;
+    const bool ok = runLossSweep(o, self, out);
+    return finish(o, out, ok);
+  }
   Json out{{"fps", o.fps},
            {"bitrate_kbps", o.bitrate_kbps},
            {"gop", gop(o)},
@@ -384,13 +467,5 @@ int main(int argc, char** argv) {
               "the machine meanwhile (other users: figures taken while it is high are skewed). Latency = time the\n"
               "decoded picture was in hand - capture time read from its time code.\n");
   std::fflush(stdout);
-  if (!o.json_path.empty()) {
-    std::ofstream f(o.json_path);
-    f << out.dump(2) << "\n";
-    if (!f) {
-      std::fprintf(stderr, "bench_video: cannot write %s\n", o.json_path.c_str());
-      return 1;
-    }
-  }
-  return ok ? 0 : 1;
+  return finish(o, out, ok);
 }

@@ -58,7 +58,14 @@ struct Options {
   int bitrate_kbps = 2000;
   std::vector<int> gst_threads{-1};  // avdec_h264 max-threads variants, -1 = its default
   std::string json_path;
+  // --loss: the loss sweep (video_loss.cpp) instead of the latency comparison
+  bool loss = false;
+  std::vector<double> loss_pcts{0, 1, 5, 10, 20};  // random loss both ways, %
+  bool burst = true;                               // and the burst case (kBurst*)
+  std::vector<double> delays_ms{10, 50};           // one-way delay
+  uint32_t seed = 1;
   // --role
+  bool nack = true;  // receiver: NACK + RTX repair (off: keyframe requests only)
   std::string role;
   uint16_t port = 0;
   double max_seconds = 120;  // a role process ends by itself after this
@@ -317,6 +324,28 @@ Window measureWindow(const Options& o, const std::vector<Child*>& kids,
 std::string gstSender(const Options& o, cv::Size sz, const std::string& port);
 std::string gstReceiver(const std::string& port, int threads);
 std::string gstPassThrough(cv::Size sz);
+
+/// (a) this system in two processes; through `relay` (a UdpRelay's
+/// parameters) when given, with the receiver's NACK repair `nack`. Its
+/// pictures (time code read) in `recs` when not null, the relay's forwarded
+/// bytes over the window in `wire_kbps`.
+struct RelayCase {
+  double drop = 0, delay_ms = 0;
+  double burst_every_ms = 0, burst_ms = 0, burst_drop = 0;
+  uint32_t seed = 1;
+  bool nack = true;
+};
+struct PairRun {
+  std::vector<FrameRecord> recs;
+  uint64_t t0_us = 0, t1_us = 0;  // the measured window
+  double wire_kbps = NAN;
+  Json receiver = Json::object(), sender = Json::object();
+};
+CaseResult runThisSystem(const Options& o, cv::Size sz, const std::string& self, const RelayCase* relay = nullptr,
+                         PairRun* run = nullptr);
+
+/// --loss: the sweep over loss and delay; prints its tables, fills `out`; false when a case failed.
+bool runLossSweep(const Options& o, const std::string& self, Json& out);
 
 /// (b) the frames through GStreamer (gst-launch-1.0 at `gst`), avdec_h264
 /// with `threads` (-1: its default).

@@ -104,6 +104,8 @@ class ReorderBuffer {
   uint64_t duplicates() const { return duplicates_; }
   uint64_t late() const { return late_; }
   std::size_t held() const { return held_.size(); }
+  /// The next sequence number to release (meaningful once a packet came).
+  uint16_t next() const { return next_; }
 
  private:
   std::size_t window_;

@@ -81,20 +81,36 @@ void RetransmissionHistory::remember(uint16_t seq, std::span<const uint8_t> data
   expire(sent_us);
 }
 
-const std::vector<uint8_t>* RetransmissionHistory::find(uint16_t seq, uint64_t now_us) const {
+RetransmissionHistory::Sent* RetransmissionHistory::locate(uint16_t seq, uint64_t now_us) {
   // Sequence numbers are consecutive in sending order: index by distance
   // from the newest, then check (a wrap or a gap falls back to a scan).
   if (packets_.empty()) return nullptr;
   const auto back = static_cast<uint16_t>(packets_.back().seq - seq);
-  const Sent* hit = nullptr;
+  Sent* hit = nullptr;
   if (back < packets_.size() && packets_[packets_.size() - 1 - back].seq == seq) {
     hit = &packets_[packets_.size() - 1 - back];
   } else {
-    for (const auto& s : packets_)
+    for (auto& s : packets_)
       if (s.seq == seq) hit = &s;
   }
   if (!hit || now_us > hit->sent_us + max_age_us_) return nullptr;
-  return &hit->datagram;
+  return hit;
+}
+
+const std::vector<uint8_t>* RetransmissionHistory::find(uint16_t seq, uint64_t now_us) const {
+  const Sent* hit = const_cast<RetransmissionHistory*>(this)->locate(seq, now_us);
+  return hit ? &hit->datagram : nullptr;
+}
+
+RetransmissionHistory::Plan RetransmissionHistory::planRetransmission(uint16_t seq, uint64_t now_us,
+                                                                      uint64_t repeat_us) {
+  Sent* hit = locate(seq, now_us);
+  if (!hit) return {};
+  if (hit->rtx_count > 0 && now_us < hit->rtx_us + repeat_us) return {&hit->datagram, 0};
+  const int copies = hit->rtx_count > 0 ? 2 : 1;
+  ++hit->rtx_count;
+  hit->rtx_us = now_us;
+  return {&hit->datagram, copies};
 }
 
 void NackList::onPacket(uint16_t seq, uint64_t now_us) {
@@ -104,8 +120,7 @@ void NackList::onPacket(uint16_t seq, uint64_t now_us) {
     return;
   }
   const auto ahead = static_cast<uint16_t>(seq - highest_);
-  if (ahead == 0) return;  // a duplicate of the highest
-  if (ahead < 0x8000) {
+  if (ahead != 0 && ahead < 0x8000) {
     // Newer: everything between was skipped. A jump larger than the list's
     // bound keeps only the newest of the gap.
     const uint16_t gap = static_cast<uint16_t>(ahead - 1);
@@ -120,12 +135,32 @@ void NackList::onPacket(uint16_t seq, uint64_t now_us) {
     highest_ = seq;
     return;
   }
-  // Older: a reordered or retransmitted packet fills its hole.
+  // Older (or the highest: a duplicate, or a tail probe's packet): a
+  // reordered or retransmitted packet fills its hole.
   const auto it = std::find_if(missing_.begin(), missing_.end(), [seq](const Missing& m) { return m.seq == seq; });
   if (it != missing_.end()) {
     if (it->tries > 0) ++recovered_;
     missing_.erase(it);
   }
+}
+
+std::size_t NackList::expireBefore(uint16_t next) {
+  const std::size_t n =
+      std::erase_if(missing_, [next](const Missing& m) { return static_cast<uint16_t>(m.seq - next) >= 0x8000; });
+  given_up_ += n;
+  return n;
+}
+
+bool NackList::probeTail(uint64_t now_us) {
+  if (!started_) return false;
+  highest_ = static_cast<uint16_t>(highest_ + 1);
+  missing_.push_back({highest_, now_us});
+  ++probes_;
+  while (missing_.size() > s_.max_missing) {
+    missing_.pop_front();
+    ++given_up_;
+  }
+  return true;
 }
 
 uint64_t NackList::retryInterval(uint64_t rtt_us) const {

@@ -45,6 +45,16 @@ class RetransmissionHistory {
   void remember(uint16_t seq, std::span<const uint8_t> datagram, uint64_t sent_us);
   /// The datagram sent as `seq`, if still held at `now_us`.
   const std::vector<uint8_t>* find(uint16_t seq, uint64_t now_us) const;
+  /// What to send for a NACK of `seq` at `now_us`: the datagram (null when no
+  /// longer held) and how many RTX copies. None for a repeat within
+  /// `repeat_us` of its last retransmission (the receiver sends each NACK
+  /// twice: the second copy is for when the first is lost); two when it was
+  /// retransmitted before (a retry: that retransmission was lost); else one.
+  struct Plan {
+    const std::vector<uint8_t>* datagram = nullptr;
+    int copies = 0;
+  };
+  Plan planRetransmission(uint16_t seq, uint64_t now_us, uint64_t repeat_us);
   std::size_t size() const { return packets_.size(); }
   std::size_t bytes() const { return bytes_; }
 
@@ -53,7 +63,10 @@ class RetransmissionHistory {
     uint16_t seq;
     uint64_t sent_us;
     std::vector<uint8_t> datagram;
+    uint64_t rtx_us = 0;  // last retransmission
+    uint32_t rtx_count = 0;
   };
+  Sent* locate(uint16_t seq, uint64_t now_us);
   void expire(uint64_t now_us);
   std::size_t capacity_;
   uint64_t max_age_us_;
@@ -64,9 +77,9 @@ class RetransmissionHistory {
 /// Settings of the receiver's NACK list.
 struct NackSettings {
   uint64_t reorder_wait_us = 5000;   // a gap this young may still be reordering: wait before the first NACK
-  double retry_rtts = 1.5;           // NACK again after this many RTTs without the packet
+  double retry_rtts = 1.25;          // NACK again after this many RTTs without the packet
   uint64_t min_retry_us = 10000;     // ...but not sooner than this
-  int max_tries = 3;                 // NACKs per packet before giving up
+  int max_tries = 4;                 // NACKs per packet before giving up
   std::size_t max_missing = 512;     // the list's bound (the oldest go first)
 };
 
@@ -87,8 +100,20 @@ class NackList {
   /// first missed before `deadline_us`, and those past max_tries whose last
   /// NACK had a retry interval to come back. Returns them.
   std::vector<uint16_t> expire(uint64_t deadline_us, uint64_t now_us, uint64_t rtt_us);
+  /// Gives up on the packets before `next` (in 16-bit order): those the
+  /// reorder buffer has released without. Returns how many.
+  std::size_t expireBefore(uint16_t next);
+  /// The newest packet had no marker and nothing came after it for a while:
+  /// the rest of its frame may be lost, and no later packet shows that until
+  /// the next frame. Counts the next sequence number as missing (NACKed like
+  /// the others; a sender that has not sent it yet has nothing to resend).
+  bool probeTail(uint64_t now_us);
+  uint64_t tailProbes() const { return probes_; }
+  /// The highest sequence number seen (or probed).
+  uint16_t highest() const { return highest_; }
   bool missing(uint16_t seq) const;
   std::size_t size() const { return missing_.size(); }
+  const NackSettings& settings() const { return s_; }
   uint64_t nacked() const { return nacked_; }
   uint64_t recovered() const { return recovered_; }
   uint64_t givenUp() const { return given_up_; }
@@ -102,6 +127,7 @@ class NackList {
   };
   uint64_t retryInterval(uint64_t rtt_us) const;
   NackSettings s_;
+  uint64_t probes_ = 0;
   bool started_ = false;
   uint16_t highest_ = 0;
   std::deque<Missing> missing_;  // in sequence order

@@ -23,6 +23,10 @@ constexpr int kTicksPerWindow = 10;            // rates over 1 s
 constexpr std::size_t kLatencyHistory = 300;
 constexpr uint32_t kReceiverSsrc = 0x5E55AE01;  // the server's RTCP SSRC (it sends no media)
 constexpr std::size_t kNackWindow = 1024;        // packets a gap may hold behind it while waiting for RTX
+constexpr auto kRepairTick = std::chrono::milliseconds(3);  // NACK retries and give-ups while a gap waits
+// A frame's packets leave the robot back to back: a frame without its marker
+// packet this long after its newest packet has probably lost its tail (NackList::probeTail).
+constexpr uint64_t kTailWaitUs = 4000;
 
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return -1;
@@ -61,9 +65,12 @@ struct VideoReceiver::Stream {
   rtcp::ReceiverStats rstats;
   NackList nacks;
   asio::ip::udp::endpoint feedback_to;  // where this stream's RTP comes from; unset = nothing yet
-  std::map<uint16_t, uint64_t> nacked_at_us;  // first NACK time per sequence number, for the RTT
+  std::map<uint16_t, uint64_t> nacked_at_us;  // NACK time per sequence number, for the RTT; 0 = NACKed again (no sample)
   double rtt_us = 20000;                      // assumed until measured
   bool rtt_measured = false;
+  // The newest packet had no marker (its frame is still open) since newest_us; probed once.
+  bool tail_open = false, tail_probed = false;
+  uint64_t newest_us = 0;
 
   static NackSettings nackSettings() {
     NackSettings n;
@@ -73,7 +80,8 @@ struct VideoReceiver::Stream {
 };
 
 VideoReceiver::VideoReceiver(ReceiverSettings s)
-    : settings_(std::move(s)), socket_(io_), tick_timer_(io_), rx_buf_(kMaxDatagram) {
+    : settings_(std::move(s)), socket_(io_), tick_timer_(io_), repair_timer_(io_), rx_buf_(kMaxDatagram) {
+  settings_.nack = settings_.nack && settings_.rtcp;  // NACKs are RTCP
   boost::system::error_code ec;
   const auto addr = asio::ip::make_address(settings_.bind, ec);
   if (ec) throw VideoError("video receiver: bad bind address '" + settings_.bind + "'");
@@ -264,7 +272,8 @@ void VideoReceiver::onRtx(std::span<const uint8_t> data) {
       ++s->st.rtx_unneeded;
       return;
     }
-    if (auto it = s->nacked_at_us.find(seq); it != s->nacked_at_us.end()) {
+    // Karn: a packet NACKed more than once gives no sample (which NACK did it answer?).
+    if (auto it = s->nacked_at_us.find(seq); it != s->nacked_at_us.end() && it->second != 0) {
       const double sample = static_cast<double>(monoNowUs() - it->second);
       s->rtt_us = s->rtt_measured ? 0.875 * s->rtt_us + 0.125 * sample : sample;  // RFC 6298-style smoothing
       s->rtt_measured = true;
@@ -294,25 +303,43 @@ void VideoReceiver::sendNacks(Stream& s) {
   if (due.empty()) return;
   std::vector<uint8_t> d;
   rtcp::appendNack(d, kReceiverSsrc, s.ssrc, due);
+  // Twice: a lost NACK costs a whole retry interval, and both copies are lost
+  // only with the loss rate squared. The robot answers the second copy only
+  // when the first was lost (VideoSender ignores a repeat within a few ms).
+  sendFeedback(s, d);
   sendFeedback(s, d);
   ++s.st.nacks_sent;
   s.st.nacked_packets += due.size();
-  for (uint16_t q : due) s.nacked_at_us.try_emplace(q, now_us);
+  for (uint16_t q : due)
+    if (auto [it, fresh] = s.nacked_at_us.try_emplace(q, now_us); !fresh) it->second = 0;
   while (s.nacked_at_us.size() > kNackWindow) s.nacked_at_us.erase(s.nacked_at_us.begin());
 }
 
 Clock::duration VideoReceiver::gapWait(const Stream& s) const {
   const double base = settings_.reorder_timeout_s;
   if (!settings_.nack) return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(base));
-  // Time for a NACK and its retransmission, twice (one lost either way), plus scheduling slack.
-  const double w = std::clamp(2.0 * s.rtt_us / 1e6 + 0.015, base, std::max(base, settings_.max_wait_s));
+  // Time for every try: the first NACK's round trip, then a retry interval
+  // per further try (NackList), plus scheduling slack; at most max_wait_s.
+  const NackSettings& n = s.nacks.settings();
+  const double rtt_s = s.rtt_us / 1e6;
+  const double retry_s = std::max(n.min_retry_us / 1e6, n.retry_rtts * rtt_s);
+  const double w = std::clamp(n.reorder_wait_us / 1e6 + rtt_s + retry_s * (n.max_tries - 1) + 0.010, base,
+                              std::max(base, settings_.max_wait_s));
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(w));
 }
 
 void VideoReceiver::handlePacket(Stream& s, const std::string& name, uint16_t seq, std::vector<uint8_t> datagram,
                                  bool retransmitted) {
   const auto now = Clock::now();
-  if (settings_.nack) s.nacks.onPacket(seq, monoNowUs());
+  if (settings_.nack) {
+    const uint64_t now_us = monoNowUs();
+    s.nacks.onPacket(seq, now_us);
+    if (s.nacks.highest() == seq && datagram.size() > 1) {
+      s.tail_open = !(datagram[1] & 0x80);  // the marker bit
+      s.tail_probed = false;
+      s.newest_us = now_us;
+    }
+  }
   if (retransmitted) s.nacked_at_us.erase(seq);
   s.last_packet = now;
   ++s.st.packets;
@@ -335,9 +362,10 @@ void VideoReceiver::handlePacket(Stream& s, const std::string& name, uint16_t se
     s.gap_since = {};
   }
   // What is no longer held behind a gap is given up (nothing more to NACK).
-  if (s.reorder.held() == 0 && s.nacks.size() > 0) (void)s.nacks.expire(~0ull, 0, 0);
+  if (s.nacks.size() > 0) (void)s.nacks.expireBefore(s.reorder.next());
   sendNacks(s);
   depacketizeReady(s, name);
+  armRepair();
   maybeRequestKeyframe(s, name);
 }
 
@@ -359,7 +387,7 @@ void VideoReceiver::maybeRequestKeyframe(Stream& s, const std::string& name) {
   s.last_request = now;
   ++s.st.keyframe_requests;
   if (keyframe_request_) keyframe_request_(name);
-  if (settings_.nack) {  // and over RTCP, which reaches the robot without the TCP link's queue
+  if (settings_.rtcp) {  // and over RTCP, which reaches the robot without the TCP link's queue
     std::vector<uint8_t> d;
     rtcp::appendPli(d, kReceiverSsrc, s.ssrc);
     sendFeedback(s, d);
@@ -418,20 +446,56 @@ void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) 
   if (frame_hook_) frame_hook_(name, bgr, capture_server_us);
 }
 
+void VideoReceiver::releaseStaleGap(Stream& s, const std::string& name, Clock::time_point now) {
+  // A gap nobody will fill (lost for good, or the stream paused): release what is held.
+  if (s.reorder.held() > 0 && s.gap_since != Clock::time_point{} && now - s.gap_since >= gapWait(s)) {
+    s.ready.clear();
+    s.reorder.flush(s.ready);
+    s.gap_since = {};
+    (void)s.nacks.expireBefore(s.reorder.next());
+    depacketizeReady(s, name);
+    maybeRequestKeyframe(s, name);
+  }
+}
+
+void VideoReceiver::armRepair() {
+  if (repair_armed_) return;
+  const bool nack = settings_.nack;
+  const bool waiting = std::any_of(streams_.begin(), streams_.end(), [nack](const auto& e) {
+    const Stream& s = *e.second;
+    return s.reorder.held() > 0 || s.nacks.size() > 0 || (nack && s.tail_open && !s.tail_probed);
+  });
+  if (!waiting) return;
+  repair_armed_ = true;
+  repair_timer_.expires_after(kRepairTick);
+  repair_timer_.async_wait([this](const boost::system::error_code& ec) {
+    repair_armed_ = false;
+    if (!ec) repairTick();
+  });
+}
+
+void VideoReceiver::repairTick() {
+  const auto now = Clock::now();
+  const uint64_t now_us = monoNowUs();
+  for (auto& [name, sp] : streams_) {
+    Stream& s = *sp;
+    releaseStaleGap(s, name, now);
+    if (!settings_.nack) continue;
+    if (s.tail_open && !s.tail_probed && now_us >= s.newest_us + kTailWaitUs) {
+      s.tail_probed = true;
+      if (s.nacks.probeTail(now_us)) ++s.st.tail_probes;
+    }
+    sendNacks(s);
+  }
+  armRepair();
+}
+
 void VideoReceiver::tick() {
   const auto now = Clock::now();
   const bool window_end = ++tick_count_ % kTicksPerWindow == 0;
   for (auto& [name, sp] : streams_) {
     Stream& s = *sp;
-    // A gap nobody will fill (the stream paused): release what is held.
-    if (s.reorder.held() > 0 && s.gap_since != Clock::time_point{} && now - s.gap_since >= gapWait(s)) {
-      s.ready.clear();
-      s.reorder.flush(s.ready);
-      s.gap_since = {};
-      (void)s.nacks.expire(~0ull, 0, 0);
-      depacketizeReady(s, name);
-      maybeRequestKeyframe(s, name);
-    }
+    releaseStaleGap(s, name, now);
     if (settings_.nack) sendNacks(s);  // retries while no packet arrives
     const auto& dc = s.depack.counters();
     s.w_lost += dc.lost_packets - s.st.lost_packets;
@@ -442,7 +506,7 @@ void VideoReceiver::tick() {
     s.st.duplicates = s.reorder.duplicates();
     s.st.late = s.reorder.late();
     s.st.active = s.last_packet != Clock::time_point{} && now - s.last_packet < std::chrono::seconds(2);
-    if (window_end && settings_.nack && s.rstats.started()) {
+    if (window_end && settings_.rtcp && s.rstats.started()) {
       const rtcp::ReportBlock b = s.rstats.report(s.ssrc, monoNowUs());
       std::vector<uint8_t> d;
       rtcp::appendReceiverReport(d, kReceiverSsrc, std::span(&b, 1));

@@ -35,9 +35,11 @@ struct ReceiverSettings {
   double keyframe_min_interval_s = 0.3; // at most one keyframe request per this per stream
   bool decode = true;                   // false: reassemble and count only
   /// RTCP feedback to each stream's sender (rtcp-mux, to the address its
-  /// RTP comes from): NACKs for missing packets (their RTX repairs are taken
-  /// in), a PLI with each keyframe request, a receiver report every second.
-  /// A gap then waits for its retransmission up to about two round trips
+  /// RTP comes from): a PLI with each keyframe request, a receiver report
+  /// every second.
+  bool rtcp = true;
+  /// Repair (with rtcp): NACKs for missing packets, their RTX repairs taken
+  /// in. A gap then waits for its retransmission up to about two round trips
   /// (at least reorder_timeout_s, at most max_wait_s) before it is given up.
   bool nack = true;
   double max_wait_s = 0.25;
@@ -62,11 +64,12 @@ struct StreamStats {
   uint64_t frames_skipped = 0; // intact frames not decoded: they follow a loss and the
                                // keyframe that repairs the picture has not come yet
   uint64_t keyframe_requests = 0;
-  // RTCP feedback (ReceiverSettings::nack):
+  // RTCP feedback (ReceiverSettings::rtcp, nack):
   uint64_t nacks_sent = 0;          // NACK packets
   uint64_t nacked_packets = 0;      // sequence numbers asked for (each try)
   uint64_t retransmissions = 0;     // RTX packets that filled a hole
   uint64_t rtx_unneeded = 0;        // RTX packets for a hole already filled or given up
+  uint64_t tail_probes = 0;         // NACKs of the packet after a frame's newest when its marker was late
   uint64_t plis_sent = 0;
   uint64_t reports_sent = 0;        // receiver reports
   double rtt_ms = -1;               // NACK -> its retransmission, smoothed; < 0 = none yet
@@ -147,11 +150,18 @@ class VideoReceiver {
   void maybeRequestKeyframe(Stream& s, const std::string& name);
   void onFrame(Stream& s, const std::string& name, const Frame& f);
   void tick();
+  // Repair runs on its own short timer while a stream waits for a packet:
+  // NACK retries and give-ups are due within milliseconds, not at the next tick.
+  void armRepair();
+  void repairTick();
+  void releaseStaleGap(Stream& s, const std::string& name, std::chrono::steady_clock::time_point now);
 
   ReceiverSettings settings_;
   boost::asio::io_context io_;
   boost::asio::ip::udp::socket socket_;
   boost::asio::steady_timer tick_timer_;
+  boost::asio::steady_timer repair_timer_;
+  bool repair_armed_ = false;
   boost::asio::ip::udp::endpoint sender_;
   std::vector<uint8_t> rx_buf_;
   uint16_t port_ = 0;

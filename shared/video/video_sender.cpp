@@ -24,6 +24,10 @@ namespace {
 // IPv4 + UDP headers, the RTP header and the capture-time extension on a
 // frame's first packet (docs/video.md).
 constexpr std::size_t kOverhead = 28 + kRtpHeaderSize + 16;
+// A NACK of a packet retransmitted less than this ago is the receiver's
+// second copy of the same NACK (VideoReceiver sends each twice): not answered.
+// Its retries come at least 10 ms apart (NackSettings::min_retry_us).
+constexpr uint64_t kRepeatNackUs = 5000;
 
 EncoderSettings effectiveEncoder(const SenderSettings& s) {
   EncoderSettings e = s.encoder;
@@ -393,24 +397,26 @@ void VideoSender::onFeedback(std::span<const uint8_t> datagram) {
       loss = b.fraction_lost / 2.56;
       if (auto r = rtcp::roundTripSeconds(now_middle, b.lsr, b.dlsr)) rtt_s = r;
     }
-  uint64_t asked = 0, sent = 0, missed = 0, nacks = 0;
+  uint64_t asked = 0, sent = 0, missed = 0, nacks = 0, repeats = 0;
   const uint64_t now_us = monoNowUs();
   for (const auto& n : c.nacks) {
     if (n.media_ssrc != ssrc_) continue;
     ++nacks;
     for (uint16_t seq : n.seqs) {
       ++asked;
-      std::optional<std::vector<uint8_t>> rtx;
+      std::vector<std::vector<uint8_t>> rtx;
+      bool held = false;
       {
         std::lock_guard hl(net_->history_mu);
-        if (const auto* orig = net_->history.find(seq, now_us))
-          rtx = makeRtx(*orig, rtx_ssrc_, kRtxPayloadType, net_->rtx_seq++);
+        const auto plan = net_->history.planRetransmission(seq, now_us, kRepeatNackUs);
+        held = plan.datagram != nullptr;
+        for (int k = 0; k < plan.copies; ++k)
+          if (auto r = makeRtx(*plan.datagram, rtx_ssrc_, kRtxPayloadType, net_->rtx_seq++)) rtx.push_back(std::move(*r));
       }
-      if (!rtx) {
-        ++missed;
-        continue;
-      }
-      if (net_->send(*rtx, nullptr)) ++sent;
+      if (!held) ++missed;
+      else if (rtx.empty()) ++repeats;
+      for (const auto& r : rtx)
+        if (net_->send(r, nullptr)) ++sent;
     }
   }
   uint64_t plis = 0;
@@ -425,6 +431,7 @@ void VideoSender::onFeedback(std::span<const uint8_t> datagram) {
   st_.nacked_packets += asked;
   st_.retransmitted += sent;
   st_.not_in_history += missed;
+  st_.repeat_nacks += repeats;
   st_.plis += plis;
   st_.keyframe_requests += plis;
 }

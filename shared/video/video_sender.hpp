@@ -63,6 +63,7 @@ struct SenderStats {
   uint64_t nacked_packets = 0;       // sequence numbers asked for
   uint64_t retransmitted = 0;        // RTX packets sent
   uint64_t not_in_history = 0;       // asked for but no longer held
+  uint64_t repeat_nacks = 0;         // asked again within a few ms (the receiver's second copy): not resent
   uint64_t plis = 0;                 // picture loss indications received
   uint64_t rtcp_errors = 0;          // datagrams on the socket that were not RTCP we accept
   double peer_loss_pct = -1;         // the receiver's last reported fraction lost; < 0 = no report yet

@@ -9,7 +9,8 @@
 // NACK, PLI; what it parses to is rebuilt by the builders and parses back
 // the same); any other record is one RTP datagram (also wrapped as RFC 4588
 // RTX and unwrapped: the same bytes). tag bit 3 picks the BGR
-// or the luma-only decode for the frames it completes.
+// or the luma-only decode for the frames it completes; RTP records also feed
+// the NACK list and a sender's retransmission history (tag bit 4: a tail probe).
 // Invariants: frames hold Annex B NAL units; a frame re-packetized by the
 // robot's packetizer (small and normal MTU) comes out of a fresh
 // depacketizer with the same NAL units.
@@ -121,6 +122,26 @@ struct Receiver {
   bool damaged = false;
   rtcp::ReceiverStats stats;
   std::vector<std::pair<uint32_t, std::vector<uint8_t>>> ready;
+  // Repair: the receiver's NACK list fed every sequence number (tail probes
+  // on tag bit 4), answered from a sender's history of the same datagrams.
+  NackList nacks;
+  RetransmissionHistory history{64, 1'000'000};
+  uint64_t now_us = 0;
+
+  void repair(uint16_t seq, std::span<const uint8_t> dgram, bool probe) {
+    now_us += 1000;
+    history.remember(seq, dgram, now_us);
+    nacks.onPacket(seq, now_us);
+    if (probe) (void)nacks.probeTail(now_us);
+    for (uint16_t q : nacks.due(now_us, 20000)) {
+      const auto plan = history.planRetransmission(q, now_us, 5000);
+      FUZZ_CHECK(plan.copies >= 0 && plan.copies <= 2 && (plan.datagram != nullptr || plan.copies == 0));
+    }
+    (void)nacks.expire(now_us > 250000 ? now_us - 250000 : 0, now_us, 20000);
+    (void)nacks.expireBefore(reorder.next());
+    FUZZ_CHECK(nacks.size() <= NackSettings{}.max_missing);
+    FUZZ_CHECK(!nacks.missing(static_cast<uint16_t>(reorder.next() - 1)));  // released: nothing left to ask for
+  }
 
   void onFrame(const Frame& f, bool luma) {
     FUZZ_CHECK(f.annexb.size() >= 5);
@@ -203,6 +224,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
       FUZZ_CHECK(rx.stats.report(p.ssrc, 0).fraction_lost <= 255);
       rx.reorder.push(p.seq, std::vector<uint8_t>(r.body.begin(), r.body.end()));
       rx.reorder.pop(rx.ready);
+      rx.repair(p.seq, r.body, r.tag & 0x10);
     }
     FUZZ_CHECK(rx.reorder.held() <= 16);
     rx.depacketizeReady(luma);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <random>
 #include <stdexcept>
@@ -57,6 +58,13 @@ void UdpRelay::run() {
     bool back;
     std::vector<uint8_t> d;
   };
+  const auto started = Clock::now();
+  // The loss probability now: drop, or burst_drop inside a periodic burst.
+  auto lossNow = [&] {
+    if (p_.burst_every_ms <= 0 || p_.burst_ms <= 0) return p_.drop;
+    const double t_ms = std::chrono::duration<double, std::milli>(Clock::now() - started).count();
+    return std::fmod(t_ms, p_.burst_every_ms) < p_.burst_ms ? p_.burst_drop : p_.drop;
+  };
   std::deque<Due> queue;  // in release order (the delay is the same for every datagram)
   auto emit = [&](bool back, const std::vector<uint8_t>& d) {
     if (back) {
@@ -65,6 +73,7 @@ void UdpRelay::run() {
     } else {
       ::sendto(out_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
       ++c_.sent;
+      c_.bytes_sent += d.size();
     }
   };
   auto send = [&](bool back, std::vector<uint8_t> d) {
@@ -102,7 +111,7 @@ void UdpRelay::run() {
       const ssize_t n = ::recv(out_, buf.data(), buf.size(), 0);
       if (n >= 0) {
         ++c_.back_received;
-        if (!have_from || (p_.drop_back && u(back_rng) < p_.drop))
+        if (!have_from || (p_.drop_back && u(back_rng) < lossNow()))
           ++c_.back_dropped;
         else
           send(true, std::vector<uint8_t>(buf.begin(), buf.begin() + n));
@@ -119,7 +128,7 @@ void UdpRelay::run() {
     const uint64_t i = index++;
     std::vector<uint8_t> d(buf.begin(), buf.begin() + n);
     const bool in_burst = p_.burst_len > 0 && i >= p_.burst_from && i < p_.burst_from + p_.burst_len;
-    if (in_burst || u(rng) < p_.drop) {
+    if (in_burst || u(rng) < lossNow()) {
       ++c_.dropped;
       continue;
     }

@@ -28,11 +28,16 @@ struct UdpRelayParams {
   // A burst: every datagram with index in [burst_from, burst_from + burst_len) is lost.
   uint64_t burst_from = 0;
   uint64_t burst_len = 0;
-  bool drop_back = true;    // feedback is lost at `drop` too (bursts are forward only)
+  bool drop_back = true;    // feedback is lost at `drop` too (index bursts are forward only)
+  // Periodic bursts (both ways, with drop_back): for burst_ms of every
+  // burst_every_ms (from the relay's start) a datagram is lost with
+  // probability burst_drop instead of drop.
+  double burst_every_ms = 0, burst_ms = 0, burst_drop = 0;
 };
 
 struct UdpRelayCounters {
   std::atomic<uint64_t> received{0}, sent{0}, dropped{0}, duplicated{0}, reordered{0};
+  std::atomic<uint64_t> bytes_sent{0};  // forwarded to the target (duplicates included)
   std::atomic<uint64_t> back_received{0}, back_sent{0}, back_dropped{0};  // target -> sender
 };
 

@@ -78,7 +78,7 @@ TEST(RetransmissionHistory, BoundedInCountAndAgeAcrossTheWrap) {
   EXPECT_EQ(none.find(1, 0), nullptr);
 }
 
-TEST(NackList, NacksAGapAfterTheReorderWaitThenRetriesEveryOneAndAHalfRtt) {
+TEST(NackList, NacksAGapAfterTheReorderWaitThenRetriesEveryRttAndAQuarter) {
   NackList n;
   n.onPacket(100, 0);
   n.onPacket(101, 1000);
@@ -89,14 +89,67 @@ TEST(NackList, NacksAGapAfterTheReorderWaitThenRetriesEveryOneAndAHalfRtt) {
   n.onPacket(103, 4000);  // was only reordered
   EXPECT_FALSE(n.missing(103));
   EXPECT_EQ(n.due(7000, 20000), std::vector<uint16_t>{102});
-  EXPECT_TRUE(n.due(20000, 20000).empty()) << "retry after 1.5 RTT = 30 ms";
-  EXPECT_EQ(n.due(37000, 20000), std::vector<uint16_t>{102});
-  EXPECT_EQ(n.due(67000, 20000), std::vector<uint16_t>{102});
-  EXPECT_TRUE(n.due(200000, 20000).empty()) << "three tries at most";
-  EXPECT_EQ(n.nacked(), 3u);
-  EXPECT_EQ(n.expire(0, 97000, 20000), std::vector<uint16_t>{102}) << "its last try had its 30 ms";
+  EXPECT_TRUE(n.due(31000, 20000).empty()) << "retry after 1.25 RTT = 25 ms";
+  EXPECT_EQ(n.due(32000, 20000), std::vector<uint16_t>{102});
+  EXPECT_EQ(n.due(57000, 20000), std::vector<uint16_t>{102});
+  EXPECT_EQ(n.due(82000, 20000), std::vector<uint16_t>{102});
+  EXPECT_TRUE(n.due(200000, 20000).empty()) << "four tries at most";
+  EXPECT_EQ(n.nacked(), 4u);
+  EXPECT_TRUE(n.expire(0, 106000, 20000).empty()) << "its last try still has time";
+  EXPECT_EQ(n.expire(0, 107000, 20000), std::vector<uint16_t>{102}) << "its last try had its 25 ms";
   EXPECT_EQ(n.givenUp(), 1u);
   EXPECT_EQ(n.size(), 0u);
+}
+
+TEST(NackList, ATailProbeAsksForThePacketAfterTheNewestAndIsFilledByIt) {
+  // A frame's marker packet lost: nothing after it shows the loss until the
+  // next frame, so the receiver probes for the next sequence number.
+  NackList n;
+  EXPECT_FALSE(n.probeTail(0)) << "nothing seen yet";
+  n.onPacket(10, 0);
+  n.onPacket(11, 100);
+  EXPECT_TRUE(n.probeTail(4100));
+  EXPECT_TRUE(n.missing(12));
+  EXPECT_EQ(n.highest(), 12);
+  EXPECT_EQ(n.due(9100, 20000), std::vector<uint16_t>{12}) << "after the reorder wait, like any gap";
+  n.onPacket(12, 25000);  // its retransmission (or the late original)
+  EXPECT_FALSE(n.missing(12));
+  EXPECT_EQ(n.recovered(), 1u);
+  EXPECT_TRUE(n.probeTail(30000));  // 13 probed; the next frame's 13, 14 arrive
+  n.onPacket(14, 33000);
+  EXPECT_TRUE(n.missing(13)) << "still missing: 14 came, 13 did not";
+  n.onPacket(13, 34000);
+  EXPECT_EQ(n.size(), 0u);
+  EXPECT_EQ(n.tailProbes(), 2u);
+}
+
+TEST(NackList, ExpireBeforeGivesUpOnlyWhatTheReorderBufferReleasedWithout) {
+  NackList n;
+  n.onPacket(65533, 0);
+  n.onPacket(3, 0);  // 65534..2 missing
+  ASSERT_TRUE(n.probeTail(5000));  // 4
+  EXPECT_EQ(n.size(), 6u);
+  EXPECT_EQ(n.expireBefore(1), 3u) << "65534, 65535, 0: before 1 across the wrap";
+  EXPECT_TRUE(n.missing(1));
+  EXPECT_TRUE(n.missing(4)) << "a probe past the released ones stays";
+  EXPECT_EQ(n.expireBefore(4), 2u);
+  EXPECT_EQ(n.size(), 1u);
+  EXPECT_EQ(n.givenUp(), 5u);
+}
+
+TEST(RetransmissionHistory, ARepeatedNackWithinTheWindowIsNotResentARetryGoesTwice) {
+  RetransmissionHistory h(100, 1'000'000);
+  h.remember(7, std::vector<uint8_t>(20, 7), 0);
+  const auto first = h.planRetransmission(7, 10'000, 5'000);
+  ASSERT_NE(first.datagram, nullptr);
+  EXPECT_EQ(first.copies, 1);
+  const auto repeat = h.planRetransmission(7, 11'000, 5'000);  // the receiver's second copy of that NACK
+  EXPECT_NE(repeat.datagram, nullptr);
+  EXPECT_EQ(repeat.copies, 0);
+  const auto retry = h.planRetransmission(7, 40'000, 5'000);  // the first retransmission was lost
+  EXPECT_EQ(retry.copies, 2);
+  EXPECT_EQ(h.planRetransmission(8, 40'000, 5'000).datagram, nullptr) << "never sent";
+  EXPECT_EQ(h.planRetransmission(7, 2'000'000, 5'000).datagram, nullptr) << "too old";
 }
 
 TEST(NackList, ARetransmissionCountsAsRecoveredAndTheDeadlineGivesUp) {

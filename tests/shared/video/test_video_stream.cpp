@@ -246,6 +246,7 @@ class StreamRig {
     rs.port = 0;
     rs.reorder_window = o.reorder_window;
     rs.nack = o.nack;
+    rs.rtcp = o.nack;
     receiver_ = std::make_unique<VideoReceiver>(rs);
     uint16_t dest = receiver_->port();
     if (o.relay) {

@@ -145,7 +145,10 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   EXPECT_GE(frames[3], 2) << "the first IDR and at least one on request\n" << out;
   const auto counters = statsNumbers(out, "counters", 0);  // packets, lost, ...
   ASSERT_GE(counters.size(), 2u) << out;
-  EXPECT_GE(counters[1], 20) << "the relay's burst was seen as lost\n" << out;
+  // Of the burst's 40 datagrams a few are the repair's own RTX packets (a
+  // tail probe's answer, retries sent twice: 7 in a run here); of the media
+  // packets it took, the history (20) repairs the newest 18-20.
+  EXPECT_GE(counters[1], 8) << "the relay's burst was seen as lost, beyond the history\n" << out;
   const auto repair = statsNumbers(out, "repair", 0);  // NACKs, packets, retransmissions, unneeded, PLIs, RTT
   ASSERT_GE(repair.size(), 5u) << out;
   EXPECT_GE(repair[0], 1) << "NACKs sent\n" << out;
