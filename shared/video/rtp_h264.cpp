@@ -210,6 +210,19 @@ void ReorderBuffer::flush(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>
   }
 }
 
+void ReorderBuffer::skipGap(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out) {
+  if (held_.empty()) return;
+  const uint16_t d = static_cast<uint16_t>(held_.front().first - next_);
+  out.emplace_back(d, std::move(held_.front().second));
+  next_ = static_cast<uint16_t>(held_.front().first + 1);
+  held_.erase(held_.begin());
+  while (!held_.empty() && held_.front().first == next_) {
+    out.emplace_back(0, std::move(held_.front().second));
+    next_ = static_cast<uint16_t>(next_ + 1);
+    held_.erase(held_.begin());
+  }
+}
+
 // --- depacketizer -------------------------------------------------------------
 
 void H264Depacketizer::noteType(uint8_t type) {

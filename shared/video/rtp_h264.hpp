@@ -100,6 +100,9 @@ class ReorderBuffer {
   void pop(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out);
   /// Releases everything held (gaps included), e.g. after a pause.
   void flush(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out);
+  /// Gives up the first gap only: releases the first packet held (the
+  /// missing ones before it reported skipped) and those in order after it.
+  void skipGap(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out);
 
   uint64_t duplicates() const { return duplicates_; }
   uint64_t late() const { return late_; }

@@ -196,6 +196,12 @@ std::vector<uint16_t> NackList::expire(uint64_t deadline_us, uint64_t now_us, ui
   return out;
 }
 
+std::optional<uint64_t> NackList::firstMissedUs(uint16_t seq) const {
+  const auto it = std::find_if(missing_.begin(), missing_.end(), [seq](const Missing& m) { return m.seq == seq; });
+  if (it == missing_.end()) return std::nullopt;
+  return it->first_us;
+}
+
 bool NackList::missing(uint16_t seq) const {
   return std::any_of(missing_.begin(), missing_.end(), [seq](const Missing& m) { return m.seq == seq; });
 }

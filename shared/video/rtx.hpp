@@ -112,6 +112,8 @@ class NackList {
   /// The highest sequence number seen (or probed).
   uint16_t highest() const { return highest_; }
   bool missing(uint16_t seq) const;
+  /// When `seq` was first found missing; none when it is not missing.
+  std::optional<uint64_t> firstMissedUs(uint16_t seq) const;
   std::size_t size() const { return missing_.size(); }
   const NackSettings& settings() const { return s_; }
   uint64_t nacked() const { return nacked_; }

@@ -65,9 +65,35 @@ struct VideoReceiver::Stream {
   rtcp::ReceiverStats rstats;
   NackList nacks;
   asio::ip::udp::endpoint feedback_to;  // where this stream's RTP comes from; unset = nothing yet
-  std::map<uint16_t, uint64_t> nacked_at_us;  // NACK time per sequence number, for the RTT; 0 = NACKed again (no sample)
-  double rtt_us = 20000;                      // assumed until measured
+  struct NackTimes {
+    uint64_t first_us = 0, last_us = 0;
+    int count = 0;
+  };
+  std::map<uint16_t, NackTimes> nacked_at_us;  // per sequence number NACKed, for the RTT
+  // Assumed high until measured: only a first try's answer is an exact
+  // sample (Karn), and an over-estimate corrects itself with the first one,
+  // while an under-estimate retries before any answer can come.
+  double rtt_us = 100000;
   bool rtt_measured = false;
+
+  // The RTT from an RTX packet of `seq` (needed or not). One NACK: an exact
+  // sample (1/8 gain). More: which one it answers is unknown, but now - the
+  // last is a lower bound; taken when it exceeds the estimate (a link whose
+  // RTT rose must not stay stuck with retries that come too soon to sample).
+  void sampleRtt(uint16_t seq, uint64_t now_us) {
+    const auto it = nacked_at_us.find(seq);
+    if (it == nacked_at_us.end() || now_us < it->second.last_us) return;
+    if (it->second.count == 1) {
+      const double sample = static_cast<double>(now_us - it->second.first_us);
+      rtt_us = rtt_measured ? 0.875 * rtt_us + 0.125 * sample : sample;  // RFC 6298-style smoothing
+    } else if (const double lower = static_cast<double>(now_us - it->second.last_us); lower > rtt_us) {
+      rtt_us = lower;
+    } else {
+      return;
+    }
+    rtt_measured = true;
+    st.rtt_ms = rtt_us / 1000.0;
+  }
   // The newest packet had no marker (its frame is still open) since newest_us; probed once.
   bool tail_open = false, tail_probed = false;
   uint64_t newest_us = 0;
@@ -268,16 +294,10 @@ void VideoReceiver::onRtx(std::span<const uint8_t> data) {
       std::lock_guard lk(mu_);
       ++counters_.datagrams;
     }
+    s->sampleRtt(seq, monoNowUs());  // a late answer to a given-up packet still tells the RTT
     if (!s->nacks.missing(seq)) {
       ++s->st.rtx_unneeded;
       return;
-    }
-    // Karn: a packet NACKed more than once gives no sample (which NACK did it answer?).
-    if (auto it = s->nacked_at_us.find(seq); it != s->nacked_at_us.end() && it->second != 0) {
-      const double sample = static_cast<double>(monoNowUs() - it->second);
-      s->rtt_us = s->rtt_measured ? 0.875 * s->rtt_us + 0.125 * sample : sample;  // RFC 6298-style smoothing
-      s->rtt_measured = true;
-      s->st.rtt_ms = s->rtt_us / 1000.0;
     }
     ++s->st.retransmissions;  // not counted in rstats: the reports give the loss on the wire
     handlePacket(*s, name, seq, std::move(orig), true);
@@ -311,7 +331,14 @@ void VideoReceiver::sendNacks(Stream& s) {
   ++s.st.nacks_sent;
   s.st.nacked_packets += due.size();
   for (uint16_t q : due)
-    if (auto [it, fresh] = s.nacked_at_us.try_emplace(q, now_us); !fresh) it->second = 0;
+    if (auto [it, fresh] = s.nacked_at_us.try_emplace(q, Stream::NackTimes{now_us, now_us, 1}); !fresh) {
+      if (now_us > it->second.last_us + 1'000'000) {
+        it->second = {now_us, now_us, 1};  // a sequence number reused since (the 16-bit wrap)
+      } else {
+        it->second.last_us = now_us;
+        ++it->second.count;
+      }
+    }
   while (s.nacked_at_us.size() > kNackWindow) s.nacked_at_us.erase(s.nacked_at_us.begin());
 }
 
@@ -350,19 +377,12 @@ void VideoReceiver::handlePacket(Stream& s, const std::string& name, uint16_t se
   s.reorder.push(seq, std::move(datagram));
   s.ready.clear();
   s.reorder.pop(s.ready);
-  // A gap is given up after reorder_timeout_s even when fewer than `window`
-  // packets wait behind it: a loss must freeze the picture and ask for a
-  // keyframe at once, not 16 packets later.
-  if (s.reorder.held() == 0) {
-    s.gap_since = {};
-  } else if (s.gap_since == Clock::time_point{}) {
-    s.gap_since = now;
-  } else if (now - s.gap_since >= gapWait(s)) {
-    s.reorder.flush(s.ready);
-    s.gap_since = {};
-  }
-  // What is no longer held behind a gap is given up (nothing more to NACK).
-  if (s.nacks.size() > 0) (void)s.nacks.expireBefore(s.reorder.next());
+  // A gap is given up after its wait even when fewer than `window` packets
+  // wait behind it: a loss must freeze the picture and ask for a keyframe
+  // at once, not 16 packets later.
+  if (s.reorder.held() == 0) s.gap_since = {};
+  else if (s.gap_since == Clock::time_point{} || !s.ready.empty()) s.gap_since = headGapSince(s, now);
+  giveUpStaleGaps(s, now);
   sendNacks(s);
   depacketizeReady(s, name);
   armRepair();
@@ -446,16 +466,36 @@ void VideoReceiver::onFrame(Stream& s, const std::string& name, const Frame& f) 
   if (frame_hook_) frame_hook_(name, bgr, capture_server_us);
 }
 
-void VideoReceiver::releaseStaleGap(Stream& s, const std::string& name, Clock::time_point now) {
-  // A gap nobody will fill (lost for good, or the stream paused): release what is held.
-  if (s.reorder.held() > 0 && s.gap_since != Clock::time_point{} && now - s.gap_since >= gapWait(s)) {
-    s.ready.clear();
-    s.reorder.flush(s.ready);
-    s.gap_since = {};
-    (void)s.nacks.expireBefore(s.reorder.next());
-    depacketizeReady(s, name);
-    maybeRequestKeyframe(s, name);
+Clock::time_point VideoReceiver::headGapSince(const Stream& s, Clock::time_point now) const {
+  // With repair, each gap waits from when it was found (the NACK list knows);
+  // else from when it became the first (a gap only waits for reordering).
+  if (settings_.nack)
+    if (const auto first = s.nacks.firstMissedUs(s.reorder.next())) {
+      const uint64_t now_us = monoNowUs();
+      return now - std::chrono::microseconds(now_us > *first ? now_us - *first : 0);
+    }
+  return now;
+}
+
+void VideoReceiver::giveUpStaleGaps(Stream& s, Clock::time_point now) {
+  // With repair, gap by gap (the ones behind are younger and still being
+  // repaired); without, everything held at once (nothing will fill them).
+  while (s.reorder.held() > 0 && s.gap_since != Clock::time_point{} && now - s.gap_since >= gapWait(s)) {
+    if (settings_.nack) s.reorder.skipGap(s.ready);
+    else s.reorder.flush(s.ready);
+    s.gap_since = s.reorder.held() > 0 ? headGapSince(s, now) : Clock::time_point{};
   }
+  // What is no longer held behind a gap is given up (nothing more to NACK).
+  if (s.nacks.size() > 0) (void)s.nacks.expireBefore(s.reorder.next());
+}
+
+void VideoReceiver::releaseStaleGap(Stream& s, const std::string& name, Clock::time_point now) {
+  // A gap nobody will fill (lost for good, or the stream paused): release what waits behind it.
+  s.ready.clear();
+  giveUpStaleGaps(s, now);
+  if (s.ready.empty()) return;
+  depacketizeReady(s, name);
+  maybeRequestKeyframe(s, name);
 }
 
 void VideoReceiver::armRepair() {

@@ -155,6 +155,9 @@ class VideoReceiver {
   void armRepair();
   void repairTick();
   void releaseStaleGap(Stream& s, const std::string& name, std::chrono::steady_clock::time_point now);
+  // When the first gap held began waiting; and giving up the gaps whose wait is over (into s.ready).
+  std::chrono::steady_clock::time_point headGapSince(const Stream& s, std::chrono::steady_clock::time_point now) const;
+  void giveUpStaleGaps(Stream& s, std::chrono::steady_clock::time_point now);
 
   ReceiverSettings settings_;
   boost::asio::io_context io_;

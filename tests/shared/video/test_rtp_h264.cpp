@@ -258,6 +258,27 @@ TEST(RtpH264, AStartCodeInsideANalUnitDropsItsFrame) {
   EXPECT_EQ(dp.counters().frames, 1u);
 }
 
+TEST(ReorderBuffer, SkipGapGivesUpTheFirstGapOnlyAndKeepsWaitingForTheNext) {
+  ReorderBuffer rb(1024);
+  std::vector<std::pair<uint32_t, std::vector<uint8_t>>> out;
+  for (uint16_t q : {65534, 1, 2, 4}) rb.push(q, std::vector<uint8_t>{static_cast<uint8_t>(q)});  // 65535, 0, 3 missing
+  rb.pop(out);
+  ASSERT_EQ(out.size(), 1u);  // 65534
+  out.clear();
+  rb.skipGap(out);  // gives up 65535 and 0: releases 1, 2
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].first, 2u) << "two skipped before it";
+  EXPECT_EQ(out[0].second[0], 1);
+  EXPECT_EQ(out[1].first, 0u);
+  EXPECT_EQ(rb.next(), 3);
+  EXPECT_EQ(rb.held(), 1u) << "4 still waits for 3";
+  out.clear();
+  rb.push(3, {3});
+  rb.pop(out);
+  EXPECT_EQ(out.size(), 2u);
+  EXPECT_EQ(rb.held(), 0u);
+}
+
 TEST(RtpH264, BadHeadersAreNamed) {
   RtpPacket p;
   EXPECT_EQ(parseRtp(std::vector<uint8_t>(5, 0x80), p), RtpError::kTooShort);

@@ -132,6 +132,9 @@ TEST(NackList, ExpireBeforeGivesUpOnlyWhatTheReorderBufferReleasedWithout) {
   EXPECT_EQ(n.expireBefore(1), 3u) << "65534, 65535, 0: before 1 across the wrap";
   EXPECT_TRUE(n.missing(1));
   EXPECT_TRUE(n.missing(4)) << "a probe past the released ones stays";
+  EXPECT_EQ(n.firstMissedUs(1), std::optional<uint64_t>(0));
+  EXPECT_EQ(n.firstMissedUs(4), std::optional<uint64_t>(5000)) << "the probe's time";
+  EXPECT_EQ(n.firstMissedUs(3), std::nullopt) << "arrived";
   EXPECT_EQ(n.expireBefore(4), 2u);
   EXPECT_EQ(n.size(), 1u);
   EXPECT_EQ(n.givenUp(), 5u);
