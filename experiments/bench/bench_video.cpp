@@ -58,7 +58,6 @@
 #include "shared/video/video_sender.hpp"
 
 #include "experiments/bench/video_bench.hpp"
-#include "tests/support/udp_relay.hpp"
 
 namespace inspect::bench_video {
 namespace {
@@ -188,15 +187,8 @@ CaseResult runThisSystem(const Options& o, cv::Size sz, const std::string& self,
   // The lossy link: a seeded UdpRelay in this process, both ways.
   std::optional<test::UdpRelay> link;
   if (relay) {
-    test::UdpRelayParams lp;
-    lp.drop = relay->drop;
-    lp.delay_ms = relay->delay_ms;
-    lp.burst_every_ms = relay->burst_every_ms;
-    lp.burst_ms = relay->burst_ms;
-    lp.burst_drop = relay->burst_drop;
-    lp.seed = relay->seed;
     try {
-      link.emplace(port, lp);
+      link.emplace(port, relay->link);
     } catch (const std::exception& e) {
       return failed(r, e.what());
     }

@@ -38,6 +38,7 @@
 #include "shared/video/timecode.hpp"
 #include "shared/video/video_receiver.hpp"
 #include "shared/video/video_sender.hpp"
+#include "tests/support/udp_relay.hpp"
 
 namespace inspect::bench_video {
 
@@ -325,14 +326,12 @@ std::string gstSender(const Options& o, cv::Size sz, const std::string& port);
 std::string gstReceiver(const std::string& port, int threads);
 std::string gstPassThrough(cv::Size sz);
 
-/// (a) this system in two processes; through `relay` (a UdpRelay's
-/// parameters) when given, with the receiver's NACK repair `nack`. Its
-/// pictures (time code read) in `recs` when not null, the relay's forwarded
-/// bytes over the window in `wire_kbps`.
+/// (a) this system in two processes; through `relay` when given (a seeded
+/// UdpRelay with its link's parameters, the receiver's NACK repair on or
+/// off). What the run saw goes to `run` when not null: its pictures (time
+/// code read), the window, the relay's delivered rate, both processes' counters.
 struct RelayCase {
-  double drop = 0, delay_ms = 0;
-  double burst_every_ms = 0, burst_ms = 0, burst_drop = 0;
-  uint32_t seed = 1;
+  test::UdpRelayParams link;
   bool nack = true;
 };
 struct PairRun {

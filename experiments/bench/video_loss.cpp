@@ -123,14 +123,14 @@ bool runLossSweep(const Options& o, const std::string& self, Json& out) {
     for (const auto& lv : levels)
       for (const bool nack : {true, false}) {
         RelayCase rc;
-        rc.drop = lv.drop;
-        rc.delay_ms = delay;
+        rc.link.drop = lv.drop;
+        rc.link.delay_ms = delay;
         if (lv.burst_drop > 0) {
-          rc.burst_every_ms = kBurstEveryMs;
-          rc.burst_ms = kBurstMs;
-          rc.burst_drop = lv.burst_drop;
+          rc.link.burst_every_ms = kBurstEveryMs;
+          rc.link.burst_ms = kBurstMs;
+          rc.link.burst_drop = lv.burst_drop;
         }
-        rc.seed = o.seed;
+        rc.link.seed = o.seed;
         rc.nack = nack;
         LossRow row;
         row.delay_ms = delay;

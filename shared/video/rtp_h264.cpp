@@ -191,36 +191,26 @@ bool ReorderBuffer::push(uint16_t seq, std::vector<uint8_t> datagram) {
   return true;
 }
 
-void ReorderBuffer::pop(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out) {
-  while (!held_.empty()) {
-    const uint16_t d = static_cast<uint16_t>(held_.front().first - next_);
-    if (d != 0 && held_.size() <= window_) break;  // wait for the missing one a little longer
-    out.emplace_back(d, std::move(held_.front().second));
-    next_ = static_cast<uint16_t>(held_.front().first + 1);
-    held_.erase(held_.begin());
-  }
-}
-
-void ReorderBuffer::flush(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out) {
-  while (!held_.empty()) {
-    const uint16_t d = static_cast<uint16_t>(held_.front().first - next_);
-    out.emplace_back(d, std::move(held_.front().second));
-    next_ = static_cast<uint16_t>(held_.front().first + 1);
-    held_.erase(held_.begin());
-  }
-}
-
-void ReorderBuffer::skipGap(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out) {
-  if (held_.empty()) return;
+void ReorderBuffer::releaseFront(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out) {
   const uint16_t d = static_cast<uint16_t>(held_.front().first - next_);
   out.emplace_back(d, std::move(held_.front().second));
   next_ = static_cast<uint16_t>(held_.front().first + 1);
   held_.erase(held_.begin());
-  while (!held_.empty() && held_.front().first == next_) {
-    out.emplace_back(0, std::move(held_.front().second));
-    next_ = static_cast<uint16_t>(next_ + 1);
-    held_.erase(held_.begin());
-  }
+}
+
+void ReorderBuffer::pop(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out) {
+  // Wait for a missing one a little longer, unless more than `window` are held.
+  while (!held_.empty() && (held_.front().first == next_ || held_.size() > window_)) releaseFront(out);
+}
+
+void ReorderBuffer::flush(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out) {
+  while (!held_.empty()) releaseFront(out);
+}
+
+void ReorderBuffer::skipGap(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out) {
+  if (held_.empty()) return;
+  releaseFront(out);
+  pop(out);
 }
 
 // --- depacketizer -------------------------------------------------------------

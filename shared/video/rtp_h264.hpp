@@ -111,6 +111,8 @@ class ReorderBuffer {
   uint16_t next() const { return next_; }
 
  private:
+  // Releases the first packet held, with how many were skipped before it.
+  void releaseFront(std::vector<std::pair<uint32_t, std::vector<uint8_t>>>& out);
   std::size_t window_;
   bool started_ = false;
   uint16_t next_ = 0;  // the next sequence number to release

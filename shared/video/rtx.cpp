@@ -202,8 +202,6 @@ std::optional<uint64_t> NackList::firstMissedUs(uint16_t seq) const {
   return it->first_us;
 }
 
-bool NackList::missing(uint16_t seq) const {
-  return std::any_of(missing_.begin(), missing_.end(), [seq](const Missing& m) { return m.seq == seq; });
-}
+bool NackList::missing(uint16_t seq) const { return firstMissedUs(seq).has_value(); }
 
 }  // namespace inspect::video
