@@ -81,6 +81,12 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   vp.retransmission = v.boolean("retransmission", vp.retransmission);
   vp.history_packets = static_cast<int>(v.integer("history_packets", vp.history_packets, 0, 65536));
   vp.history_s = v.number("history_s", vp.history_s, 0.01, 10);
+  const auto ad = v.optChild("adapt");
+  vp.adapt = ad.boolean("enabled", vp.adapt);
+  vp.adapt_min_kbps = static_cast<int>(ad.integer("min_kbps", vp.adapt_min_kbps, 50, 50000));
+  vp.adapt_max_kbps = static_cast<int>(ad.integer("max_kbps", vp.adapt_max_kbps, 0, 50000));
+  if (vp.adapt_max_kbps != 0 && vp.adapt_max_kbps < vp.adapt_min_kbps)
+    ad.fail("max_kbps", std::to_string(vp.adapt_max_kbps) + " is below min_kbps " + std::to_string(vp.adapt_min_kbps));
   return c;
 }
 

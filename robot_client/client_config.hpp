@@ -26,6 +26,9 @@ struct VideoParams {
   bool retransmission = true;        // answer the server's NACKs with RTX, send RTCP sender reports
   int history_packets = 1024;
   double history_s = 1.0;
+  bool adapt = true;                 // rate adaptation from the receiver reports (docs/video.md)
+  int adapt_min_kbps = 500;          // floor; below it the frame rate halves, then the size
+  int adapt_max_kbps = 0;            // ceiling; 0 = bitrate_kbps
 };
 
 /// Mutual TLS on the link (docs/security.md); relative paths are from the working directory.

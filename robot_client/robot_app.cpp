@@ -36,6 +36,9 @@ video::SenderSettings senderSettings(const ClientConfig& cfg) {
   s.retransmission = v.retransmission;
   s.history_packets = static_cast<std::size_t>(v.history_packets);
   s.history_s = v.history_s;
+  s.adapt.enabled = v.adapt;
+  s.adapt.min_kbps = v.adapt_min_kbps;
+  s.adapt.max_kbps = v.adapt_max_kbps;
   return s;
 }
 
@@ -240,6 +243,22 @@ void RobotApp::fillVideoStatus(v1::Telemetry& t) const {
   v->set_port(s.port);
   v->set_error(s.error);
   v->set_keyframe_requests(s.keyframe_requests);
+  v->set_adapt(s.adapt);
+  v->set_min_kbps(static_cast<uint32_t>(s.min_kbps));
+  v->set_max_kbps(static_cast<uint32_t>(s.max_kbps));
+  v->set_rate_kbps(static_cast<uint32_t>(s.rate_kbps));
+  v->set_send_width(static_cast<uint32_t>(s.send_width));
+  v->set_send_height(static_cast<uint32_t>(s.send_height));
+  v->set_send_fps(s.send_fps);
+  v->set_rate_level(static_cast<uint32_t>(s.rate_level));
+  v->set_rate_reason(s.rate_reason);
+  const uint64_t now_us = monoNowUs();
+  v->set_rate_age_s(now_us > s.rate_changed_us ? static_cast<double>(now_us - s.rate_changed_us) / 1e6 : 0.0);
+  v->set_rate_changes(s.rate_changes);
+  v->set_peer_loss_pct(s.peer_loss_pct);
+  v->set_rtt_ms(s.rtt_ms);
+  v->set_nacked_packets(s.nacked_packets);
+  v->set_retransmitted(s.retransmitted);
 }
 
 void RobotApp::pumpOutbox() {

@@ -65,7 +65,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: bench_video [--seconds N] [--sizes WxH,...] [--fps F] [--bitrate-kbps K]\n"
     "                   [--warmup S] [--gst-threads LIST] [--json FILE]\n"
-    "       bench_video --loss [--loss-pcts LIST] [--delays-ms LIST] [--no-burst] [--seed N] [same options]\n"
+    "       bench_video --loss [--loss-pcts LIST] [--delays-ms LIST] [--no-burst] [--seed N]\n"
+    "                   [--intra-refresh] [--adapt 0|1] [same options]\n"
     "Glass-to-glass latency (capture -> decoded picture, read from the time code in the\n"
     "picture) and CPU of (a) this system's VideoSender/VideoReceiver in two processes,\n"
     "(b) the same frames through GStreamer x264enc/rtph264pay/udpsink -> udpsrc/rtph264depay/\n"
@@ -78,7 +79,9 @@ constexpr const char* kUsage =
     "Exit status: 0, 1 when a case failed (the others still run), 2 on bad arguments.\n"
     "--loss: the loss sweep instead (docs/video.md): (a) and (a0) (repair off, keyframe requests only)\n"
     "through a seeded UDP relay, both ways, at each --loss-pcts (default 0,1,5,10,20) and a burst case\n"
-    "(--no-burst: without), at each --delays-ms one way (default 10,50); --seed N; first size only.\n"
+    "(--no-burst: without), at each --delays-ms one way (default 10,50); --seed N; first size only;\n"
+    "--intra-refresh: libx264's periodic intra refresh instead of an IDR every second; --adapt 0: the\n"
+    "sender's rate adaptation off (default on).\n"
     "Internal: --role sender|receiver [--port P] [--max-seconds S] [--nack 0|1]: the two processes of (a).\n";
 
 // ---------------------------------------------------------------- (a) this system
@@ -147,6 +150,7 @@ int senderRole(const Options& o) {
   s.host = "127.0.0.1";
   s.port = o.port;
   s.ssrc = kSsrc;
+  s.adapt.enabled = o.adapt;
   VideoSender tx(s);
   tx.start();
   waitForStdinEof(o.max_seconds);
@@ -156,14 +160,19 @@ int senderRole(const Options& o) {
                  {"keyframes", st.keyframes}, {"packets", st.packets}, {"bytes", st.bytes},
                  {"send_errors", st.send_errors}, {"encode_ms", st.encode_ms}, {"nacked_packets", st.nacked_packets},
                  {"retransmitted", st.retransmitted}, {"not_in_history", st.not_in_history},
-                 {"repeat_nacks", st.repeat_nacks}, {"plis", st.plis}, {"error", st.error}});
+                 {"repeat_nacks", st.repeat_nacks}, {"plis", st.plis}, {"rate_kbps", st.rate_kbps},
+                 {"rate_level", st.rate_level}, {"rate_changes", st.rate_changes}, {"rate_reason", st.rate_reason},
+                 {"rate_skipped", st.rate_skipped}, {"peer_loss_pct", st.peer_loss_pct}, {"error", st.error}});
   return 0;
 }
 
 /// The common arguments of a role process.
 std::vector<std::string> roleArgs(const std::string& self, const std::string& role, const Options& o, cv::Size sz) {
-  return {self, "--role", role, "--sizes", sizeName(sz), "--fps", std::to_string(o.fps), "--bitrate-kbps",
-          std::to_string(o.bitrate_kbps), "--max-seconds", std::to_string(o.warmup + o.seconds + 60)};
+  std::vector<std::string> args{self, "--role", role, "--sizes", sizeName(sz), "--fps", std::to_string(o.fps),
+                                "--bitrate-kbps", std::to_string(o.bitrate_kbps), "--max-seconds",
+                                std::to_string(o.warmup + o.seconds + 60), "--adapt", o.adapt ? "1" : "0"};
+  if (o.intra_refresh) args.push_back("--intra-refresh");
+  return args;
 }
 
 }  // namespace
@@ -382,6 +391,8 @@ void parseArgs(int argc, char** argv, Options& o) {
     else if (a.is("--loss-pcts")) o.loss_pcts = parseNumbers(a, 0, 100);
     else if (a.is("--delays-ms")) o.delays_ms = parseNumbers(a, 0, 1000);
     else if (a.is("--no-burst")) o.burst = false;
+    else if (a.is("--intra-refresh")) o.intra_refresh = true;
+    else if (a.is("--adapt")) o.adapt = a.integer(0, 1) == 1;
     else if (a.is("--seed")) o.seed = static_cast<uint32_t>(a.unsignedInteger(UINT32_MAX));
     else a.unknown();
   });

@@ -13,6 +13,7 @@ EncoderSettings encoderSettings(const Options& o, cv::Size sz) {
   es.fps = o.fps;
   es.bitrate_kbps = o.bitrate_kbps;
   es.gop = gop(o);
+  es.intra_refresh = o.intra_refresh;
   return es;
 }
 

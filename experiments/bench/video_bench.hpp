@@ -65,6 +65,8 @@ struct Options {
   bool burst = true;                               // and the burst case (kBurst*)
   std::vector<double> delays_ms{10, 50};           // one-way delay
   uint32_t seed = 1;
+  bool intra_refresh = false;  // libx264 periodic intra refresh instead of IDRs every GOP
+  bool adapt = true;           // (a): rate adaptation on the sender
   // --role
   bool nack = true;  // receiver: NACK + RTX repair (off: keyframe requests only)
   std::string role;

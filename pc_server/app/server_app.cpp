@@ -32,6 +32,7 @@
 #include "pc_server/app/stop_flag.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/video/video_hub.hpp"
+#include "pc_server/video/video_stats_proto.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/file_util.hpp"
 #include "shared/util/log.hpp"
@@ -244,6 +245,11 @@ int runServer(const CliOptions& options) {
     fo.teleop_timeout_s = fc.teleop_timeout_s;
     fo.max_v_m_s = copt.max_v_m_s;
     fo.max_w_rad_s = copt.max_w_rad_s;
+    if (video)
+      fo.video_stats = [hub = video.get()](const std::string& robot) -> std::optional<v1::VideoReceiveStats> {
+        const auto st = hub->stats(robot);
+        return st ? std::optional(toProto(*st)) : std::nullopt;
+      };
     bridge = std::make_unique<foxglove::FoxgloveBridge>(ioc, fo, registry, link, control, site_maps, geometry, copt,
                                                         configure);
     const auto ep = bridge->start();  // a failure here leaves no pointer to a destroyed bridge

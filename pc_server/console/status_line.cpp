@@ -24,15 +24,25 @@ std::string faultNames(uint32_t faults) {
 }
 
 namespace {
+// The robot's rate in force and why it last changed (rate adaptation), "" when it does not adapt.
+std::string rateNote(const v1::VideoStatus& tv) {
+  if (!tv.adapt() || tv.rate_kbps() == 0) return {};
+  std::string s = " | rate " + std::to_string(tv.rate_kbps()) + " kbit/s";
+  if (tv.rate_level() > 0)
+    s += " " + std::to_string(tv.send_width()) + "x" + std::to_string(tv.send_height()) + "@" + fmtShort(tv.send_fps());
+  return s + " (" + tv.rate_reason() + ")";
+}
+
 std::string videoFigures(const RobotSnapshot& snap, const VideoHub* video) {
   if (!snap.telemetry.has_video()) return {};
   const auto& tv = snap.telemetry.video();
   if (!tv.enabled()) return " | video off";
   const auto st = video ? video->stats(snap.id) : std::nullopt;
-  if (!st || !st->active) return " | video no packets" + (tv.error().empty() ? std::string() : " (" + tv.error() + ")");
+  if (!st || !st->active)
+    return " | video no packets" + (tv.error().empty() ? std::string() : " (" + tv.error() + ")") + rateNote(tv);
   return " | video " + fmtFixed(st->fps_received, 0) + "/" + fmtFixed(st->fps_decoded, 0) + " fps " +
          fmtFixed(st->kbps, 0) + " kbit/s loss " + fmtFixed(st->loss_pct, 1) + "% lat " +
-         (st->latency_ms < 0 ? std::string("--") : fmtFixed(st->latency_ms, 0)) + " ms";
+         (st->latency_ms < 0 ? std::string("--") : fmtFixed(st->latency_ms, 0)) + " ms" + rateNote(tv);
 }
 }  // namespace
 
@@ -51,6 +61,21 @@ std::string videoReport(const std::string& robot_id, const std::optional<RobotSn
                              ", keyframes " + std::to_string(v.keyframes()) + " (" +
                              std::to_string(v.keyframe_requests()) + " requested), encode " +
                              fmtFixed(v.encode_ms(), 1) + " ms/frame");
+    if (v.rate_kbps() != 0) {
+      std::string rate = std::to_string(v.rate_kbps()) + " kbit/s, " + std::to_string(v.send_width()) + "x" +
+                         std::to_string(v.send_height()) + " @ " + fmtShort(v.send_fps()) + " fps";
+      if (v.adapt())
+        rate += " (adapting in " + std::to_string(v.min_kbps()) + "-" + std::to_string(v.max_kbps()) + " kbit/s, level " +
+                std::to_string(v.rate_level()) + "); last change " + fmtFixed(v.rate_age_s(), 1) + " s ago: " +
+                v.rate_reason() + " (" + std::to_string(v.rate_changes()) + " changes)";
+      else
+        rate += " (adaptation off)";
+      line("robot rate", rate);
+      line("robot feedback", "receiver's loss " + (v.peer_loss_pct() < 0 ? std::string("-") : fmtFixed(v.peer_loss_pct(), 1) + " %") +
+                                 ", RTT " + (v.rtt_ms() < 0 ? std::string("-") : fmtFixed(v.rtt_ms(), 1) + " ms") +
+                                 ", NACKed " + std::to_string(v.nacked_packets()) + ", retransmitted " +
+                                 std::to_string(v.retransmitted()));
+    }
     if (!v.error().empty()) line("robot error", v.error());
   } else {
     line("robot", "no video in telemetry");
@@ -77,7 +102,8 @@ std::string videoReport(const std::string& robot_id, const std::optional<RobotSn
                          std::to_string(st->keyframe_requests));
     line("repair", "NACKs " + std::to_string(st->nacks_sent) + " for " + std::to_string(st->nacked_packets) +
                        " packets, retransmissions " + std::to_string(st->retransmissions) + ", unneeded " +
-                       std::to_string(st->rtx_unneeded) + ", PLIs " + std::to_string(st->plis_sent) + ", RTT " +
+                       std::to_string(st->rtx_unneeded) + ", tail probes " + std::to_string(st->tail_probes) +
+                       ", PLIs " + std::to_string(st->plis_sent) + ", RTT " +
                        (st->rtt_ms < 0 ? std::string("-") : fmtFixed(st->rtt_ms, 1) + " ms"));
   }
   const auto c = video->counters();

@@ -26,7 +26,7 @@ constexpr auto kRefusalDebounce = std::chrono::seconds(1);
 }  // namespace
 
 std::vector<uint32_t> FoxgloveBridge::RobotChannels::all() const {
-  std::vector<uint32_t> ids{telemetry, events, acks, alarms, camera, tf, scene, log};
+  std::vector<uint32_t> ids{telemetry, events, acks, alarms, camera, tf, scene, log, video_stats};
   for (const auto& [name, id] : grids) ids.push_back(id);
   std::erase(ids, 0u);
   return ids;
@@ -102,6 +102,7 @@ void FoxgloveBridge::advertiseRobot(const std::string& robot, RobotState& r) {
   c.tf = addChannel(p + "tf", ::foxglove::FrameTransforms::descriptor(), WsServer::Kind::kData);
   c.scene = addChannel(p + "scene", ::foxglove::SceneUpdate::descriptor(), WsServer::Kind::kData);
   c.log = addChannel(p + "log", ::foxglove::Log::descriptor(), WsServer::Kind::kData);
+  c.video_stats = addChannel(p + "video_stats", v1::VideoStats::descriptor(), WsServer::Kind::kData);
   r.connected = true;
   log::info(kTag, robot, ": channels advertised");
 }
@@ -184,6 +185,10 @@ void FoxgloveBridge::tick() {
         r.scene->setMap(m.map ? std::optional<scene::SiteMap>(*m.map) : std::nullopt);
       }
       if (server_.subscribed(r.ch.scene)) publishMessage(r.ch.scene, ns, r.scene->scene(ns));
+      if (server_.subscribed(r.ch.video_stats) && now - r.last_video_stats >= std::chrono::seconds(1)) {
+        r.last_video_stats = now;
+        publishMessage(r.ch.video_stats, ns, videoStats(robot));
+      }
       if (now - r.last_grid >= steadyDuration(1.0 / options_.grid_hz)) {
         r.last_grid = now;
         for (const auto& name : r.scene->gridChannels()) {
@@ -199,6 +204,15 @@ void FoxgloveBridge::tick() {
   tick_timer_.async_wait([this](const boost::system::error_code& ec) {
     if (!ec) tick();
   });
+}
+
+v1::VideoStats FoxgloveBridge::videoStats(const std::string& robot) const {
+  v1::VideoStats m;
+  if (const auto snap = registry_.snapshot(robot, monoNowNs()); snap && snap->has_telemetry && snap->telemetry.has_video())
+    *m.mutable_sender() = snap->telemetry.video();
+  if (options_.video_stats)
+    if (auto r = options_.video_stats(robot)) *m.mutable_receiver() = std::move(*r);
+  return m;
 }
 
 void FoxgloveBridge::deadman() {

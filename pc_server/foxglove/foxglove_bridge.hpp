@@ -37,6 +37,9 @@ class FoxgloveBridge : public WsServer::Handler {
     double teleop_timeout_s = 0.5; // a set-point not refreshed this long lapses: the robot is stopped
     double max_v_m_s = 1.0;        // teleop limits (the console's)
     double max_w_rad_s = 2.0;
+    /// The server's receive figures of a robot's stream (VideoHub), for
+    /// /<robot>/video_stats once a second; unset or nullopt = none.
+    std::function<std::optional<v1::VideoReceiveStats>(const std::string& robot)> video_stats;
   };
 
   FoxgloveBridge(boost::asio::io_context& ioc, Options options, RobotRegistry& registry, CommandSink& sink,
@@ -69,7 +72,7 @@ class FoxgloveBridge : public WsServer::Handler {
 
  private:
   struct RobotChannels {
-    uint32_t telemetry = 0, events = 0, acks = 0, alarms = 0, camera = 0, tf = 0, scene = 0, log = 0;
+    uint32_t telemetry = 0, events = 0, acks = 0, alarms = 0, camera = 0, tf = 0, scene = 0, log = 0, video_stats = 0;
     std::map<std::string, uint32_t> grids;  // gas channel -> channel id
     std::vector<uint32_t> all() const;
   };
@@ -79,6 +82,7 @@ class FoxgloveBridge : public WsServer::Handler {
     uint64_t map_version = 0;
     bool connected = false;
     std::chrono::steady_clock::time_point last_grid{};
+    std::chrono::steady_clock::time_point last_video_stats{};
     std::chrono::steady_clock::time_point keyframe_asked{};  // for a new video subscriber, at most once a second
   };
   struct Client {
@@ -90,6 +94,7 @@ class FoxgloveBridge : public WsServer::Handler {
   };
 
   void tick();         // every 1 / scene_hz: robots appear and go, scenes and grids
+  v1::VideoStats videoStats(const std::string& robot) const;
   void deadman();      // every 50 ms: teleop set-points that lapsed
   void advertiseRobot(const std::string& robot, RobotState& r);
   void unadvertiseRobot(RobotState& r);

@@ -178,9 +178,7 @@ struct H264Encoder::Impl {
     AVDictionary* opts = nullptr;
     if (codec_name == "libx264") {
       ctx->keyint_min = s.gop;
-      ctx->rc_max_rate = ctx->bit_rate;
-      // One frame's worth; libx264 takes it in whole kbit.
-      ctx->rc_buffer_size = std::max(1000, static_cast<int>(std::ceil(static_cast<double>(ctx->bit_rate) / s.fps)));
+      setRateControl();
       ctx->thread_count = s.threads;
       ctx->thread_type = FF_THREAD_SLICE;  // frame threads would add a frame of latency each
       std::string params = "scenecut=0";    // IDRs exactly every gop frames
@@ -202,6 +200,15 @@ struct H264Encoder::Impl {
     name = codec_name;
     keepParamSets(std::span<const uint8_t>(ctx->extradata, ctx->extradata_size));
     return {};
+  }
+
+  // Capped VBR at s.bitrate_kbps with a one-frame VBV buffer (libx264 takes
+  // it in whole kbit). libx264.c compares these with its parameters before
+  // every frame and calls x264_encoder_reconfig when they differ.
+  void setRateControl() {
+    ctx->bit_rate = int64_t{s.bitrate_kbps} * 1000;
+    ctx->rc_max_rate = ctx->bit_rate;
+    ctx->rc_buffer_size = std::max(1000, static_cast<int>(std::ceil(static_cast<double>(ctx->bit_rate) / s.fps)));
   }
 
   // Remembers the SPS and PPS in `annexb`, if it has both.
@@ -313,6 +320,16 @@ bool H264Encoder::encode(const cv::Mat& bgr, uint64_t capture_us, uint32_t frame
   if (m.ready.empty()) return false;
   out = std::move(m.ready.front());
   m.ready.pop_front();
+  return true;
+}
+
+bool H264Encoder::setBitrate(int kbps) {
+  EncoderSettings n = impl_->s;
+  n.bitrate_kbps = kbps;
+  if (const std::string bad = validate(n); !bad.empty()) throw VideoError("H.264 encoder: " + bad);
+  if (impl_->name != "libx264") return false;
+  impl_->s = n;
+  impl_->setRateControl();
   return true;
 }
 

@@ -57,6 +57,12 @@ class H264Encoder {
   bool encode(const cv::Mat& bgr, uint64_t capture_us, uint32_t frame_index, bool force_keyframe,
               EncodedFrame& out);
 
+  /// Changes the bitrate from the next frame without a keyframe, where the
+  /// encoder allows it (libx264 reconfigures its rate control in place:
+  /// FFmpeg's libx264.c reconfig_encoder). False when it does not
+  /// (h264_v4l2m2m): reopen the encoder. Throws VideoError out of range.
+  bool setBitrate(int kbps);
+
   const std::string& codecName() const;  // the libavcodec encoder in use
   const EncoderSettings& settings() const;
 

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <random>
 
+#include <opencv2/imgproc.hpp>
+
 #include <poll.h>
 #include <pthread.h>
 
@@ -37,6 +39,30 @@ EncoderSettings effectiveEncoder(const SenderSettings& s) {
   return e;
 }
 
+// What the encoder does at the rate controller's state: its bitrate, and
+// at a reduced level half the frame rate and half the size (even, >= 64).
+EncoderSettings adaptedEncoder(const SenderSettings& s, const RateState& r) {
+  EncoderSettings e = effectiveEncoder(s);
+  e.bitrate_kbps = r.kbps;
+  e.fps /= RateController::fpsDivisor(r.level);
+  const int d = RateController::sizeDivisor(r.level);
+  if (d > 1) {
+    e.width = std::max(64, e.width / d / 2 * 2);
+    e.height = std::max(64, e.height / d / 2 * 2);
+  }
+  return e;
+}
+
+RateSettings rateSettings(const SenderSettings& s) {
+  RateSettings r = s.adapt;
+  r.start_kbps = s.encoder.bitrate_kbps;
+  // The range always holds the configured rate; max 0 = the configured rate.
+  r.max_kbps = r.max_kbps == 0 ? r.start_kbps : std::max(r.max_kbps, r.start_kbps);
+  r.min_kbps = std::min(r.min_kbps, r.start_kbps);
+  r.enabled = r.enabled && s.retransmission;  // the reports come on the RTCP path
+  return r;
+}
+
 uint32_t randomSsrc() {
   std::random_device rd;
   uint32_t v = 0;
@@ -53,6 +79,8 @@ std::string validate(const SenderSettings& s) {
     return "video.history_packets: " + std::to_string(s.history_packets) + " out of range [0, 65536]";
   if (!(s.history_s >= 0.01 && s.history_s <= 10))
     return "video.history_s: " + std::to_string(s.history_s) + " out of range [0.01, 10]";
+  if (s.adapt.enabled && s.retransmission)
+    if (auto why = validate(rateSettings(s)); !why.empty()) return why;
   return validate(effectiveEncoder(s));
 }
 
@@ -97,6 +125,7 @@ VideoSender::VideoSender(SenderSettings s) : s_(std::move(s)), net_(std::make_un
   net_->socket.set_option(asio::socket_base::send_buffer_size(1 << 20), ec);
   st_.ssrc = ssrc_;
   st_.rtx_ssrc = rtx_ssrc_;
+  rate_ = RateController(rateSettings(s_), monoNowUs());
 }
 
 VideoSender::~VideoSender() { stop(); }
@@ -143,11 +172,17 @@ std::string VideoSender::apply(const SenderChange& c) {
     n.source.height = *c.height;
   }
   if (c.fps) n.source.fps = *c.fps;
-  if (c.bitrate_kbps) n.encoder.bitrate_kbps = *c.bitrate_kbps;
+  if (c.bitrate_kbps) {
+    n.encoder.bitrate_kbps = *c.bitrate_kbps;
+    n.adapt.min_kbps = std::min(n.adapt.min_kbps, *c.bitrate_kbps);
+    n.adapt.max_kbps = *c.bitrate_kbps;
+  }
   if (auto why = validate(n); !why.empty()) return why;
   const bool restart = n.source.width != s_.source.width || n.source.height != s_.source.height ||
-                       n.source.fps != s_.source.fps || n.encoder.bitrate_kbps != s_.encoder.bitrate_kbps;
+                       n.source.fps != s_.source.fps;
   if (restart) ++generation_;
+  // The operator's bitrate is the new ceiling and the rate in force (in place, no keyframe).
+  if (c.bitrate_kbps) rate_.setOperatorRate(monoNowUs(), *c.bitrate_kbps);
   if (n.enabled && !s_.enabled) keyframe_requested_ = true;
   s_ = n;
   wake_cv_.notify_all();
@@ -170,6 +205,19 @@ SenderStats VideoSender::stats() const {
   s.bitrate_kbps = s_.encoder.bitrate_kbps;
   s.source = s_.source.uri;
   s.port = s_.port;
+  const RateState& r = rate_.state();
+  const EncoderSettings e = adaptedEncoder(s_, r);
+  s.adapt = rate_.settings().enabled;
+  s.min_kbps = rate_.settings().min_kbps;
+  s.max_kbps = rate_.settings().max_kbps;
+  s.rate_kbps = r.kbps;
+  s.send_width = e.width;
+  s.send_height = e.height;
+  s.send_fps = e.fps;
+  s.rate_level = r.level;
+  s.rate_reason = r.reason;
+  s.rate_changed_us = r.changed_us;
+  s.rate_changes = r.changes;
   return s;
 }
 
@@ -247,6 +295,7 @@ void VideoSender::encodeLoop() {
   std::unique_ptr<H264Packetizer> packetizer;
   std::vector<std::vector<uint8_t>> packets;
   EncodedFrame out;
+  uint64_t skip_phase = 0;
   double window_ms = 0;
   int window_n = 0;
   Clock::time_point window_start = Clock::now();
@@ -261,11 +310,31 @@ void VideoSender::encodeLoop() {
     const uint64_t capture_us = slot_capture_us_;
     const uint32_t index = slot_index_;
     const uint64_t gen = slot_generation_;
-    const EncoderSettings es = effectiveEncoder(s_);
+    rate_.tick(monoNowUs());
+    const RateState rate = rate_.state();
+    const EncoderSettings es = adaptedEncoder(s_, rate);
+    const int source_width = s_.source.width, source_height = s_.source.height;
     const std::size_t mtu = s_.mtu;
     const bool current = gen == generation_;
+    // At a reduced frame rate, every fps-divisor-th picture only.
+    const int divisor = RateController::fpsDivisor(rate.level);
+    if (current && divisor > 1 && skip_phase++ % divisor != 0) {
+      ++st_.rate_skipped;
+      continue;
+    }
+    if (divisor == 1) skip_phase = 0;
     lk.unlock();
 
+    if (current && enc && gen == enc_generation &&
+        (es.width != enc->settings().width || es.height != enc->settings().height || es.fps != enc->settings().fps))
+      enc_generation = ~0ull;  // a new level: reopened with an IDR
+    if (current && enc && gen == enc_generation && es.bitrate_kbps != enc->settings().bitrate_kbps) {
+      try {
+        if (!enc->setBitrate(es.bitrate_kbps)) enc_generation = ~0ull;  // no in-place change: reopen
+      } catch (const VideoError& e) {
+        setError(e.what());
+      }
+    }
     if (current && (!enc || gen != enc_generation)) {
       try {
         enc.reset();
@@ -273,7 +342,8 @@ void VideoSender::encodeLoop() {
         enc_generation = gen;
         keyframe_requested_ = true;
         log::info(log::tag::kVideo, "encoder ", enc->codecName(), " ", es.width, "x", es.height, " @ ", es.fps, " fps, ",
-                  es.bitrate_kbps, " kbit/s, GOP ", es.gop, es.intra_refresh ? ", intra refresh" : "");
+                  es.bitrate_kbps, " kbit/s, GOP ", es.gop, es.intra_refresh ? ", intra refresh" : "",
+                  rate.changes > 0 ? " (rate adaptation: " + rate.reason + ")" : std::string());
       } catch (const VideoError& e) {
         enc.reset();
         setError(e.what());
@@ -284,6 +354,9 @@ void VideoSender::encodeLoop() {
     uint64_t bytes = 0, npackets = 0, send_errors = 0;
     double ms = 0;
     std::string send_error;
+    if (current && frame.cols == source_width && frame.rows == source_height &&
+        (frame.cols != es.width || frame.rows != es.height))
+      cv::resize(frame, frame, cv::Size(es.width, es.height), 0, 0, cv::INTER_AREA);
     if (current && enc && frame.cols == es.width && frame.rows == es.height) {
       const bool force = keyframe_requested_.exchange(false);
       const auto t0 = Clock::now();
@@ -387,6 +460,7 @@ void VideoSender::onFeedback(std::span<const uint8_t> datagram) {
     st_.error = std::string("video: RTCP from the receiver: ") + rtcp::toString(e);
     return;
   }
+  const uint64_t now_mono_us = monoNowUs();
   const uint32_t now_middle = rtcp::ntpMiddle(rtcp::ntpFromUnixMicros(wallNowNs() / 1000));
   std::optional<double> rtt_s, loss;
   uint64_t blocks = 0;
@@ -424,6 +498,7 @@ void VideoSender::onFeedback(std::span<const uint8_t> datagram) {
     if (p.media_ssrc == ssrc_) ++plis;
   if (plis) keyframe_requested_ = true;
   std::lock_guard lk(mu_);
+  if (loss) rate_.onReport(now_mono_us, *loss / 100.0, rtt_s ? std::optional<double>(*rtt_s * 1000.0) : std::nullopt);
   st_.receiver_reports += blocks;
   if (loss) st_.peer_loss_pct = *loss;
   if (rtt_s) st_.rtt_ms = *rtt_s * 1000.0;

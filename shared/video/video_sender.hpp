@@ -21,6 +21,7 @@
 
 #include "shared/video/frame_source.hpp"
 #include "shared/video/h264_codec.hpp"
+#include "shared/video/rate_controller.hpp"
 
 namespace inspect::video {
 
@@ -38,6 +39,10 @@ struct SenderSettings {
   bool retransmission = true;
   std::size_t history_packets = 1024;  // packets kept for retransmission; [0, 65536]
   double history_s = 1.0;              // ...and for at most this long; [0.01, 10]
+  /// Rate adaptation from the receiver reports (needs `retransmission`, the
+  /// RTCP path); its start rate is encoder.bitrate_kbps, its ceiling
+  /// max_kbps (0 = encoder.bitrate_kbps; the range always holds that rate).
+  RateSettings adapt{.max_kbps = 0};
 };
 
 /// Checks the settings (ranges, encoder settings); "" or the first problem.
@@ -70,6 +75,17 @@ struct SenderStats {
   double rtt_ms = -1;                // from the last report's LSR/DLSR; < 0 = none yet
   double encode_ms = 0;     // mean over the last second
   std::string error;        // last error, "" = none
+  // Rate adaptation (RateController): what the encoder does now.
+  bool adapt = false;
+  int min_kbps = 0, max_kbps = 0;
+  int rate_kbps = 0;        // bitrate in force
+  int send_width = 0, send_height = 0;
+  double send_fps = 0;      // frame rate in force (the source's, halved at level 1 and 2)
+  int rate_level = 0;
+  std::string rate_reason;  // why the rate or level last changed
+  uint64_t rate_changed_us = 0;  // when (monotonic clock)
+  uint64_t rate_changes = 0;
+  uint64_t rate_skipped = 0;     // captured frames left out at a reduced frame rate
 };
 
 /// A change of settings from the operator; unset fields stay.
@@ -119,6 +135,7 @@ class VideoSender {
   uint64_t slot_generation_ = 0;
   bool slot_full_ = false;
   SenderStats st_;            // guarded by mu_
+  RateController rate_;       // guarded by mu_
   std::atomic<bool> keyframe_requested_{false};
   std::atomic<bool> running_{false};
   uint32_t ssrc_;

@@ -63,4 +63,12 @@ TEST(ClientConfig, Video) {
             std::string::npos);
   EXPECT_NE(clientConfigError("video:\n  source: ''\n").find("video.source: must not be empty"), std::string::npos);
   EXPECT_NE(clientConfigError("video:\n  gopp: 3\n").find("video.gopp: unknown key"), std::string::npos);
+  EXPECT_TRUE(c.video.adapt);
+  EXPECT_EQ(c.video.adapt_min_kbps, 500);
+  EXPECT_EQ(c.video.adapt_max_kbps, 0);
+  EXPECT_NE(clientConfigError("video:\n  adapt:\n    min_kbps: 10\n").find("video.adapt.min_kbps: 10 is out of range"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("video:\n  adapt:\n    min_kbps: 500\n    max_kbps: 400\n")
+                .find("video.adapt.max_kbps: 400 is below min_kbps 500"),
+            std::string::npos);
 }

@@ -222,11 +222,11 @@ async function main() {
   // 2. A client that subscribes to every channel and decodes everything.
   const a = new Session("A");
   await a.opened;
-  await until(() => a.serverInfo && a.channels.size >= 8 && a.services.size > 0, 5000);
+  await until(() => a.serverInfo && a.channels.size >= 9 && a.services.size > 0, 5000);
   check(a.serverInfo && a.serverInfo.capabilities.includes("clientPublish") && a.serverInfo.capabilities.includes("services"),
         `serverInfo capabilities: ${JSON.stringify(a.serverInfo && a.serverInfo.capabilities)}`);
   check(a.serverInfo && a.serverInfo.sessionId, "serverInfo has no sessionId");
-  for (const t of ["telemetry", "events", "acks", "alarms", "camera", "tf", "scene", "log"])
+  for (const t of ["telemetry", "events", "acks", "alarms", "camera", "tf", "scene", "log", "video_stats"])
     check([...a.channels.values()].some((c) => c.topic === `/${robot}/${t}`), `no channel /${robot}/${t}`);
   for (const s of ["/stop", "/estop", "/resume", "/goto", "/route", "/inspect", "/record_start", "/record_stop",
                    "/control_take", "/control_release"])
@@ -268,6 +268,12 @@ async function main() {
   check(scn >= 5, `scene ${scn.toFixed(1)} Hz < 5`);
   check(a.decodeErrors === 0, `${a.decodeErrors} messages did not decode with their schema`);
   check(Object.keys(a.counts).some((t) => t.includes("/gas/")), "no gas grid received");
+  // The video path as a whole once a second: the robot's rate in force and the server's receive figures.
+  const vs = a.latest[`/${robot}/video_stats`];
+  figures.video_stats = vs ? { rate_kbps: vs.sender?.rate_kbps, rate_reason: vs.sender?.rate_reason,
+                               fps_decoded: vs.receiver?.fps_decoded, latency_p50_ms: vs.receiver?.latency_p50_ms } : null;
+  check(vs && vs.sender && vs.sender.rate_kbps > 0 && vs.sender.rate_reason, `video_stats: no sender rate (${JSON.stringify(vs)})`);
+  check(vs && vs.receiver && vs.receiver.fps_decoded > 0, `video_stats: no receiver figures (${JSON.stringify(vs)})`);
   const scene = a.latest[`/${robot}/scene`];
   const ids = scene ? scene.entities.map((e) => e.id) : [];
   figures.scene_entities = ids;

@@ -657,6 +657,34 @@ TEST_F(ConsoleTest, VideoStatsWithoutAServerStreamSaysSo) {
   EXPECT_HAS(out, "server: video off");
 }
 
+TEST_F(ConsoleTest, VideoStatsAndTheStatusLineShowTheRateInForceAndWhy) {
+  connectRobot();
+  v1::Telemetry t;
+  auto* v = t.mutable_video();
+  v->set_enabled(true);
+  v->set_adapt(true);
+  v->set_min_kbps(300);
+  v->set_max_kbps(2000);
+  v->set_rate_kbps(300);
+  v->set_send_width(640);
+  v->set_send_height(480);
+  v->set_send_fps(15);
+  v->set_rate_level(1);
+  v->set_rate_reason("loss 21.1 % > 10 %: x0.89; below 300 kbit/s: frame rate halved");
+  v->set_rate_age_s(1.5);
+  v->set_rate_changes(17);
+  v->set_peer_loss_pct(21.1);
+  v->set_rtt_ms(20.4);
+  registry_.onTelemetry("robot1", kSerial, t, now());
+  const auto [ok, out] = run("video stats");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_HAS(out, "robot rate: 300 kbit/s, 640x480 @ 15 fps (adapting in 300-2000 kbit/s, level 1); last change 1.5 s ago: "
+                  "loss 21.1 % > 10 %: x0.89; below 300 kbit/s: frame rate halved (17 changes)");
+  EXPECT_HAS(out, "robot feedback: receiver's loss 21.1 %, RTT 20.4 ms");
+  const std::string line = server::statusLine("robot1", registry_.snapshot("robot1", now()), nullptr);
+  EXPECT_HAS(line, "| rate 300 kbit/s 640x480@15 (loss 21.1 % > 10 %: x0.89; below 300 kbit/s: frame rate halved)");
+}
+
 TEST_F(ConsoleTest, RecordingCommandsWithoutARecorderSaySo) {
   connectRobot();
   for (const char* line : {"record start x", "runs", "run show 1"}) {

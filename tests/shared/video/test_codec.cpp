@@ -368,6 +368,35 @@ TEST(H264, ForcedKeyframeIsIdrMidGop) {
   expectParameterSetsFirst(c.frames[7], 7);
 }
 
+
+// Rate adaptation's path into libx264: a new bitrate takes effect from the
+// next frames without an IDR (rate control reconfigured in place).
+TEST(H264, BitrateChangesInPlaceWithoutAKeyframe) {
+  const EncoderSettings s = settings(640, 480, 3000, 300);
+  H264Encoder enc(s);
+  SyntheticSource src(s.width, s.height);
+  H264Decoder dec;
+  std::size_t before = 0, after = 0;
+  for (uint32_t i = 0; i < 90; ++i) {
+    if (i == 45) {
+      ASSERT_TRUE(enc.setBitrate(300));
+    }
+    cv::Mat bgr, out;
+    src.read(bgr, captureUs(i), i);
+    EncodedFrame f;
+    ASSERT_TRUE(enc.encode(bgr, captureUs(i), i, false, f)) << "frame " << i;
+    EXPECT_EQ(f.keyframe, i == 0) << "frame " << i;
+    ASSERT_TRUE(dec.decode(f.annexb.data(), f.annexb.size(), out)) << "frame " << i;
+    if (i >= 15 && i < 45) before += f.annexb.size();
+    if (i >= 60) after += f.annexb.size();
+  }
+  EXPECT_EQ(enc.settings().bitrate_kbps, 300);
+  // 30 frames each: about 3000 vs 300 kbit/s (12.5 kB vs 1.25 kB a frame).
+  EXPECT_LT(after * 4, before) << "before " << before << " after " << after;
+  EXPECT_GT(after, 30u * 300);  // still a picture: not starved
+  EXPECT_THROW(enc.setBitrate(20), VideoError);
+  EXPECT_EQ(dec.counters().errors, 0u);
+}
 TEST(H264, IntraRefreshHasOneIdrAndDecodes) {
   EncoderSettings s = settings(640, 480, 1500, 15);
   s.intra_refresh = true;

@@ -5,14 +5,19 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <algorithm>
 #include <map>
+#include <optional>
+#include <thread>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/udp.hpp>
 #include <poll.h>
 
 #include "shared/util/clock.hpp"
+#include "shared/video/h264_codec.hpp"
 #include "shared/video/rtcp.hpp"
+#include "shared/video/rtp_h264.hpp"
 #include "shared/video/rtx.hpp"
 #include "shared/video/video_sender.hpp"
 
@@ -158,4 +163,108 @@ TEST(SenderFeedback, GarbageOnTheFeedbackPathIsCountedNotFatal) {
   EXPECT_EQ(tx.stats().rtcp_errors, 3u);
   EXPECT_NE(tx.stats().error.find("RTCP"), std::string::npos);
   EXPECT_EQ(tx.stats().retransmitted, 0u);
+}
+
+// Rate adaptation end to end on the real sender: receiver reports of heavy
+// loss lower the bitrate in place (no keyframe), then halve the frame rate,
+// then the size (each a new IDR); clean reports bring back the size first,
+// then the frame rate. The stream is depacketized and decoded to see it.
+TEST(SenderFeedback, ReportsOfHeavyLossLowerTheRateThenTheFrameRateThenTheSizeAndCleanOnesUndoIt) {
+  Peer peer;
+  SenderSettings s = settings(peer.port());
+  s.source.width = 320;
+  s.source.height = 240;
+  s.encoder.bitrate_kbps = 1000;
+  s.adapt.min_kbps = 300;
+  s.adapt.level_hold_s = 0.3;
+  s.adapt.increase_per_s = 2.0;  // a fast climb back, so that the test is short
+  VideoSender tx(s);
+  tx.start();
+  H264Depacketizer depack;
+  H264Decoder dec;
+  struct Seen {
+    int level;
+    int width;
+    bool keyframe;
+    uint32_t ts;
+  };
+  std::vector<Seen> frames;
+  std::vector<std::pair<int, int>> rates;  // (kbps, level) after each report
+  std::vector<std::string> reasons;
+  std::optional<uint16_t> last_seq;
+  auto next_report = std::chrono::steady_clock::now() + std::chrono::milliseconds(300);
+  int reports = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
+  bool clean_phase = false, done = false;
+  for (int k = 0; k < 20000 && !done && std::chrono::steady_clock::now() < deadline; ++k) {
+    const auto d = peer.read();
+    if (!d.empty() && !rtcp::looksLikeRtcp(d)) {
+      RtpPacket p;
+      ASSERT_EQ(parseRtp(d, p), RtpError::kNone);
+      if (p.payload_type != kPayloadType) continue;
+      const uint32_t skipped = last_seq ? static_cast<uint16_t>(p.seq - *last_seq - 1) : 0;
+      last_seq = p.seq;
+      if (auto f = depack.push(p, skipped)) {
+        cv::Mat bgr;
+        if (dec.decode(f->annexb.data(), f->annexb.size(), bgr))
+          frames.push_back({tx.stats().rate_level, bgr.cols, f->keyframe, f->timestamp});
+      }
+    }
+    if (std::chrono::steady_clock::now() < next_report) continue;
+    next_report += std::chrono::milliseconds(100);
+    rtcp::ReportBlock b;
+    b.ssrc = tx.ssrc();
+    b.fraction_lost = clean_phase ? 0 : 102;  // 40 %: x0.8 a report
+    std::vector<uint8_t> fb;
+    rtcp::appendReceiverReport(fb, 0x5E55, std::span(&b, 1));
+    peer.send(fb);
+    ++reports;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    const SenderStats st = tx.stats();
+    rates.emplace_back(st.rate_kbps, st.rate_level);
+    if (reasons.empty() || reasons.back() != st.rate_reason) reasons.push_back(st.rate_reason);
+    if (!clean_phase && st.rate_level == 2) {
+      // Stay a while at the lowest level, then the link is clean again.
+      if (std::count_if(rates.begin(), rates.end(), [](auto r) { return r.second == 2; }) >= 8) clean_phase = true;
+    } else if (clean_phase && st.rate_level == 0 && st.rate_kbps >= 600) {
+      done = true;
+    }
+  }
+  tx.stop();
+  const SenderStats st = tx.stats();
+  ASSERT_TRUE(done) << "level " << st.rate_level << " rate " << st.rate_kbps << " after " << reports << " reports";
+  // The rate fell x0.8 a report while it stayed at full frame rate and size: 1000, 801, 641, 513, 411, 329.
+  ASSERT_GE(rates.size(), 6u);
+  EXPECT_EQ(rates[0], std::make_pair(801, 0));  // 102/256 lost: x0.8008
+  EXPECT_EQ(rates[4], std::make_pair(329, 0));
+  // Levels went 0 -> 1 -> 2 -> 1 -> 0, one step at a time.
+  std::vector<int> levels;
+  for (const auto& [kbps, level] : rates) {
+    EXPECT_GE(kbps, 300);
+    if (levels.empty() || levels.back() != level) levels.push_back(level);
+  }
+  EXPECT_EQ(levels, (std::vector<int>{0, 1, 2, 1, 0}));
+  // What was decoded: full size at levels 0 and 1, half at level 2; no
+  // keyframe for an in-place rate change, one for each level change.
+  int keyframes_at_level0_before_any_step = 0, small = 0, big_at_2 = 0;
+  bool stepped = false;
+  for (const auto& f : frames) {
+    stepped = stepped || f.level > 0;
+    if (!stepped && f.keyframe) ++keyframes_at_level0_before_any_step;
+    if (f.width == 160) ++small;
+    if (f.level == 2 && f.width == 320) ++big_at_2;
+  }
+  EXPECT_EQ(keyframes_at_level0_before_any_step, 1) << "only the first frame: rate changes are in place";
+  EXPECT_GT(small, 5);
+  EXPECT_LT(big_at_2, 3) << "frames in flight when the level changed";
+  EXPECT_GE(st.keyframes, 5u) << "the first, and one per level change";
+  EXPECT_GT(st.rate_skipped, 10u) << "half the frame rate at levels 1 and 2";
+  EXPECT_EQ(dec.counters().errors, 0u);
+  const auto said = [&](const char* what) {
+    return std::any_of(reasons.begin(), reasons.end(), [&](const std::string& r) { return r.find(what) != r.npos; });
+  };
+  EXPECT_TRUE(said("loss 39.8 % > 10 %: x0.80; below 300 kbit/s: frame rate halved"));
+  EXPECT_TRUE(said("size halved"));
+  EXPECT_TRUE(said("size restored"));
+  EXPECT_TRUE(said("frame rate restored"));
 }
