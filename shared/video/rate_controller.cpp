@@ -10,6 +10,11 @@ namespace inspect::video {
 using util::fmtFixed;
 using util::fmtShort;
 
+namespace {
+// Time since `then`; 0 when the clock reads earlier (reports and frames come from two threads).
+uint64_t since(uint64_t now_us, uint64_t then_us) { return now_us > then_us ? now_us - then_us : 0; }
+}  // namespace
+
 std::string validate(const RateSettings& s) {
   const auto range = [](const char* key, double v, double lo, double hi) -> std::string {
     if (v >= lo && v <= hi) return {};
@@ -40,7 +45,7 @@ void RateController::apply(uint64_t now_us, double target_kbps, const std::strin
   target_ = target_kbps;
   int level = st_.level;
   std::string reason = why;
-  const bool may_step = now_us - level_changed_us_ >= static_cast<uint64_t>(s_.level_hold_s * 1e6);
+  const bool may_step = since(now_us, level_changed_us_) >= static_cast<uint64_t>(s_.level_hold_s * 1e6);
   if (target_ < s_.min_kbps && level < s_.max_level && may_step) {
     ++level;
     reason += level == 1 ? "; below " + std::to_string(s_.min_kbps) + " kbit/s: frame rate halved"
@@ -65,7 +70,7 @@ void RateController::apply(uint64_t now_us, double target_kbps, const std::strin
 void RateController::onReport(uint64_t now_us, double loss_fraction, std::optional<double> rtt_ms) {
   if (!s_.enabled) return;
   const double p = std::clamp(loss_fraction, 0.0, 1.0);
-  const double dt_s = last_report_us_ == 0 ? 1.0 : std::clamp((now_us - last_report_us_) / 1e6, 0.0, 2.0);
+  const double dt_s = last_report_us_ == 0 ? 1.0 : std::min(static_cast<double>(since(now_us, last_report_us_)) / 1e6, 2.0);
   last_report_us_ = now_us;
   last_timeout_us_ = now_us;
   const std::string loss = "loss " + fmtFixed(100 * p, 1) + " %";
@@ -91,10 +96,10 @@ void RateController::onReport(uint64_t now_us, double loss_fraction, std::option
 void RateController::tick(uint64_t now_us) {
   if (!s_.enabled || last_report_us_ == 0) return;  // before the first report: the start rate
   const auto timeout = static_cast<uint64_t>(s_.report_timeout_s * 1e6);
-  if (now_us - last_timeout_us_ < timeout) return;
+  if (since(now_us, last_timeout_us_) < timeout) return;
   last_timeout_us_ = now_us;
   apply(now_us, target_ * 0.5,
-        "no receiver report for " + fmtFixed((now_us - last_report_us_) / 1e6, 1) + " s: x0.5");
+        "no receiver report for " + fmtFixed(static_cast<double>(since(now_us, last_report_us_)) / 1e6, 1) + " s: x0.5");
 }
 
 void RateController::setOperatorRate(uint64_t now_us, int kbps) {

@@ -7,7 +7,8 @@
 // Input: records (fuzz_records.hpp). tag % 8 == 7 flushes the reorder buffer
 // (a pause); tag % 8 == 6 is an RTCP datagram (shared/video/rtcp: reports,
 // NACK, PLI; what it parses to is rebuilt by the builders and parses back
-// the same); any other record is one RTP datagram (also wrapped as RFC 4588
+// the same; its report blocks drive the robot's rate adaptation, which stays
+// within its range and levels); any other record is one RTP datagram (also wrapped as RFC 4588
 // RTX and unwrapped: the same bytes). tag bit 3 picks the BGR
 // or the luma-only decode for the frames it completes; RTP records also feed
 // the NACK list and a sender's retransmission history (tag bit 4: a tail probe).
@@ -24,6 +25,7 @@
 
 #include "shared/util/log.hpp"
 #include "shared/video/h264_codec.hpp"
+#include "shared/video/rate_controller.hpp"
 #include "shared/video/rtcp.hpp"
 #include "shared/video/rtp_h264.hpp"
 #include "shared/video/rtx.hpp"
@@ -79,10 +81,28 @@ bool sameBlocks(const std::vector<rtcp::ReportBlock>& a, const std::vector<rtcp:
 }
 
 // An RTCP datagram: whatever parses is rebuilt and parses back the same.
-void checkRtcp(std::span<const uint8_t> d, rtcp::ReceiverStats& stats) {
+// The robot's rate adaptation fed every report block: it stays in its range and levels.
+void adapt(const rtcp::Compound& c, RateController& rate, uint64_t now_us) {
+  const auto feed = [&](const std::vector<rtcp::ReportBlock>& blocks) {
+    for (const auto& b : blocks) {
+      rate.onReport(now_us, b.fraction_lost / 256.0,
+                    b.dlsr % 3 == 0 ? std::nullopt : std::optional<double>((b.dlsr % 4096) / 8.0));
+      rate.tick(now_us + b.lsr % 5'000'000);
+      const RateState& st = rate.state();
+      FUZZ_CHECK(st.kbps >= rate.settings().min_kbps && st.kbps <= rate.settings().max_kbps);
+      FUZZ_CHECK(st.level >= 0 && st.level <= rate.settings().max_level);
+      FUZZ_CHECK(!st.reason.empty());
+    }
+  };
+  for (const auto& sr : c.sender_reports) feed(sr.blocks);
+  for (const auto& rr : c.receiver_reports) feed(rr.blocks);
+}
+
+void checkRtcp(std::span<const uint8_t> d, rtcp::ReceiverStats& stats, RateController& rate, uint64_t now_us) {
   rtcp::Compound c;
   const rtcp::RtcpError e = rtcp::parseCompound(d, c);
   FUZZ_CHECK(std::string(rtcp::toString(e)) != "?");
+  adapt(c, rate, now_us);
   std::vector<uint8_t> again;
   for (const auto& sr : c.sender_reports) {
     rtcp::appendSenderReport(again, sr.ssrc, sr.info, sr.blocks);
@@ -121,6 +141,7 @@ struct Receiver {
   std::vector<uint8_t> sps, pps;
   bool damaged = false;
   rtcp::ReceiverStats stats;
+  RateController rate;
   std::vector<std::pair<uint32_t, std::vector<uint8_t>>> ready;
   // Repair: the receiver's NACK list fed every sequence number (tail probes
   // on tag bit 4), answered from a sender's history of the same datagrams.
@@ -206,7 +227,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     if (r.tag % 8 == 7) {
       rx.reorder.flush(rx.ready);
     } else if (r.tag % 8 == 6) {
-      checkRtcp(r.body, rx.stats);
+      checkRtcp(r.body, rx.stats, rx.rate, rx.now_us);
       (void)rx.stats.report(1, r.body.size());
     } else {
       RtpPacket p;
