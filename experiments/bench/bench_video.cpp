@@ -66,7 +66,7 @@ constexpr const char* kUsage =
     "usage: bench_video [--seconds N] [--sizes WxH,...] [--fps F] [--bitrate-kbps K]\n"
     "                   [--warmup S] [--gst-threads LIST] [--json FILE]\n"
     "       bench_video --loss [--loss-pcts LIST] [--delays-ms LIST] [--no-burst] [--seed N]\n"
-    "                   [--intra-refresh] [--adapt 0|1] [same options]\n"
+    "                   [--intra-refresh] [--adapt 0|1] [--systems a,a0,b] [same options]\n"
     "Glass-to-glass latency (capture -> decoded picture, read from the time code in the\n"
     "picture) and CPU of (a) this system's VideoSender/VideoReceiver in two processes,\n"
     "(b) the same frames through GStreamer x264enc/rtph264pay/udpsink -> udpsrc/rtph264depay/\n"
@@ -81,7 +81,8 @@ constexpr const char* kUsage =
     "through a seeded UDP relay, both ways, at each --loss-pcts (default 0,1,5,10,20) and a burst case\n"
     "(--no-burst: without), at each --delays-ms one way (default 10,50); --seed N; first size only;\n"
     "--intra-refresh: libx264's periodic intra refresh instead of an IDR every second; --adapt 0: the\n"
-    "sender's rate adaptation off (default on).\n"
+    "sender's rate adaptation off (default on); --systems: which of (a), (a0), (b) run (default all;\n"
+    "(b) = GStreamer rtpbin + rtprtxsend/rtprtxreceive through gst_rtx_pipeline, built beside this).\n"
     "Internal: --role sender|receiver [--port P] [--max-seconds S] [--nack 0|1]: the two processes of (a).\n";
 
 // ---------------------------------------------------------------- (a) this system
@@ -358,6 +359,17 @@ std::vector<int> parseThreads(cli::ArgReader& a) {
   return out;
 }
 
+/// --systems a,a0,b: a non-empty subset, in the order given.
+std::vector<std::string> parseSystems(cli::ArgReader& a) {
+  std::vector<std::string> out;
+  for (const auto& t : a.list()) {
+    if (t != "a" && t != "a0" && t != "b") a.fail("'" + t + "' is not a, a0 or b");
+    out.push_back(t);
+  }
+  if (out.empty()) a.fail("no system");
+  return out;
+}
+
 /// A comma-separated list of numbers in [lo, hi].
 std::vector<double> parseNumbers(cli::ArgReader& a, double lo, double hi) {
   std::vector<double> out;
@@ -392,6 +404,7 @@ void parseArgs(int argc, char** argv, Options& o) {
     else if (a.is("--delays-ms")) o.delays_ms = parseNumbers(a, 0, 1000);
     else if (a.is("--no-burst")) o.burst = false;
     else if (a.is("--intra-refresh")) o.intra_refresh = true;
+    else if (a.is("--systems")) o.systems = parseSystems(a);
     else if (a.is("--adapt")) o.adapt = a.integer(0, 1) == 1;
     else if (a.is("--seed")) o.seed = static_cast<uint32_t>(a.unsignedInteger(UINT32_MAX));
     else a.unknown();

@@ -67,6 +67,7 @@ struct Options {
   uint32_t seed = 1;
   bool intra_refresh = false;  // libx264 periodic intra refresh instead of IDRs every GOP
   bool adapt = true;           // (a): rate adaptation on the sender
+  std::vector<std::string> systems{"a", "a0", "b"};  // --loss: which systems run
   // --role
   bool nack = true;  // receiver: NACK + RTX repair (off: keyframe requests only)
   std::string role;
@@ -263,6 +264,9 @@ class Child {
     return name_ + " (" + how() + ")" + (t.empty() ? "" : ": " + t);
   }
 
+  /// All it wrote on stderr so far (or before it was stopped).
+  std::string stderrText() const { return err_ >= 0 ? readErr() : stderr_text_; }
+
   std::function<double()> cpu() const {
     const pid_t p = pid_;
     return [p] { return processCpuSeconds(p); };
@@ -351,6 +355,14 @@ bool runLossSweep(const Options& o, const std::string& self, Json& out);
 /// (b) the frames through GStreamer (gst-launch-1.0 at `gst`), avdec_h264
 /// with `threads` (-1: its default).
 CaseResult runGstreamer(const Options& o, cv::Size sz, const std::string& gst, int threads);
+/// (b) of the loss sweep: the frames through GStreamer with retransmission
+/// (gst_rtx_pipeline at `tool`: rtpbin + rtprtxsend / rtprtxreceive, the
+/// jitter buffer's do-retransmission, AVPF), RTP and both RTCP directions
+/// each through a seeded UdpRelay with `link`'s loss and delay; the jitter
+/// buffer's latency `latency_ms`. Fills `run` like runThisSystem (capture
+/// times from the time code; ext_capture_us = capture_us when readable).
+CaseResult runGstreamerRtx(const Options& o, cv::Size sz, const std::string& tool, const test::UdpRelayParams& link,
+                           int latency_ms, PairRun* run);
 /// (p) the cost of (b)'s two pipes alone.
 CaseResult runPipeOverhead(const Options& o, cv::Size sz, const std::string& gst);
 /// (c) the in-process encode+decode floor.

@@ -164,6 +164,94 @@ CaseResult runGstreamer(const Options& o, cv::Size sz, const std::string& gst, i
   return r;
 }
 
+CaseResult runGstreamerRtx(const Options& o, cv::Size sz, const std::string& tool, const test::UdpRelayParams& link,
+                           int latency_ms, PairRun* run) {
+  CaseResult r{"gstreamer_rtx", "(b)", "(b) GStreamer rtpbin + RTX"};
+  if (tool.empty()) return failed(r, "gst_rtx_pipeline was not built (libgstreamer1.0-dev missing)");
+  // Three free ports: the receiver's RTP and RTCP, the sender's RTCP.
+  uint16_t rtp = 0, rtcp_rx = 0, rtcp_tx = 0;
+  for (int k = 0; k < 20 && (rtp == 0 || rtcp_rx == 0 || rtcp_tx == 0 || rtp == rtcp_rx || rtp == rtcp_tx ||
+                             rtcp_rx == rtcp_tx);
+       ++k) {
+    rtp = freeUdpPort();
+    rtcp_rx = freeUdpPort();
+    rtcp_tx = freeUdpPort();
+  }
+  if (rtp == 0 || rtcp_rx == 0 || rtcp_tx == 0) return failed(r, "no three free UDP ports on 127.0.0.1");
+  // One relay per direction and stream, each with the link's loss and delay (seeds apart).
+  std::optional<test::UdpRelay> media, reports, feedback;
+  try {
+    test::UdpRelayParams p = link;
+    media.emplace(rtp, p);
+    p.seed = link.seed + 1000;
+    reports.emplace(rtcp_rx, p);
+    p.seed = link.seed + 2000;
+    feedback.emplace(rtcp_tx, p);
+  } catch (const std::exception& e) {
+    return failed(r, e.what());
+  }
+  const std::string caps = "application/x-rtp,media=video,clock-rate=90000,encoding-name=H264,payload=96";
+  std::ostringstream recv, send;
+  recv << "rtpbin name=rtpbin latency=" << latency_ms << " do-retransmission=true rtp-profile=avpf"
+       << " udpsrc port=" << rtp << " caps=" << caps << " ! rtpbin.recv_rtp_sink_0"
+       << " rtpbin. ! rtph264depay request-keyframe=true ! avdec_h264 ! videoconvert ! video/x-raw,format=I420 ! fdsink fd=1 sync=false"
+       << " udpsrc port=" << rtcp_rx << " ! rtpbin.recv_rtcp_sink_0"
+       << " rtpbin.send_rtcp_src_0 ! udpsink host=127.0.0.1 port=" << feedback->port() << " sync=false async=false";
+  const std::size_t bytes = static_cast<std::size_t>(sz.area()) * 3 / 2;
+  send << "rtpbin name=rtpbin rtp-profile=avpf"
+       << " fdsrc fd=0 blocksize=" << bytes << " ! rawvideoparse width=" << sz.width << " height=" << sz.height
+       << " format=i420 framerate=" << fpsFraction(o.fps) << " ! x264enc tune=zerolatency speed-preset=ultrafast"
+       << " bitrate=" << o.bitrate_kbps << " key-int-max=" << gop(o)
+       << " ! rtph264pay config-interval=-1 pt=96 ! rtpbin.send_rtp_sink_0"
+       << " rtpbin.send_rtp_src_0 ! udpsink host=127.0.0.1 port=" << media->port() << " sync=false"
+       << " rtpbin.send_rtcp_src_0 ! udpsink host=127.0.0.1 port=" << reports->port() << " sync=false async=false"
+       << " udpsrc port=" << rtcp_tx << " ! rtpbin.recv_rtcp_sink_0";
+  r.detail = Json{{"sender_pipeline", send.str()}, {"receiver_pipeline", recv.str()}, {"latency_ms", latency_ms},
+                  {"receiver_session", "rtcp-min-interval=0"}};
+  Child rx, tx;
+  // The receiver's NACKs go out as soon as the jitter buffer asks (AVPF early
+  // feedback), not held back by the regular RTCP interval (5 s by default).
+  std::vector<std::string> rargs{tool, "--receive", "--session", "rtcp-min-interval=0"}, sargs{tool, "--send"};
+  for (auto& t : split(recv.str())) rargs.push_back(t);
+  for (auto& t : split(send.str())) sargs.push_back(t);
+  if (auto e = rx.start(rargs, false, true); !e.empty()) return failed(r, e);
+  const auto until = Clock::now() + toDuration(kStartTimeoutS);
+  while (!(udpPortBound(rtp) && udpPortBound(rtcp_rx)) && rx.alive() && Clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (!udpPortBound(rtp)) return failed(r, "the receiving pipeline did not bind its ports: " + rx.errorText());
+  if (auto e = tx.start(sargs, true, false); !e.empty()) return failed(r, e);
+  test::UdpRelay* m = &*media;
+  FeedResult f = feedAndRead(o, sz, tx, rx,
+                             {tx.cpu(), rx.cpu(), [m] { return static_cast<double>(m->counters().bytes_sent.load()); }});
+  tx.stop(2);  // stdin closed: EOS, exits by itself
+  rx.stop(0.5);
+  if (!f.w.error.empty()) return failed(r, f.w.error);
+  // The retransmission elements' counters: the last JSON line of each one's stderr.
+  const auto counters = [](const Child& c) {
+    std::istringstream is(c.stderrText());
+    Json j = Json::object();
+    for (std::string line; std::getline(is, line);)
+      if (!line.empty() && line.front() == '{') j = Json::parse(line, nullptr, false);
+    return j.is_discarded() ? Json::object() : j;
+  };
+  const Json sc = counters(tx), rc = counters(rx);
+  r.lat = summarize(f.recs, f.w.t0_us, f.w.t1_us);
+  r.detail["sender_rtx"] = sc;
+  r.detail["receiver_rtx"] = rc;
+  if (run) {
+    run->recs = f.recs;
+    for (auto& rec : run->recs) rec.ext_capture_us = rec.capture_us;
+    run->t0_us = f.w.t0_us;
+    run->t1_us = f.w.t1_us;
+    run->wire_kbps = f.w.cpu_pct.at(4) / 100.0 * 8.0 / 1000.0;
+    // The receiver's rtprtxreceive: requests it saw go upstream (NACKed) and RTX packets it associated (repaired).
+    run->receiver = Json{{"nacked_packets", rc.value("rtx_requests", 0u)},
+                         {"retransmissions", rc.value("rtx_assoc_packets", 0u)}, {"rtx", rc}};
+    run->sender = Json{{"rtx", sc}};
+  }
+  return r;
+}
+
 /// The cost of the two pipes of (b): raw frames through `fdsrc ! fdsink`,
 /// from the start of the write to the end of the read (no drawing).
 CaseResult runPipeOverhead(const Options& o, cv::Size sz, const std::string& gst) {
