@@ -259,6 +259,8 @@ void RobotApp::fillVideoStatus(v1::Telemetry& t) const {
   v->set_rtt_ms(s.rtt_ms);
   v->set_nacked_packets(s.nacked_packets);
   v->set_retransmitted(s.retransmitted);
+  v->set_repeat_nacks(s.repeat_nacks);
+  v->set_not_in_history(s.not_in_history);
 }
 
 void RobotApp::pumpOutbox() {

@@ -66,7 +66,7 @@ constexpr const char* kUsage =
     "usage: bench_video [--seconds N] [--sizes WxH,...] [--fps F] [--bitrate-kbps K]\n"
     "                   [--warmup S] [--gst-threads LIST] [--json FILE]\n"
     "       bench_video --loss [--loss-pcts LIST] [--delays-ms LIST] [--no-burst] [--seed N]\n"
-    "                   [--intra-refresh] [--adapt 0|1] [--systems a,a0,b] [same options]\n"
+    "                   [--intra-refresh] [--adapt 0|1] [--systems a,a0,b] [--gst-latency-ms N] [same options]\n"
     "Glass-to-glass latency (capture -> decoded picture, read from the time code in the\n"
     "picture) and CPU of (a) this system's VideoSender/VideoReceiver in two processes,\n"
     "(b) the same frames through GStreamer x264enc/rtph264pay/udpsink -> udpsrc/rtph264depay/\n"
@@ -82,7 +82,8 @@ constexpr const char* kUsage =
     "(--no-burst: without), at each --delays-ms one way (default 10,50); --seed N; first size only;\n"
     "--intra-refresh: libx264's periodic intra refresh instead of an IDR every second; --adapt 0: the\n"
     "sender's rate adaptation off (default on); --systems: which of (a), (a0), (b) run (default all;\n"
-    "(b) = GStreamer rtpbin + rtprtxsend/rtprtxreceive through gst_rtx_pipeline, built beside this).\n"
+    "(b) = GStreamer rtpbin + rtprtxsend/rtprtxreceive through gst_rtx_pipeline, built beside this;\n"
+    "its jitter buffer latency --gst-latency-ms, default 2 RTT + 30 ms).\n"
     "Internal: --role sender|receiver [--port P] [--max-seconds S] [--nack 0|1]: the two processes of (a).\n";
 
 // ---------------------------------------------------------------- (a) this system
@@ -405,6 +406,7 @@ void parseArgs(int argc, char** argv, Options& o) {
     else if (a.is("--no-burst")) o.burst = false;
     else if (a.is("--intra-refresh")) o.intra_refresh = true;
     else if (a.is("--systems")) o.systems = parseSystems(a);
+    else if (a.is("--gst-latency-ms")) o.gst_latency_ms = static_cast<int>(a.integer(1, 10000));
     else if (a.is("--adapt")) o.adapt = a.integer(0, 1) == 1;
     else if (a.is("--seed")) o.seed = static_cast<uint32_t>(a.unsignedInteger(UINT32_MAX));
     else a.unknown();

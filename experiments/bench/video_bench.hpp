@@ -68,6 +68,7 @@ struct Options {
   bool intra_refresh = false;  // libx264 periodic intra refresh instead of IDRs every GOP
   bool adapt = true;           // (a): rate adaptation on the sender
   std::vector<std::string> systems{"a", "a0", "b"};  // --loss: which systems run
+  int gst_latency_ms = 0;      // (b)'s jitter buffer latency; 0 = 2 RTT + 30 ms
   // --role
   bool nack = true;  // receiver: NACK + RTX repair (off: keyframe requests only)
   std::string role;

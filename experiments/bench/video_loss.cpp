@@ -185,7 +185,8 @@ bool runLossSweep(const Options& o, const std::string& self, Json& out) {
         std::fprintf(stderr, "bench_video --loss: %g ms, %s, %s ...\n", delay, lv.name.c_str(), row.system.c_str());
         PairRun run;
         // (b)'s jitter buffer waits 2 RTT + 30 ms: room for one retransmission and a retry.
-        const CaseResult c = sys == "(b)" ? runGstreamerRtx(o, sz, gst_tool, rc.link, gstLatencyMs(delay), &run)
+        const int latency = o.gst_latency_ms > 0 ? o.gst_latency_ms : gstLatencyMs(delay);
+        const CaseResult c = sys == "(b)" ? runGstreamerRtx(o, sz, gst_tool, rc.link, latency, &run)
                                           : runThisSystem(o, sz, self, &rc, &run);
         if (!c.error.empty()) {
           row.error = c.error;
@@ -204,15 +205,17 @@ bool runLossSweep(const Options& o, const std::string& self, Json& out) {
         rows.push_back(toJson(row));
       }
   std::printf("\n(a) = NACK + RTX repair + rate adaptation; (a0) = repair off, keyframe requests (RTCP PLI) only;\n"
-              "(b) = GStreamer: x264enc (same settings) ! rtph264pay ! rtpbin + rtprtxsend -> rtpbin\n"
-              "(do-retransmission, rtprtxreceive, AVPF, jitter buffer latency 2 RTT + 30 ms) ! rtph264depay !\n"
-              "avdec_h264 (depay request-keyframe=true), RTP and both RTCP directions through relays with the same loss and delay; its\n"
-              "pictures count when their time code reads (a concealed picture whose time code survived counts\n"
-              "as clean: (b)'s damage is not measured, its 'coarse' are pictures too damaged to read). lost = packets\n"
-              "never repaired (the receiver's depacketizer saw them missing). Targets (issue 39) at 10 %% loss,\n"
-              "10 ms one way: clean >= 97 %%, freeze p99 < 150 ms, g2g p99 < 2 RTT + 50 ms = 90 ms.\n");
+              "(b) = GStreamer: x264enc (same settings) ! rtph264pay ! rtpbin + rtprtxsend -> rtpbin with\n"
+              "rtprtxreceive (do-retransmission, AVPF, jitter buffer latency 2 RTT + 30 ms or --gst-latency-ms)\n"
+              "! rtph264depay request-keyframe=true ! avdec_h264; RTP and both RTCP directions through relays\n"
+              "with the same loss and delay. (b)'s pictures count when their time code reads: a concealed\n"
+              "picture whose time code survived counts as clean ((b)'s damage is not measured; its 'coarse'\n"
+              "are pictures too damaged to read). lost = packets never repaired (the receiver's depacketizer\n"
+              "saw them missing). Targets (issue 39) at 10 %% loss, 10 ms one way: clean >= 97 %%, freeze\n"
+              "p99 < 150 ms, g2g p99 < 2 RTT + 50 ms = 90 ms.\n");
   out = Json{{"size", sizeName(sz)},   {"fps", o.fps},         {"bitrate_kbps", o.bitrate_kbps},
              {"intra_refresh", o.intra_refresh}, {"adapt", o.adapt},
+             {"gst_latency_ms", o.gst_latency_ms > 0 ? Json(o.gst_latency_ms) : Json("2 RTT + 30 ms")},
              {"gop", gop(o)},          {"seconds", o.seconds}, {"warmup_s", o.warmup},
              {"seed", o.seed},         {"burst", {{"every_ms", kBurstEveryMs}, {"ms", kBurstMs}, {"drop", kBurstDrop}}},
              {"rows", rows}};

@@ -74,7 +74,9 @@ std::string videoReport(const std::string& robot_id, const std::optional<RobotSn
       line("robot feedback", "receiver's loss " + (v.peer_loss_pct() < 0 ? std::string("-") : fmtFixed(v.peer_loss_pct(), 1) + " %") +
                                  ", RTT " + (v.rtt_ms() < 0 ? std::string("-") : fmtFixed(v.rtt_ms(), 1) + " ms") +
                                  ", NACKed " + std::to_string(v.nacked_packets()) + ", retransmitted " +
-                                 std::to_string(v.retransmitted()));
+                                 std::to_string(v.retransmitted()) + ", repeat NACKs " +
+                                 std::to_string(v.repeat_nacks()) + ", not in history " +
+                                 std::to_string(v.not_in_history()));
     }
     if (!v.error().empty()) line("robot error", v.error());
   } else {

@@ -680,7 +680,8 @@ TEST_F(ConsoleTest, VideoStatsAndTheStatusLineShowTheRateInForceAndWhy) {
   EXPECT_TRUE(ok) << out;
   EXPECT_HAS(out, "robot rate: 300 kbit/s, 640x480 @ 15 fps (adapting in 300-2000 kbit/s, level 1); last change 1.5 s ago: "
                   "loss 21.1 % > 10 %: x0.89; below 300 kbit/s: frame rate halved (17 changes)");
-  EXPECT_HAS(out, "robot feedback: receiver's loss 21.1 %, RTT 20.4 ms");
+  EXPECT_HAS(out, "robot feedback: receiver's loss 21.1 %, RTT 20.4 ms, NACKed 0, retransmitted 0, repeat NACKs 0, "
+                  "not in history 0");
   const std::string line = server::statusLine("robot1", registry_.snapshot("robot1", now()), nullptr);
   EXPECT_HAS(line, "| rate 300 kbit/s 640x480@15 (loss 21.1 % > 10 %: x0.89; below 300 kbit/s: frame rate halved)");
 }
