@@ -172,16 +172,13 @@ std::string VideoSender::apply(const SenderChange& c) {
     n.source.height = *c.height;
   }
   if (c.fps) n.source.fps = *c.fps;
-  if (c.bitrate_kbps) {
-    n.encoder.bitrate_kbps = *c.bitrate_kbps;
-    n.adapt.min_kbps = std::min(n.adapt.min_kbps, *c.bitrate_kbps);
-    n.adapt.max_kbps = *c.bitrate_kbps;
-  }
+  if (c.bitrate_kbps) n.encoder.bitrate_kbps = *c.bitrate_kbps;
   if (auto why = validate(n); !why.empty()) return why;
   const bool restart = n.source.width != s_.source.width || n.source.height != s_.source.height ||
                        n.source.fps != s_.source.fps;
   if (restart) ++generation_;
-  // The operator's bitrate is the new ceiling and the rate in force (in place, no keyframe).
+  // The operator's bitrate is the new ceiling and the rate in force (in place,
+  // no keyframe); the controller holds the range from here on.
   if (c.bitrate_kbps) rate_.setOperatorRate(monoNowUs(), *c.bitrate_kbps);
   if (n.enabled && !s_.enabled) keyframe_requested_ = true;
   s_ = n;
@@ -311,13 +308,13 @@ void VideoSender::encodeLoop() {
     const uint32_t index = slot_index_;
     const uint64_t gen = slot_generation_;
     rate_.tick(monoNowUs());
-    const RateState rate = rate_.state();
-    const EncoderSettings es = adaptedEncoder(s_, rate);
+    const int level = rate_.state().level;  // the reason is read only when the encoder reopens
+    const EncoderSettings es = adaptedEncoder(s_, rate_.state());
     const int source_width = s_.source.width, source_height = s_.source.height;
     const std::size_t mtu = s_.mtu;
     const bool current = gen == generation_;
     // At a reduced frame rate, every fps-divisor-th picture only.
-    const int divisor = RateController::fpsDivisor(rate.level);
+    const int divisor = RateController::fpsDivisor(level);
     if (current && divisor > 1 && skip_phase++ % divisor != 0) {
       ++st_.rate_skipped;
       continue;
@@ -341,9 +338,13 @@ void VideoSender::encodeLoop() {
         enc = std::make_unique<H264Encoder>(es);
         enc_generation = gen;
         keyframe_requested_ = true;
+        std::string why;
+        {
+          std::lock_guard rl(mu_);
+          if (rate_.state().changes > 0) why = " (rate adaptation: " + rate_.state().reason + ")";
+        }
         log::info(log::tag::kVideo, "encoder ", enc->codecName(), " ", es.width, "x", es.height, " @ ", es.fps, " fps, ",
-                  es.bitrate_kbps, " kbit/s, GOP ", es.gop, es.intra_refresh ? ", intra refresh" : "",
-                  rate.changes > 0 ? " (rate adaptation: " + rate.reason + ")" : std::string());
+                  es.bitrate_kbps, " kbit/s, GOP ", es.gop, es.intra_refresh ? ", intra refresh" : "", why);
       } catch (const VideoError& e) {
         enc.reset();
         setError(e.what());
