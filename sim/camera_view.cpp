@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "shared/video/timecode.hpp"
+#include "sim/person_figure.hpp"
 
 namespace inspect::sim {
 
@@ -38,10 +39,6 @@ const cv::Vec3f kRail(62, 98, 136);
 const cv::Vec3f kSkirting(58, 60, 64);
 const cv::Vec3f kLineColour(24, 196, 232);  // yellow tape
 const cv::Vec3f kObstacles[] = {{72, 112, 160}, {150, 118, 84}, {84, 140, 104}, {128, 92, 140}, {96, 150, 170}};
-const cv::Vec3f kShirts[] = {{20, 120, 250}, {190, 96, 40}, {60, 150, 60}, {50, 50, 190}, {150, 70, 130}, {40, 170, 190}};
-const cv::Vec3f kTrousers[] = {{70, 50, 36}, {52, 52, 56}, {60, 80, 96}};
-const cv::Vec3f kSkins[] = {{130, 165, 215}, {96, 128, 178}, {70, 96, 140}};
-const cv::Vec3f kHair(28, 34, 44);
 
 template <class T, std::size_t N>
 const T& pick(const T (&table)[N], int i) {
@@ -83,6 +80,10 @@ CameraView::CameraView(const World& world, const config::CameraMount& mount, int
   if (width < 64 || height < 64 || width > 4096 || height > 4096)
     throw std::invalid_argument("camera view: size " + std::to_string(width) + "x" + std::to_string(height) +
                                 " outside [64, 4096]");
+  if (!(style.noise_sigma >= 0 && style.noise_sigma <= 50))
+    throw std::invalid_argument("camera view: noise_sigma " + std::to_string(style.noise_sigma) + " outside [0, 50]");
+  if (!(style.exposure_ms >= 0 && style.exposure_ms <= 100))
+    throw std::invalid_argument("camera view: exposure_ms " + std::to_string(style.exposure_ms) + " outside [0, 100]");
   f_ = (width / 2.0) / std::tan(mount.hfov_deg * kPi / 360.0);
   cx_ = width / 2.0;
   cy_ = height / 2.0;
@@ -153,6 +154,7 @@ void CameraView::render(const CameraScene& scene, uint64_t capture_us, uint32_t 
   castColumns(l);
   paintColumns(l, bgr);
   drawPeople(scene, l, bgr);
+  applySensor(scene, frame_index, bgr);
   drawCaption(scene, capture_us, frame_index, bgr);
   video::drawTimecode(bgr, capture_us, frame_index);
 }
@@ -405,7 +407,12 @@ void CameraView::paintColumns(const Lens& l, cv::Mat& bgr) {
 // People: a body (shirt, trousers with the legs apart, the arms hanging at
 // its sides) with rounded shoulders, a neck and a head with hair, shaded as a cylinder, farthest
 // first; in each column only the rows above what nearer hits painted.
+// People far to near, each drawn as a figure (sim/person_figure.hpp) into a
+// patch and laid into the picture below whatever walls and boxes stand
+// nearer in each column; a map of which person painted each pixel gives how
+// much of each was shown.
 void CameraView::drawPeople(const CameraScene& scene, const Lens& l, cv::Mat& bgr) {
+  drawn_.clear();
   struct Seen {
     double x, y;
     const PersonInView* p;
@@ -417,67 +424,109 @@ void CameraView::drawPeople(const CameraScene& scene, const Lens& l, cv::Mat& bg
     const double x = dot(d, l.fwd);
     if (x > p.radius_m * 0.5 + kNear_m) seen.push_back({x, dot(d, l.left), &p});
   }
+  if (seen.empty()) return;
   std::sort(seen.begin(), seen.end(), [](const Seen& a, const Seen& b) { return a.x > b.x; });
-  const double zc = mount_.z_m;
-  const double k_h = style_.person_height_m / 1.75;
+  owner_.create(height_, width_, CV_16SC1);
+  owner_.setTo(cv::Scalar(-1));
+  const cv::Rect frame(0, 0, width_, height_);
+  std::vector<double> full_area;
+  std::vector<int> lim(static_cast<std::size_t>(width_));
   for (const auto& s : seen) {
-    const double x = s.x;
-    const double rb = 0.8 * s.p->radius_m;  // half the shoulders' width
-    const double rh = 0.105 * k_h;          // head
-    const double uc = cx_ - f_ * s.y / x;
-    const double half = std::max(rb, rh) * f_ / x;
-    const int c0 = std::max(0, static_cast<int>(std::floor(uc - half)));
-    const int c1 = std::min(width_ - 1, static_cast<int>(std::ceil(uc + half)));
-    if (c0 > c1) continue;
-    const double b = brightness(std::hypot(x, s.y));
-    const cv::Vec3f& shirt = pick(kShirts, s.p->index);
-    const cv::Vec3f& trousers = pick(kTrousers, s.p->index);
-    const cv::Vec3f& skin = pick(kSkins, s.p->index / 2);
-    auto rowAt = [&](double z) { return toRow(l.horizon + f_ * (zc - z * k_h) / x); };
-    const int r_waist = rowAt(0.86), r_crotch = rowAt(0.76), r_feet = rowAt(0.0), r_neck = rowAt(1.53);
-    const int r_wrist = rowAt(0.84), r_hand = rowAt(0.72);
-    for (int col = c0; col <= c1; ++col) {
-      const double xs = ((col + 0.5) - uc) * x / f_;  // metres right of the centre
-      // Rows that hits nearer than the body's front leave free.
+    const PersonLook look = personLook(style_.look_seed, s.p->index);
+    const Vec2 to_cam = l.c - s.p->position;
+    const Vec2 facing = geometry::unitAt(s.p->heading_rad);
+    const double view = std::atan2(cross(to_cam, facing), dot(to_cam, facing));
+    const FigurePose pose = gaitAt(view, s.p->speed_m_s, s.p->walked_m, look.height_m);
+    const FigurePlacement at{cx_ - f_ * s.y / s.x, l.horizon, mount_.z_m, f_ / s.x};
+    PersonTruth t;
+    t.index = s.p->index;
+    t.distance_m = std::hypot(s.x, s.y);
+    t.bearing_rad = std::atan2(s.y, s.x);
+    t.view_rad = view;
+    t.feet_in_view = at.row(0.0) < height_ && at.row(0.0) >= 0;
+    t.head_in_view = at.row(look.height_m) >= 0 && at.row(look.height_m) < height_;
+    const cv::Rect2d bounds = figureBounds(look, pose, at);
+    const double light = brightness(t.distance_m);
+    // The whole figure's area and box, drawn small enough to be cheap (~200 rows).
+    const double k = std::min(1.0, 200.0 / std::max(1.0, bounds.height));
+    FigurePlacement small = at;
+    small.axis_col = (at.axis_col - bounds.x) * k;
+    small.horizon_row = (at.horizon_row - bounds.y) * k;
+    small.px_per_m = at.px_per_m * k;
+    const cv::Size small_size(static_cast<int>(std::ceil(bounds.width * k)) + 1,
+                              static_cast<int>(std::ceil(bounds.height * k)) + 1);
+    count_mask_.create(small_size, CV_8UC1);
+    count_mask_.setTo(0);
+    patch_.create(small_size, CV_8UC3);
+    drawFigure(look, pose, small, light, {0, 0}, patch_, count_mask_);
+    const cv::Rect figure_small = cv::boundingRect(count_mask_);
+    full_area.push_back(cv::countNonZero(count_mask_) / (k * k));
+    t.full_box = {bounds.x + figure_small.x / k, bounds.y + figure_small.y / k, figure_small.width / k,
+                  figure_small.height / k};
+    const cv::Rect clip = cv::Rect(static_cast<int>(std::floor(bounds.x)), static_cast<int>(std::floor(bounds.y)),
+                                   static_cast<int>(std::ceil(bounds.width)) + 1,
+                                   static_cast<int>(std::ceil(bounds.height)) + 1) & frame;
+    const int slot = static_cast<int>(drawn_.size());
+    drawn_.push_back(t);
+    if (clip.empty()) continue;
+    patch_.create(clip.size(), CV_8UC3);
+    patch_mask_.create(clip.size(), CV_8UC1);
+    patch_mask_.setTo(0);
+    drawFigure(look, pose, at, light, clip.tl(), patch_, patch_mask_);
+    const cv::Rect shape = cv::boundingRect(patch_mask_);
+    if (!shape.empty()) drawn_.back().box = shape + clip.tl();
+    // Rows that walls and boxes nearer than the body's front leave free, per column.
+    const double front = s.x - 0.15;
+    for (int col = clip.x; col < clip.x + clip.width; ++col) {
       const std::size_t base = static_cast<std::size_t>(col) * kMaxHits;
-      int lim = height_;
-      const double front = x - rb * 0.5;
-      for (int k = 0; k < hit_count_[static_cast<std::size_t>(col)]; ++k) {
-        if (hits_[base + static_cast<std::size_t>(k)].depth >= front) break;
-        lim = limit_[base + static_cast<std::size_t>(k)];
+      int lm = height_;
+      for (int h = 0; h < hit_count_[static_cast<std::size_t>(col)]; ++h) {
+        if (hits_[base + static_cast<std::size_t>(h)].depth >= front) break;
+        lm = limit_[base + static_cast<std::size_t>(h)];
       }
-      if (lim <= 0) continue;
-      auto span = [&](int r0, int r1, const cv::Vec3f& c, double k) {
-        paintSpan(bgr, col, r0, std::min(r1, lim), shade(c, k));
-      };
-      if (std::abs(xs) < rb) {
-        const double sn = xs / rb, cyl = std::sqrt(1 - sn * sn);
-        const double k = b * (0.42 + 0.58 * cyl) * (1.0 - 0.12 * sn);
-        const int r_shoulder = rowAt(1.40 + 0.07 * cyl);
-        if (std::abs(sn) > 0.72) {  // an arm hanging at the side, the hand below the sleeve
-          const bool edge = std::abs(sn) < 0.76;
-          span(r_shoulder, r_wrist, shirt, k * (edge ? 0.6 : 0.88));
-          span(r_wrist, r_hand, skin, k * 0.9);
-        } else {
-          span(r_shoulder, r_waist, shirt, k);
-          if (std::abs(xs) < 0.035 * k_h) {
-            span(r_waist, r_crotch, trousers, k);  // the legs apart below
-          } else {
-            span(r_waist, r_feet, trousers, k);
-          }
-        }
-        if (std::abs(xs) < 0.045 * k_h) span(r_neck, r_shoulder, skin, k * 0.85);
-      }
-      if (std::abs(xs) < rh) {
-        const double hc = std::sqrt(rh * rh - xs * xs);
-        const double k = b * (0.45 + 0.55 * hc / rh) * (1.0 - 0.12 * xs / rh);
-        const double zh = 1.63;
-        const int r_top = rowAt(zh + 1.12 * hc / k_h), r_hair = rowAt(zh + 0.35 * hc / k_h),
-                  r_chin = rowAt(zh - 1.12 * hc / k_h);
-        span(r_top, r_hair, kHair, k);
-        span(r_hair, r_chin, skin, k);
+      lim[static_cast<std::size_t>(col)] = lm;
+    }
+    for (int r = 0; r < clip.height; ++r) {
+      const int row = clip.y + r;
+      const uint8_t* m = patch_mask_.ptr<uint8_t>(r);
+      const cv::Vec3b* c = patch_.ptr<cv::Vec3b>(r);
+      cv::Vec3b* out = bgr.ptr<cv::Vec3b>(row) + clip.x;
+      int16_t* own = owner_.ptr<int16_t>(row) + clip.x;
+      for (int q = 0; q < clip.width; ++q) {
+        if (m[q] == 0 || row >= lim[static_cast<std::size_t>(clip.x + q)]) continue;
+        out[q] = c[q];
+        own[q] = static_cast<int16_t>(slot);
       }
     }
+  }
+  std::vector<double> shown(drawn_.size(), 0.0);
+  for (int r = 0; r < height_; ++r) {
+    const int16_t* own = owner_.ptr<int16_t>(r);
+    for (int c = 0; c < width_; ++c)
+      if (own[c] >= 0) shown[static_cast<std::size_t>(own[c])] += 1;
+  }
+  for (std::size_t i = 0; i < drawn_.size(); ++i)
+    drawn_[i].visible = full_area[i] > 0 ? std::min(1.0, shown[i] / full_area[i]) : 0.0;
+}
+
+// A real sensor: motion blur along the rows over the exposure, then noise
+// (a window of a fixed noise field, moved per picture: cheap and seeded).
+void CameraView::applySensor(const CameraScene& scene, uint32_t frame_index, cv::Mat& bgr) {
+  if (style_.exposure_ms > 0) {
+    const double px = f_ * std::abs(scene.yaw_rate_rad_s) * style_.exposure_ms * 1e-3;
+    const int k = std::min(width_ / 4, static_cast<int>(std::lround(px)));
+    if (k >= 2) cv::blur(bgr, bgr, cv::Size(k, 1), cv::Point(-1, -1), cv::BORDER_REPLICATE);
+  }
+  if (style_.noise_sigma > 0) {
+    if (noise_.empty()) {
+      noise_.create(2 * height_, 2 * width_, CV_16SC3);
+      cv::RNG rng(0x5EEDu ^ style_.look_seed);
+      rng.fill(noise_, cv::RNG::NORMAL, 0, style_.noise_sigma);
+    }
+    const uint64_t h = (frame_index + 1ull) * 0x9E3779B97F4A7C15ull;
+    const int ox = static_cast<int>((h >> 20) % static_cast<uint64_t>(width_));
+    const int oy = static_cast<int>((h >> 42) % static_cast<uint64_t>(height_));
+    cv::add(bgr, noise_(cv::Rect(ox, oy, width_, height_)), bgr, cv::noArray(), CV_8U);
   }
 }
 

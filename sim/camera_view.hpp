@@ -2,7 +2,9 @@
 // What the robot's PTZ camera sees in the simulated world, drawn as a BGR
 // picture: walls and obstacle faces (shaded by distance and by the angle they
 // are seen at), a tiled floor with the world's floor lines on it, a ceiling,
-// the pedestrians as upright figures, and along the top the machine-readable
+// the pedestrians as figures seen from the front, side or back with their
+// gait, heights and clothes (sim/person_figure.hpp), optionally sensor noise
+// and motion blur, and along the top the machine-readable
 // time code of shared/video/timecode.hpp with the frame counter and time as
 // text at the bottom (docs/simulator.md "Camera").
 //
@@ -33,7 +35,24 @@ namespace inspect::sim {
 struct PersonInView {
   Vec2 position;           // centre of the body circle, world frame (m)
   double radius_m = 0.25;  // body circle (the world file's radius_m)
-  int index = 0;           // the world file's pedestrian index (picks the clothes)
+  int index = 0;           // the world file's pedestrian index (picks their look)
+  double heading_rad = 0;  // where they face, world frame
+  double speed_m_s = 0;    // how fast they walk (the swing of the gait)
+  double walked_m = 0;     // how far they have walked (the phase of the gait)
+};
+
+/// Where a person was drawn, from the camera model: the truth that a
+/// detector's boxes are scored against (experiments/bench/bench_people).
+struct PersonTruth {
+  int index = 0;             // PersonInView::index
+  cv::Rect box;              // the whole figure's box, cut to the picture (empty when out of it)
+  cv::Rect2d full_box;       // the same, not cut
+  double distance_m = 0;     // lens to the body axis, on the floor
+  double bearing_rad = 0;    // of the body axis from the optical axis, left positive
+  double view_rad = 0;       // FigurePose::view_rad: 0 faces the camera, pi the back
+  double visible = 0;        // share of the figure's pixels shown (walls, boxes, people and the picture's edge hide the rest)
+  bool feet_in_view = false; // the lower foot's row is inside the picture
+  bool head_in_view = false; // the top of the head is inside the picture
 };
 
 /// One instant of the world's truth, as the camera shows it.
@@ -43,14 +62,20 @@ struct CameraScene {
   double tilt_rad = 0.0;             // up positive; clamped to +-80 degrees
   std::vector<PersonInView> people;  // the present pedestrians
   double sim_time_s = 0.0;           // shown in the caption
+  double yaw_rate_rad_s = 0.0;       // the camera's turn rate (robot + pan): motion blur
 };
 
 /// What the world file does not say: heights, and how quickly light falls off.
 struct CameraViewStyle {
   double wall_height_m = 2.6;      // walls reach the ceiling at this height
   double obstacle_height_m = 1.0;  // benches, boxes, shelves
-  double person_height_m = 1.75;
   double falloff_m = 9.0;          // brightness 0.3 + 0.7 exp(-distance / falloff_m)
+  uint32_t look_seed = 0;          // people's heights, builds and clothes (sim/person_figure.hpp)
+  // A real sensor (0 = off, a clean synthetic picture): Gaussian noise of this
+  // standard deviation in grey levels, and motion blur along the rows over
+  // the exposure while the camera turns (yaw_rate_rad_s x exposure, in pixels).
+  double noise_sigma = 0.0;
+  double exposure_ms = 0.0;
 };
 
 class CameraView {
@@ -72,6 +97,9 @@ class CameraView {
   std::optional<double> columnOf(const CameraScene& scene, Vec2 p) const;
   /// The row of the horizon (height of the lens, far away).
   double horizonRow(const CameraScene& scene) const;
+  /// The people of the last render(), nearest last, each with where they
+  /// were drawn and how much of them was shown (people behind the lens left out).
+  const std::vector<PersonTruth>& peopleDrawn() const { return drawn_; }
 
  private:
   struct Face {  // one wall segment or obstacle edge
@@ -97,6 +125,7 @@ class CameraView {
   void paintColumns(const Lens& l, cv::Mat& bgr);
   void drawPeople(const CameraScene& scene, const Lens& l, cv::Mat& bgr);
   void drawCaption(const CameraScene& scene, uint64_t capture_us, uint32_t frame_index, cv::Mat& bgr) const;
+  void applySensor(const CameraScene& scene, uint32_t frame_index, cv::Mat& bgr);
   double brightness(double distance_m) const;
 
   static constexpr int kMaxHits = 12;  // nearest hits kept per column
@@ -113,6 +142,10 @@ class CameraView {
   std::vector<int> hit_count_;    // per column
   std::vector<int> limit_;        // width x kMaxHits: top row painted once hit k is painted
   std::vector<int> painted_;      // per column: hits painted
+  std::vector<PersonTruth> drawn_;
+  cv::Mat owner_;                 // CV_16SC1: which drawn_ entry painted each pixel (-1: none)
+  cv::Mat patch_, patch_mask_, count_mask_;  // one figure's drawing
+  cv::Mat noise_;                 // CV_16SC3, 2x the picture: a window of it per picture
 };
 
 }  // namespace inspect::sim

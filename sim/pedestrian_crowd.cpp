@@ -19,6 +19,7 @@ PedestrianCrowd::PedestrianCrowd(const World& world, SimObserver* observer)
   owner_.reserve(n);
   scratch_.resize(n);
   circles_.reserve(n);
+  gait_.reserve(n);
   appear(0.0);
 }
 
@@ -51,6 +52,9 @@ void PedestrianCrowd::appear(double t_s) {
     agents_.push_back(a);
     owner_.push_back(i);
     circles_.push_back({s.route.front(), s.radius_m});
+    // Facing their route's second point until they walk.
+    const Vec2 next = s.route.size() > 1 ? s.route[1] : s.route.front();
+    gait_.push_back({0.0, s.route.size() > 1 ? std::atan2(next.y - s.route.front().y, next.x - s.route.front().x) : 0.0});
     if (started_) reportStart(i, t_s);
   }
 }
@@ -104,8 +108,15 @@ void PedestrianCrowd::step(double t_s, double dt_s, const behavior::Agent& robot
   reportInitial();
   for (std::size_t k = 0; k < agents_.size(); ++k) followRoute(owner_[k], t_s, dt_s);
   behavior::stepAgents(agents_, walls_, &robot, world_.social_force, dt_s, scratch_);
-  for (std::size_t k = 0; k < agents_.size(); ++k)
+  for (std::size_t k = 0; k < agents_.size(); ++k) {
+    const Eigen::Vector2d moved = Eigen::Vector2d(agents_[k].position_m.x(), agents_[k].position_m.y()) -
+                                  Eigen::Vector2d(circles_[k].centre.x, circles_[k].centre.y);
+    const double v = agents_[k].velocity_m_s.norm();
+    gait_[k].walked_m += moved.norm();
+    // Someone turns to where they walk; standing (or pushed slowly), they keep their facing.
+    if (v > 0.15) gait_[k].facing_rad = std::atan2(agents_[k].velocity_m_s.y(), agents_[k].velocity_m_s.x());
     circles_[k].centre = {agents_[k].position_m.x(), agents_[k].position_m.y()};
+  }
   appear(t_s + dt_s);
 }
 

@@ -39,6 +39,10 @@ class PedestrianCrowd {
   /// Body and motion of pedestrian i; meaningful only while present(i).
   const behavior::Agent& agent(std::size_t i) const { return agents_[progress_[i].slot]; }
   const PedestrianScript& script(std::size_t i) const { return world_.pedestrians[i]; }
+  /// How far pedestrian i has walked and where they face (world frame): the
+  /// camera draws their gait and their front, side or back from these.
+  double walkedM(std::size_t i) const { return gait_[progress_[i].slot].walked_m; }
+  double facingRad(std::size_t i) const { return gait_[progress_[i].slot].facing_rad; }
   /// Bodies of the present pedestrians, for the ultrasonic sensors.
   std::span<const Circle> circles() const { return circles_; }
 
@@ -65,6 +69,11 @@ class PedestrianCrowd {
   std::vector<std::size_t> owner_;       // script index of each agents_ slot
   std::vector<Eigen::Vector2d> scratch_;
   std::vector<Circle> circles_;          // parallel to agents_
+  struct Gait {
+    double walked_m = 0.0;
+    double facing_rad = 0.0;
+  };
+  std::vector<Gait> gait_;               // parallel to agents_
 };
 
 }  // namespace inspect::sim

@@ -8,7 +8,6 @@
 // max) and the thread's CPU time per picture. The target: the camera view at
 // 640x480 within 5 ms of CPU per picture. Not a test; the ctest smoke entry
 // runs --quick.
-#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -28,6 +27,7 @@
 #include "shared/config/config_node.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/util/cli_args.hpp"
+#include "shared/util/thread_cpu.hpp"
 #include "shared/video/frame_slot.hpp"
 #include "shared/video/frame_source.hpp"
 #include "sim/camera_view.hpp"
@@ -57,39 +57,22 @@ struct Case {
   double cpu_ms = 0;                          // thread CPU time per picture (mean)
 };
 
-double threadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) / 1e6;
-}
 
 // Warm-up (10 calls), then `frames` timed calls of body(k).
 Case timeFrames(const std::string& name, int w, int h, int frames, const std::function<void(int)>& body) {
   for (int k = 0; k < 10; ++k) body(k);
   std::vector<double> ms;
   ms.reserve(static_cast<std::size_t>(frames));
-  const double cpu0 = threadCpuMs();
+  const double cpu0 = util::threadCpuMs();
   for (int k = 0; k < frames; ++k) {
     const auto t0 = Clock::now();
     body(k);
     ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
   }
-  const double cpu = threadCpuMs() - cpu0;
+  const double cpu = util::threadCpuMs() - cpu0;
   std::sort(ms.begin(), ms.end());
   auto at = [&](double q) { return ms[std::min(ms.size() - 1, static_cast<std::size_t>(q * (ms.size() - 1) + 0.5))]; };
   return {name, w, h, frames, at(0.5), at(0.99), ms.back(), cpu / frames};
-}
-
-std::vector<cv::Size> parseSizes(cli::ArgReader& a) {
-  std::vector<cv::Size> out;
-  for (const auto& t : a.list()) {
-    int w = 0, h = 0;
-    char tail = 0;
-    if (std::sscanf(t.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 4096 || h > 4096)
-      a.fail("'" + t + "' is not WxH with W and H in [64, 4096]");
-    out.emplace_back(w, h);
-  }
-  return out;
 }
 
 // The scene of picture k of n: one turn of the robot, the camera panning.
@@ -101,9 +84,13 @@ sim::CameraScene sceneAt(const sim::World& world, int k, int n) {
   s.pan_rad = (kPi / 4) * std::sin(6 * kPi * k / n);
   s.tilt_rad = -0.1 * std::sin(2 * kPi * k / n);
   s.sim_time_s = k / 30.0;
+  s.yaw_rate_rad_s = 2 * kPi / (n / 30.0);  // one turn over the run at 30 fps
   for (std::size_t i = 0; i < world.pedestrians.size(); ++i) {
     const auto& r = world.pedestrians[i].route;
-    if (!r.empty()) s.people.push_back({r.front(), world.pedestrians[i].radius_m, static_cast<int>(i)});
+    // Walking on the spot at 1 m/s, turning: every view and gait phase is drawn.
+    if (!r.empty())
+      s.people.push_back({r.front(), world.pedestrians[i].radius_m, static_cast<int>(i), 4 * kPi * k / n, 1.0,
+                          0.033 * k});
   }
   return s;
 }
@@ -125,7 +112,8 @@ int main(int argc, char** argv) {
       frames = static_cast<int>(a.integer(10, 1000000));
       frames_given = true;
     } else if (a.is("--sizes")) {
-      sizes = parseSizes(a);
+      sizes.clear();
+      for (const auto& [w, h] : a.pictureSizes()) sizes.emplace_back(w, h);
     } else if (a.is("--world")) {
       world_path = a.path();
     } else if (a.is("--robot")) {
@@ -166,6 +154,16 @@ int main(int argc, char** argv) {
       view.render(scenes[static_cast<std::size_t>(k % frames)], 1000000ull + 33333ull * k, static_cast<uint32_t>(k),
                   frame);
     }));
+    // As bench_people draws it: sensor noise (3 grey levels) and motion blur (8 ms exposure).
+    sim::CameraViewStyle real;
+    real.noise_sigma = 3.0;
+    real.exposure_ms = 8.0;
+    sim::CameraView real_view(world, robot.camera, sz.width, sz.height, real);
+    cv::Mat real_frame;
+    cases.push_back(timeFrames("camera view, noise + blur " + tag, sz.width, sz.height, frames, [&](int k) {
+      real_view.render(scenes[static_cast<std::size_t>(k % frames)], 1000000ull + 33333ull * k,
+                       static_cast<uint32_t>(k), real_frame);
+    }));
     video::SyntheticSource synthetic(sz.width, sz.height);
     cv::Mat syn;
     cases.push_back(timeFrames("synthetic source " + tag, sz.width, sz.height, frames, [&](int k) {
@@ -200,7 +198,7 @@ int main(int argc, char** argv) {
               "%d pictures per case, one thread\n\n",
               world_path.c_str(), world.walls.size(), world.obstacles.size(), obstacle_edges,
               world.floor_lines.size(), world.pedestrians.size(), frames);
-  std::printf("%-34s %10s %10s %10s %14s %14s\n", "case", "p50 ms", "p99 ms", "max ms", "CPU ms/frame",
+  std::printf("%-40s %10s %10s %10s %14s %14s\n", "case", "p50 ms", "p99 ms", "max ms", "CPU ms/frame",
               "vs synthetic");
   auto synthetic_of = [&](const Case& c) {
     for (const auto& s : cases)
@@ -208,7 +206,7 @@ int main(int argc, char** argv) {
     return std::nan("");
   };
   for (const auto& c : cases)
-    std::printf("%-34s %10.3f %10.3f %10.3f %14.3f %13.2fx\n", c.name.c_str(), c.p50_ms, c.p99_ms, c.max_ms, c.cpu_ms,
+    std::printf("%-40s %10.3f %10.3f %10.3f %14.3f %13.2fx\n", c.name.c_str(), c.p50_ms, c.p99_ms, c.max_ms, c.cpu_ms,
                 c.cpu_ms / synthetic_of(c));
   std::printf("'vs synthetic' = this case's CPU time / the synthetic source's at the same size.\n");
   const Case* vga = nullptr;

@@ -126,6 +126,33 @@ std::vector<std::string> ArgReader::list() {
   return out;
 }
 
+namespace {
+bool parseSize(const std::string& t, std::pair<int, int>& out) {
+  int w = 0, h = 0;
+  char tail = 0;
+  if (std::sscanf(t.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 4096 || h > 4096) return false;
+  out = {w, h};
+  return true;
+}
+}  // namespace
+
+std::pair<int, int> ArgReader::pictureSize() {
+  const std::string v = path();
+  std::pair<int, int> out;
+  if (!parseSize(v, out)) fail("'" + v + "' is not WxH with W and H in [64, 4096]");
+  return out;
+}
+
+std::vector<std::pair<int, int>> ArgReader::pictureSizes() {
+  std::vector<std::pair<int, int>> out;
+  for (const auto& t : list()) {
+    std::pair<int, int> wh;
+    if (!parseSize(t, wh)) fail("'" + t + "' is not WxH with W and H in [64, 4096]");
+    out.push_back(wh);
+  }
+  return out;
+}
+
 void ArgReader::unknown() const {
   if (isPositional()) throw UsageError("unexpected argument '" + flag_ + "'");
   throw UsageError(flag_ + ": unknown option (see --help)");

@@ -24,6 +24,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace inspect::cli {
@@ -73,6 +74,10 @@ class ArgReader {
   std::string choice(std::initializer_list<std::string_view> choices);
   /// A comma list of non-empty items ("a,b,c"); an empty item is refused.
   std::vector<std::string> list();
+  /// A picture size "WxH", each side in [64, 4096] ("--sizes: '64x9' is not WxH ...").
+  std::pair<int, int> pictureSize();
+  /// A comma list of picture sizes ("640x480,320x240").
+  std::vector<std::pair<int, int>> pictureSizes();
 
   /// Throws "<flag>: unknown option (see --help)", or "unexpected argument 'x'"
   /// for a positional argument the program does not take.

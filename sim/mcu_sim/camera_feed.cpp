@@ -1,23 +1,16 @@
 #include "sim/mcu_sim/camera_feed.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 
 #include "shared/util/clock.hpp"
+#include "shared/util/thread_cpu.hpp"
 #include "shared/video/frame_slot.hpp"
 
 namespace inspect::sim {
 
 namespace {
-
-double threadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) / 1e6;
-}
 
 // Keep at most this many render times (an hour at 30 fps is 108 000).
 constexpr std::size_t kMaxSamples = std::size_t{1} << 20;
@@ -52,7 +45,8 @@ void CameraFeed::publish(const Simulation& sim) {
   for (std::size_t i = 0; i < crowd.size(); ++i) {
     if (!crowd.present(i)) continue;
     const auto& a = crowd.agent(i);
-    snapshot_.people.push_back({{a.position_m.x(), a.position_m.y()}, a.radius_m, static_cast<int>(i)});
+    snapshot_.people.push_back({{a.position_m.x(), a.position_m.y()}, a.radius_m, static_cast<int>(i),
+                                crowd.facingRad(i), a.velocity_m_s.norm(), crowd.walkedM(i)});
   }
 }
 
@@ -96,12 +90,12 @@ void CameraFeed::loop() {
     lk.unlock();
 
     const auto t0 = Clock::now();
-    const double cpu0 = threadCpuMs();
+    const double cpu0 = util::threadCpuMs();
     const uint64_t capture_us = monoNowUs();
     view_.render(scene, capture_us, index, frame);
     slot_->writer.write(frame.data, frame.step, capture_us, index);
     ++index;
-    const double cpu_ms = threadCpuMs() - cpu0;
+    const double cpu_ms = util::threadCpuMs() - cpu0;
     const auto t1 = Clock::now();
 
     next += period;

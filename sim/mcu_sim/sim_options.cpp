@@ -1,23 +1,9 @@
 #include "sim/mcu_sim/sim_options.hpp"
 
 #include <cstdio>
+#include <tuple>
 
 namespace inspect::sim {
-
-namespace {
-
-// "640x480", each side in [64, 4096].
-void readSize(cli::ArgReader& a, int& width, int& height) {
-  const std::string v = a.path();
-  int w = 0, h = 0;
-  char tail = 0;
-  if (std::sscanf(v.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 4096 || h > 4096)
-    a.fail("'" + v + "' is not WxH with W and H in [64, 4096]");
-  width = w;
-  height = h;
-}
-
-}  // namespace
 
 std::string simUsage() {
   return "usage: mcu_sim --world FILE [options]\n"
@@ -69,7 +55,7 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     else if (a.is("--realtime-priority")) o.realtime_priority = static_cast<int>(a.integer(0, 99));
     else if (a.is("--freeze-on-stall")) o.freeze_on_stall = true;
     else if (a.is("--camera")) o.camera_path = a.path();
-    else if (a.is("--camera-size")) readSize(a, o.camera_width, o.camera_height), camera_size = true;
+    else if (a.is("--camera-size")) std::tie(o.camera_width, o.camera_height) = a.pictureSize(), camera_size = true;
     else if (a.is("--camera-fps")) o.camera_fps = a.number(1.0, 120.0), camera_fps = true;
     else a.unknown();
   }

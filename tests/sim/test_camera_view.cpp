@@ -9,9 +9,11 @@
 #include <string>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "shared/video/timecode.hpp"
 #include "sim/camera_view.hpp"
+#include "sim/person_figure.hpp"
 #include "tests/sim/world_text.hpp"
 
 using namespace inspect;
@@ -123,20 +125,172 @@ TEST(CameraView, APersonAppearsInTheColumnOfTheirBearingStandingOnTheFloor) {
   const World empty;
   CameraScene with = atOrigin();
   with.people.push_back({{4.0, 1.5}, 0.25, 0});
-  const cv::Mat a = render(empty, atOrigin()), b = render(empty, with);
-  const Diff d = diff(a, b);
-  ASSERT_TRUE(d.any());
   CameraView view(empty, mount(), kW, kH);
+  cv::Mat b;
+  view.render(with, kCapture, kIndex, b);
+  const Diff d = diff(render(empty, atOrigin()), b);
+  ASSERT_TRUE(d.any());
   const double f = view.focalPx();
   const double x = 4.0 - 0.2, y = 1.5;  // from the lens: ahead, left
   const double expected_col = kW / 2.0 - f * y / x;
   EXPECT_NEAR(*view.columnOf(with, {4.0, 1.5}), expected_col, 1e-9);
+  // Facing +x (away from the camera), standing: symmetric about the body's axis.
   EXPECT_NEAR((d.col_min + d.col_max + 1) / 2.0, expected_col, 2.0);
-  // As wide as the shoulders (0.8 x radius each side), feet on the floor.
-  EXPECT_NEAR(d.col_max + 1 - d.col_min, 2 * 0.2 * f / x, 3.0);
+  const PersonLook look = personLook(0, 0);
+  // Shoulders and arms: about a quarter of the height wide; feet on the floor.
+  EXPECT_NEAR(d.col_max + 1 - d.col_min, 0.27 * look.height_m * look.build * f / x, 0.06 * look.height_m * f / x);
   EXPECT_NEAR(d.row_max + 0.5, kH / 2.0 + f * 0.6 / x, 1.5);
-  // A person 1.75 m tall: the head's top.
-  EXPECT_NEAR(d.row_min, kH / 2.0 + f * (0.6 - 1.75) / x, 3.0);
+  EXPECT_NEAR(d.row_min, kH / 2.0 + f * (0.6 - look.height_m) / x, 2.0) << "the top of the head at their height";
+  // The truth is the figure's box, as drawn.
+  ASSERT_EQ(view.peopleDrawn().size(), 1u);
+  const PersonTruth& t = view.peopleDrawn()[0];
+  EXPECT_EQ(t.box, cv::Rect(d.col_min, d.row_min, d.col_max + 1 - d.col_min, d.row_max + 1 - d.row_min));
+  EXPECT_NEAR(t.full_box.x, t.box.x, 2.0);
+  EXPECT_NEAR(t.full_box.height, t.box.height, 2.0);
+  EXPECT_NEAR(t.distance_m, std::hypot(x, y), 1e-9);
+  EXPECT_NEAR(t.bearing_rad, std::atan2(y, x), 1e-9);
+  EXPECT_GT(t.visible, 0.97);
+  EXPECT_TRUE(t.feet_in_view);
+  EXPECT_TRUE(t.head_in_view);
+}
+
+TEST(CameraView, PeopleAreSeenFromTheFrontTheSideOrTheBackAndWalkersSwingTheirLegs) {
+  const World empty;
+  // One person 5 m ahead; headings: towards the camera (pi), away (0), across (pi/2).
+  auto pictureOf = [&](double heading, double speed, double walked) {
+    CameraScene s = atOrigin();
+    s.people.push_back({{5.2, 0.0}, 0.25, 3, heading, speed, walked});
+    return render(empty, s);
+  };
+  const cv::Mat none = render(empty, atOrigin());
+  const cv::Mat front = pictureOf(kPi, 0, 0), back = pictureOf(0, 0, 0), side = pictureOf(kPi / 2, 0, 0);
+  const Diff df = diff(none, front), db = diff(none, back), ds = diff(none, side);
+  ASSERT_TRUE(df.any() && db.any() && ds.any());
+  const int wf = df.col_max - df.col_min, ws = ds.col_max - ds.col_min;
+  EXPECT_LT(ws, 0.8 * wf) << "from the side a person is narrower than from the front";
+  // Front and back have the same outline; the head differs (a face, or hair).
+  EXPECT_NEAR(db.col_max - db.col_min, wf, 2);
+  const int head_row = df.row_min + (df.row_max - df.row_min) / 14;  // the upper face
+  long differ = 0;
+  for (int c = df.col_min; c <= df.col_max; ++c) differ += front.at<cv::Vec3b>(head_row, c) != back.at<cv::Vec3b>(head_row, c);
+  EXPECT_GT(differ, 3) << "front and back differ at the face";
+  // Walking across the view: legs together at phase 0, apart a quarter cycle on.
+  const PersonLook look = personLook(0, 3);
+  const double cycle = 0.83 * look.height_m;
+  const cv::Mat together = pictureOf(kPi / 2, 1.4, 0.0), apart = pictureOf(kPi / 2, 1.4, cycle / 4);
+  auto feetWidth = [&](const cv::Mat& pic) {
+    const Diff d = diff(none, pic);
+    int c0 = kW, c1 = -1;
+    for (int r = d.row_max - 3; r <= d.row_max; ++r)
+      for (int c = 0; c < kW; ++c)
+        if (pic.at<cv::Vec3b>(r, c) != none.at<cv::Vec3b>(r, c)) c0 = std::min(c0, c), c1 = std::max(c1, c);
+    return c1 - c0;
+  };
+  EXPECT_GT(feetWidth(apart), feetWidth(together) + 8) << "a stride apart";
+  // Pure: the same gait phase gives the same picture.
+  EXPECT_EQ(cv::norm(apart, pictureOf(kPi / 2, 1.4, cycle / 4), cv::NORM_INF), 0);
+}
+
+TEST(CameraView, EachPersonLooksTheirOwnFromTheSeed) {
+  double sum = 0, sum2 = 0, lo = 9, hi = 0;
+  int shirts_differ = 0;
+  constexpr int kN = 400;
+  for (int i = 0; i < kN; ++i) {
+    const PersonLook a = personLook(7, i);
+    const PersonLook again = personLook(7, i);
+    EXPECT_EQ(a.height_m, again.height_m);
+    EXPECT_EQ(a.shirt, again.shirt);
+    sum += a.height_m;
+    sum2 += a.height_m * a.height_m;
+    lo = std::min(lo, a.height_m);
+    hi = std::max(hi, a.height_m);
+    EXPECT_GE(a.build, 0.85);
+    EXPECT_LE(a.build, 1.2);
+    shirts_differ += personLook(8, i).shirt != a.shirt;
+  }
+  const double mean = sum / kN, sd = std::sqrt(sum2 / kN - mean * mean);
+  EXPECT_NEAR(mean, 1.75, 0.02);
+  EXPECT_NEAR(sd, 0.09, 0.02);
+  EXPECT_GE(lo, 1.50);
+  EXPECT_LE(hi, 1.98);
+  EXPECT_GT(shirts_differ, kN / 2) << "another seed dresses people otherwise";
+}
+
+TEST(CameraView, TheTruthSaysHowMuchOfEachPersonIsShown) {
+  const World empty;
+  CameraView view(empty, mount(), kW, kH);
+  cv::Mat pic;
+  // One in front of another on the same bearing: the far one is mostly hidden.
+  CameraScene s = atOrigin();
+  s.people.push_back({{6.2, 0.0}, 0.25, 1});
+  s.people.push_back({{3.2, 0.0}, 0.25, 2});
+  view.render(s, kCapture, kIndex, pic);
+  ASSERT_EQ(view.peopleDrawn().size(), 2u);
+  const auto& far = view.peopleDrawn()[0];
+  const auto& near = view.peopleDrawn()[1];
+  EXPECT_EQ(far.index, 1) << "drawn far to near";
+  EXPECT_LT(far.visible, 0.35);
+  EXPECT_GT(near.visible, 0.97);
+  // Half out of the picture at its edge: about half shown, the box cut to the picture.
+  const double f = view.focalPx();
+  const double y_edge = 4.0 * (kW / 2.0) / f;  // the picture's left edge, 4 m from the lens
+  CameraScene edge = atOrigin();
+  edge.people.push_back({{4.2, y_edge}, 0.25, 1});
+  view.render(edge, kCapture, kIndex, pic);
+  ASSERT_EQ(view.peopleDrawn().size(), 1u);
+  EXPECT_NEAR(view.peopleDrawn()[0].visible, 0.5, 0.15);
+  EXPECT_EQ(view.peopleDrawn()[0].box.x, 0);
+  EXPECT_LT(view.peopleDrawn()[0].full_box.x, 0);
+  // Close up (1.5 m), the head is above the picture at tilt 0; tilted up 20 degrees it is in.
+  CameraScene close = atOrigin();
+  close.people.push_back({{1.7, 0.0}, 0.25, 1});
+  view.render(close, kCapture, kIndex, pic);
+  EXPECT_FALSE(view.peopleDrawn()[0].head_in_view);
+  EXPECT_TRUE(view.peopleDrawn()[0].feet_in_view);
+  close.tilt_rad = 20 * kPi / 180;
+  view.render(close, kCapture, kIndex, pic);
+  EXPECT_TRUE(view.peopleDrawn()[0].head_in_view);
+  // Behind the lens: not drawn, not in the truth.
+  CameraScene behind = atOrigin();
+  behind.people.push_back({{-2.0, 0.0}, 0.25, 1});
+  view.render(behind, kCapture, kIndex, pic);
+  EXPECT_TRUE(view.peopleDrawn().empty());
+}
+
+TEST(CameraView, SensorNoiseAndMotionBlurAreSeededAndLeaveTheTimeCodeReadable) {
+  const World w = wallAt(4.2);
+  CameraViewStyle real;
+  real.noise_sigma = 4.0;
+  CameraScene s = atOrigin();
+  const cv::Mat clean = render(w, s), noisy = render(w, s, kW, kH, real);
+  // Mean |noise| of a Gaussian is 0.8 sigma (a little less where it saturates).
+  cv::Mat d;
+  cv::absdiff(clean(cv::Rect(0, 60, kW, 300)), noisy(cv::Rect(0, 60, kW, 300)), d);
+  const double mean_abs = cv::mean(d)[0];
+  EXPECT_NEAR(mean_abs, 0.8 * 4.0, 0.5);
+  EXPECT_EQ(cv::norm(noisy, render(w, s, kW, kH, real), cv::NORM_INF), 0) << "seeded: the same picture again";
+  const auto code = video::readTimecode(noisy);
+  ASSERT_TRUE(code);
+  EXPECT_EQ(code->capture_us, kCapture);
+  // Motion blur: turning at 1 rad/s over 10 ms smears the panel seam (a vertical
+  // line straight ahead) over f x 0.01 = 5.5 pixels.
+  CameraViewStyle blur;
+  blur.exposure_ms = 10;
+  s.yaw_rate_rad_s = 1.0;
+  const cv::Mat sharp = render(w, s), smeared = render(w, s, kW, kH, blur);
+  auto strongestStep = [](const cv::Mat& pic, int row) {
+    int best = 0;
+    for (int c = 1; c < pic.cols; ++c)
+      best = std::max(best, std::abs(static_cast<int>(pic.at<cv::Vec3b>(row, c)[1]) - pic.at<cv::Vec3b>(row, c - 1)[1]));
+    return best;
+  };
+  EXPECT_LT(strongestStep(smeared, 150), strongestStep(sharp, 150) * 0.6);
+  CameraViewStyle bad;
+  bad.noise_sigma = -1;
+  EXPECT_THROW(CameraView(World{}, mount(), kW, kH, bad), std::invalid_argument);
+  bad = {};
+  bad.exposure_ms = 500;
+  EXPECT_THROW(CameraView(World{}, mount(), kW, kH, bad), std::invalid_argument);
 }
 
 TEST(CameraView, PeopleBehindAWallAreHiddenAndPeopleBehindALowBoxShowAboveIt) {

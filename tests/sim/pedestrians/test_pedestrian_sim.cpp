@@ -27,6 +27,7 @@ using namespace inspect::sim;
 namespace {
 
 using inspect::test::worldOf;
+constexpr double kPiOver2 = 1.57079632679489661923;
 
 
 struct Recorder : SimObserver {
@@ -109,6 +110,33 @@ TEST(PedestrianCrowd, AbsentBeforeStartThenWalksTheRouteAndStops) {
   ASSERT_EQ(crowd.circles().size(), 1u);
   EXPECT_DOUBLE_EQ(crowd.circles()[0].radius_m, 0.25);
   EXPECT_DOUBLE_EQ(crowd.circles()[0].centre.x, crowd.agent(0).position_m.x());
+}
+
+TEST(PedestrianCrowd, KeepsHowFarEachHasWalkedAndWhereTheyFaceForTheCamera) {
+  // Up the y axis, then back: the camera draws the gait from the distance walked and the
+  // front or back from the facing.
+  const World w = worldOf("pedestrians:\n  - {id: a, route_m: [0, 0, 0, 3, 0, 0]}\n", "peds.yaml");
+  PedestrianCrowd crowd(w);
+  EXPECT_NEAR(crowd.facingRad(0), kPiOver2, 1e-9) << "facing the route's second point before walking";
+  EXPECT_EQ(crowd.walkedM(0), 0.0);
+  behavior::Agent robot;
+  robot.position_m = {100, 100};
+  double walked_out = 0, facing_out = 0, y_out = 0;
+  for (int k = 0; k < 16000; ++k) {
+    crowd.step(k * 0.001, 0.001, robot);
+    if (k == 4000) {
+      walked_out = crowd.walkedM(0);
+      facing_out = crowd.facingRad(0);
+      y_out = crowd.agent(0).position_m.y();
+    }
+  }
+  EXPECT_NEAR(walked_out, y_out, 0.02) << "a straight walk: the distance walked is the distance from the start";
+  EXPECT_GT(walked_out, 1.5);
+  EXPECT_NEAR(facing_out, kPiOver2, 0.1) << "walking up: facing +y";
+  EXPECT_TRUE(crowd.finished(0));
+  EXPECT_NEAR(crowd.walkedM(0), 6.0, 0.6) << "there and back";
+  EXPECT_NEAR(std::abs(crowd.facingRad(0)), kPiOver2, 0.3) << "came back facing -y and kept it standing";
+  EXPECT_LT(crowd.facingRad(0), 0.0);
 }
 
 TEST(PedestrianCrowd, PausesAtAWaypoint) {

@@ -1,0 +1,604 @@
+// bench_people: how well the people detector (shared/perception) finds the
+// simulator's people, and what it costs. Seeded scenes in four of the
+// repository's worlds: the robot somewhere free, facing anywhere; 0-4 people
+// at 1-10 m within the field of view, facing anywhere, standing or walking
+// (gait), heights, builds and clothes varied (sim/person_figure.hpp), hidden
+// in part by walls, boxes and each other; sensor noise and motion blur on.
+// Truth boxes come from the camera model (sim::CameraView::peopleDrawn()).
+//
+// Per detector and picture size: recall and precision, false boxes per
+// picture, bearing error of the box centre, range error from the box's foot
+// row on a flat floor, ms per picture; recall by distance, bearing, share
+// visible and view (front, side, back). With --video FILE (Debian's
+// opencv-doc ships real pedestrians: /usr/share/doc/opencv-doc/examples/
+// data/vtest.avi) also detections per frame on real footage (no truth
+// there: look at --png's annotated frames). Not a test; ctest runs --quick.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "shared/config/config_node.hpp"
+#include "shared/config/robot_config.hpp"
+#include "shared/geometry/vec2.hpp"
+#include "shared/perception/people_detector.hpp"
+#include "shared/util/cli_args.hpp"
+#include "shared/util/thread_cpu.hpp"
+#include "shared/world/world.hpp"
+#include "sim/camera_view.hpp"
+#include "tests/support/paths.hpp"
+
+namespace {
+
+using namespace inspect;
+using Clock = std::chrono::steady_clock;
+using geometry::Vec2;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = 180.0 / kPi;
+
+constexpr const char* kUsage =
+    "usage: bench_people [--frames N] [--sizes WxH,...] [--detectors NAME,...] [--seed S] [--noise SIGMA]\n"
+    "                    [--exposure-ms MS] [--tilt-deg D] [--video FILE] [--video-frames N] [--threads N]\n"
+    "                    [--png DIR] [--quick] [--json FILE]\n"
+    "Runs the people detector on seeded simulator scenes with truth boxes and reports recall,\n"
+    "precision, false boxes per picture, bearing and range error, ms per picture, and recall by\n"
+    "distance, bearing, share visible and view. Detectors: hog (OpenCV's default 64x128 people\n"
+    "HOG, step 1.05, stride 8), hog-fast (step 1.2), hog-x2 (the picture doubled first; 320x240\n"
+    "and smaller only), daimler (48x96 HOG, threshold 0.5), haar-full and haar-upper (opencv-data's\n"
+    "cascades); NAME:thr=X:step=Y:up=Z:group=N tries other settings of one.\n"
+    "A box counts when its IoU with a truth box is >= 0.3; people less than 30 % visible are\n"
+    "neither missed nor found (a box on them is not false). Defaults: 300 pictures per case\n"
+    "(--quick: 24, 320x240 only, hog and haar-full), sizes 320x240,640x480, every detector,\n"
+    "seed 1, noise 3 grey levels, exposure 8 ms, camera tilt 0 (up positive), --video: opencv-doc's vtest.avi when installed,\n"
+    "120 frames of it; OpenCV on 1 thread (--threads). --png DIR writes annotated pictures (truth green, boxes red).\n";
+
+struct DetectorSpec {
+  std::string name;
+  perception::PeopleDetectorOptions opt;
+  int max_width = 4096;  // bigger pictures are left out (too slow to be of use)
+};
+
+std::vector<DetectorSpec> catalog() {
+  using perception::DetectorMethod;
+  std::vector<DetectorSpec> c;
+  perception::PeopleDetectorOptions o;
+  c.push_back({"hog", o});
+  o.scale_step = 1.2;
+  c.push_back({"hog-fast", o});
+  o = {};
+  o.upscale = 2.0;
+  c.push_back({"hog-x2", o, 320});
+  o = {};
+  o.method = DetectorMethod::HogDaimler;
+  o.hit_threshold = 0.5;
+  c.push_back({"daimler", o});
+  o = {};
+  o.method = DetectorMethod::HaarFullBody;
+  o.scale_step = 1.1;
+  o.group_threshold = 3;
+  c.push_back({"haar-full", o});
+  o.method = DetectorMethod::HaarUpperBody;
+  c.push_back({"haar-upper", o});
+  return c;
+}
+
+struct Frame {
+  const sim::World* world;
+  sim::CameraScene scene;
+};
+
+// A seeded scene: the robot in free space, 0-4 people in front of it.
+Frame makeScene(const std::vector<sim::World>& worlds, const config::CameraMount& mount, std::mt19937_64& rng, int k) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const sim::World& w = worlds[static_cast<std::size_t>(k) % worlds.size()];
+  Frame f{&w, {}};
+  const auto b = world::solidBounds(w);
+  const Vec2 lo = b ? b->lo : Vec2{-10, -10}, hi = b ? b->hi : Vec2{10, 10};
+  Vec2 at{w.start.x_m, w.start.y_m};
+  for (int tries = 0; tries < 200; ++tries) {
+    const Vec2 p{lo.x + (hi.x - lo.x) * u(rng), lo.y + (hi.y - lo.y) * u(rng)};
+    if (world::clearance(w, p) > 0.6) {
+      at = p;
+      break;
+    }
+  }
+  // Facing the open: the longest of a few sight lines (a camera against a wall sees no one).
+  double theta = 2 * kPi * u(rng), open_m = 0;
+  for (int tries = 0; tries < 8; ++tries) {
+    const double t = 2 * kPi * u(rng);
+    const double d = world::castRay(w, at, t, 12.0).value_or(12.0);
+    if (d > open_m) {
+      open_m = d;
+      theta = t;
+    }
+  }
+  f.scene.robot = {at.x, at.y, theta};
+  f.scene.sim_time_s = k / 30.0;
+  f.scene.yaw_rate_rad_s = u(rng) < 0.3 ? (u(rng) - 0.5) * 1.2 : 0.0;  // turning on the spot at up to 0.6 rad/s
+  const double c = std::cos(f.scene.robot.theta_rad), s = std::sin(f.scene.robot.theta_rad);
+  const Vec2 lens{at.x + c * mount.x_m, at.y + s * mount.x_m};
+  const int n = static_cast<int>(u(rng) * 5.0);  // 0..4
+  const double half_fov = mount.hfov_deg / 2 / kDeg;
+  for (int i = 0; i < n; ++i) {
+    for (int tries = 0; tries < 40; ++tries) {
+      const double d = 1.0 + 9.0 * u(rng);
+      const double bearing = (2 * u(rng) - 1) * (half_fov + 0.05);
+      const double yaw = f.scene.robot.theta_rad + bearing;
+      const Vec2 p = lens + d * geometry::unitAt(yaw);
+      if (world::clearance(w, p) < 0.3) continue;
+      // Most stand in the open; some anywhere (behind a wall: not counted).
+      const auto hit = world::castRay(w, lens, yaw, d + 0.3);
+      if (hit && u(rng) < 0.8) continue;
+      sim::PersonInView person;
+      person.position = p;
+      person.index = k * 8 + i;
+      person.heading_rad = 2 * kPi * u(rng);
+      person.speed_m_s = u(rng) < 0.6 ? 0.5 + 1.1 * u(rng) : 0.0;
+      person.walked_m = 10.0 * u(rng);
+      f.scene.people.push_back(person);
+      break;
+    }
+  }
+  return f;
+}
+
+
+double iou(const cv::Rect& a, const cv::Rect& b) {
+  const double i = (a & b).area();
+  const double un = a.area() + b.area() - i;
+  return un > 0 ? i / un : 0.0;
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
+}
+
+// Recall in bins of one quantity.
+struct Bins {
+  std::string name;
+  std::vector<double> edges;  // bin i: [edges[i], edges[i+1])
+  std::vector<std::string> labels;
+  std::vector<int> found, total;
+  void init() {
+    found.assign(labels.size(), 0);
+    total.assign(labels.size(), 0);
+  }
+  void add(double v, bool hit) {
+    for (std::size_t i = 0; i + 1 < edges.size(); ++i)
+      if (v >= edges[i] && v < edges[i + 1]) {
+        ++total[i];
+        if (hit) ++found[i];
+        return;
+      }
+  }
+};
+
+struct Case {
+  std::string detector, settings;
+  int width = 0, height = 0, frames = 0;
+  int truths = 0, found = 0, boxes = 0, false_boxes = 0;
+  std::vector<double> bearing_err_deg, range_err_pct, ms;
+  double cpu_ms = 0;
+  Bins by_distance{"distance m", {1, 2, 3, 4, 6, 8, 11}, {"1-2", "2-3", "3-4", "4-6", "6-8", "8-10"}, {}, {}};
+  Bins by_bearing{"|bearing| deg", {0, 10, 20, 40}, {"0-10", "10-20", "20-33"}, {}, {}};
+  Bins by_visible{"visible", {0.3, 0.6, 0.9, 1.01}, {"30-60%", "60-90%", "90-100%"}, {}, {}};
+  Bins by_view{"view", {0, 45, 135, 181}, {"front", "side", "back"}, {}, {}};
+  Bins by_motion{"motion", {0, 0.1, 10}, {"standing", "walking"}, {}, {}};
+  std::vector<Bins*> all() { return {&by_distance, &by_bearing, &by_visible, &by_view, &by_motion}; }
+  double recall() const { return truths ? static_cast<double>(found) / truths : NAN; }
+  double precision() const { return boxes ? static_cast<double>(boxes - false_boxes) / boxes : NAN; }
+};
+
+struct VideoCase {
+  std::string detector;
+  int width = 0, height = 0, frames = 0;
+  double boxes_per_frame = 0, frames_with_box_pct = 0;
+  std::vector<double> ms;
+};
+
+void drawBoxes(cv::Mat& pic, const std::vector<sim::PersonTruth>* truth, const std::vector<perception::PersonBox>& found) {
+  if (truth)
+    for (const auto& t : *truth)
+      if (!t.box.empty()) cv::rectangle(pic, t.box, t.visible >= 0.3 ? cv::Scalar(0, 220, 0) : cv::Scalar(0, 120, 0), 1);
+  for (const auto& d : found) cv::rectangle(pic, d.box, cv::Scalar(0, 0, 255), 2);
+}
+
+nlohmann::ordered_json numberOrNull(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr; }
+
+std::string cell(double v, const char* fmt) {
+  if (!std::isfinite(v)) return "-";
+  char b[32];
+  std::snprintf(b, sizeof b, fmt, v);
+  return b;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<cv::Size> sizes{{320, 240}, {640, 480}};
+  std::vector<std::string> wanted;
+  std::string json_path, png_dir, video_path;
+  bool video_given = false, quick = false, frames_given = false, sizes_given = false;
+  int frames = 300, video_frames = 120, threads = 1;
+  uint64_t seed = 1;
+  double noise = 3.0, exposure_ms = 8.0, tilt_deg = 0.0;
+  cli::readOrExit("bench_people", argc, argv, [&](cli::ArgReader& a) {
+    if (a.isHelp()) {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (a.is("--frames")) {
+      frames = static_cast<int>(a.integer(1, 100000));
+      frames_given = true;
+    } else if (a.is("--sizes")) {
+      sizes.clear();
+      for (const auto& [w, h] : a.pictureSizes()) sizes.emplace_back(w, h);
+      sizes_given = true;
+    } else if (a.is("--detectors")) {
+      wanted = a.list();
+    } else if (a.is("--seed")) {
+      seed = a.unsignedInteger(0xFFFFFFFFull);
+    } else if (a.is("--noise")) {
+      noise = a.number(0, 50);
+    } else if (a.is("--exposure-ms")) {
+      exposure_ms = a.number(0, 100);
+    } else if (a.is("--tilt-deg")) {
+      tilt_deg = a.number(-30, 30);
+    } else if (a.is("--video")) {
+      video_path = a.text();
+      video_given = true;
+    } else if (a.is("--video-frames")) {
+      video_frames = static_cast<int>(a.integer(0, 100000));
+    } else if (a.is("--threads")) {
+      threads = static_cast<int>(a.integer(1, 64));
+    } else if (a.is("--png")) {
+      png_dir = a.path();
+    } else if (a.is("--json")) {
+      json_path = a.path();
+    } else if (a.is("--quick")) {
+      quick = true;
+    } else {
+      a.unknown();
+    }
+  });
+  // One thread, as the robot gives it (OpenCV's HOG and cascades otherwise spread over every core).
+  cv::setNumThreads(threads);
+  if (quick) {
+    if (!frames_given) frames = 24;
+    if (!sizes_given) sizes = {{320, 240}};
+    if (wanted.empty()) wanted = {"hog", "haar-full"};
+    if (!video_given) video_frames = 0;
+  }
+  const std::string kVtest = "/usr/share/doc/opencv-doc/examples/data/vtest.avi";
+  if (!video_given && std::filesystem::exists(kVtest)) video_path = kVtest;
+
+  // NAME or NAME:key=value:... (thr, step, up, group) to try other settings of one detector.
+  std::vector<DetectorSpec> specs;
+  if (wanted.empty()) specs = catalog();
+  for (const auto& w : wanted) {
+    const std::string base = w.substr(0, w.find(':'));
+    const auto cat = catalog();
+    const auto it = std::find_if(cat.begin(), cat.end(), [&](const DetectorSpec& d) { return d.name == base; });
+    if (it == cat.end()) {
+      std::fprintf(stderr, "bench_people: --detectors: '%s' is not one of hog, hog-fast, hog-x2, daimler, haar-full, haar-upper\n",
+                   base.c_str());
+      return 2;
+    }
+    DetectorSpec d = *it;
+    d.name = w;
+    for (std::size_t at = w.find(':'); at != std::string::npos;) {
+      const std::size_t next = w.find(':', at + 1);
+      const std::string kv = w.substr(at + 1, next == std::string::npos ? std::string::npos : next - at - 1);
+      const std::size_t eq = kv.find('=');
+      char* end = nullptr;
+      const double v = eq == std::string::npos ? NAN : std::strtod(kv.c_str() + eq + 1, &end);
+      const std::string key = kv.substr(0, eq);
+      if (!std::isfinite(v) || (end && *end) ||
+          (key != "thr" && key != "step" && key != "up" && key != "group")) {
+        std::fprintf(stderr, "bench_people: --detectors: '%s' in '%s' is not thr=, step=, up= or group= with a number\n",
+                     kv.c_str(), w.c_str());
+        return 2;
+      }
+      if (key == "thr") d.opt.hit_threshold = v;
+      if (key == "step") d.opt.scale_step = v;
+      if (key == "up") d.opt.upscale = v;
+      if (key == "group") d.opt.group_threshold = static_cast<int>(v);
+      at = next;
+    }
+    specs.push_back(d);
+  }
+
+  std::vector<sim::World> worlds;
+  config::RobotConfig robot;
+  try {
+    for (const char* name : {"warehouse", "narrow_aisle", "gas_lab", "square_room"})
+      worlds.push_back(sim::loadWorldFile(test::srcPath(std::string("config/worlds/") + name + ".yaml")));
+    robot = config::loadRobotConfigFile(test::srcPath("config/robot.yaml"));
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "bench_people: %s\n", e.what());
+    return 2;
+  }
+  std::mt19937_64 rng(seed);
+  std::vector<Frame> scenes;
+  for (int k = 0; k < frames; ++k) {
+    scenes.push_back(makeScene(worlds, robot.camera, rng, k));
+    scenes.back().scene.tilt_rad = tilt_deg / kDeg;
+  }
+  if (!png_dir.empty()) std::filesystem::create_directories(png_dir);
+
+  sim::CameraViewStyle style;
+  style.look_seed = static_cast<uint32_t>(seed);
+  style.noise_sigma = noise;
+  style.exposure_ms = exposure_ms;
+
+  std::vector<Case> cases;
+  std::vector<std::string> pngs;
+  for (const auto& sz : sizes) {
+    // One view per world at this size.
+    std::vector<sim::CameraView> views;
+    for (const auto& w : worlds) views.emplace_back(w, robot.camera, sz.width, sz.height, style);
+    const double f = views.front().focalPx();
+    for (const auto& spec : specs) {
+      if (sz.width > spec.max_width) continue;
+      std::optional<perception::PeopleDetector> det;
+      try {
+        det.emplace(spec.opt);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_people: %s left out: %s\n", spec.name.c_str(), e.what());
+        continue;
+      }
+      std::fprintf(stderr, "bench_people: %s at %dx%d ...\n", spec.name.c_str(), sz.width, sz.height);
+      Case c;
+      c.detector = spec.name;
+      c.settings = perception::describe(spec.opt);
+      c.width = sz.width;
+      c.height = sz.height;
+      for (auto* b : c.all()) b->init();
+      cv::Mat pic;
+      double cpu = 0;
+      for (int k = 0; k < frames; ++k) {
+        const Frame& fr = scenes[static_cast<std::size_t>(k)];
+        auto& view = views[static_cast<std::size_t>(k) % worlds.size()];
+        view.render(fr.scene, 1000000ull + 33333ull * static_cast<uint64_t>(k), static_cast<uint32_t>(k), pic);
+        const auto& truth = view.peopleDrawn();
+        const auto t0 = Clock::now();
+        const double cpu0 = util::threadCpuMs();
+        const auto found = det->detect(pic);
+        cpu += util::threadCpuMs() - cpu0;
+        c.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+        ++c.frames;
+        // Greedy matching, strongest box first.
+        std::vector<std::size_t> order(found.size());
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return found[a].score > found[b].score; });
+        std::vector<bool> taken(truth.size(), false);
+        const double horizon = view.horizonRow(fr.scene);
+        for (const std::size_t i : order) {
+          const auto& d = found[i];
+          ++c.boxes;
+          double best = 0.3;
+          int who = -1;
+          for (std::size_t t = 0; t < truth.size(); ++t) {
+            if (taken[t] || truth[t].box.empty()) continue;
+            cv::Rect ref = truth[t].box;
+            if (d.upper_body) ref.height = std::max(1, static_cast<int>(std::lround(0.35 * truth[t].full_box.height)));
+            const double o = iou(d.box, ref);
+            if (o >= best) {
+              best = o;
+              who = static_cast<int>(t);
+            }
+          }
+          if (who < 0) {
+            ++c.false_boxes;
+            continue;
+          }
+          taken[static_cast<std::size_t>(who)] = true;
+          const auto& t = truth[static_cast<std::size_t>(who)];
+          if (t.visible < 0.3) continue;  // neither found nor false
+          const double col = d.box.x + d.box.width / 2.0;
+          const double bearing = std::atan((sz.width / 2.0 - col) / f);
+          c.bearing_err_deg.push_back(std::abs(bearing - t.bearing_rad) * kDeg);
+          const int bottom = d.box.y + d.box.height;
+          if (!d.upper_body && t.feet_in_view && bottom < sz.height - 1 && bottom - horizon > 2) {
+            const double depth = f * robot.camera.z_m / (bottom - horizon);
+            const double range = depth / std::cos(bearing);
+            c.range_err_pct.push_back(100.0 * std::abs(range - t.distance_m) / t.distance_m);
+          }
+        }
+        for (std::size_t t = 0; t < truth.size(); ++t) {
+          const auto& p = truth[t];
+          if (p.visible < 0.3 || p.box.empty()) continue;
+          ++c.truths;
+          if (taken[t]) ++c.found;
+          const bool hit = taken[t];
+          c.by_distance.add(p.distance_m, hit);
+          c.by_bearing.add(std::abs(p.bearing_rad) * kDeg, hit);
+          c.by_visible.add(p.visible, hit);
+          c.by_view.add(std::abs(p.view_rad) * kDeg, hit);
+          double speed = 0;
+          for (const auto& q : fr.scene.people)
+            if (q.index == p.index) speed = q.speed_m_s;
+          c.by_motion.add(speed, hit);
+        }
+        if (!png_dir.empty() && (k % std::max(1, frames / 4)) == 0 && &spec == &specs.front()) {
+          cv::Mat shown = pic.clone();
+          drawBoxes(shown, &truth, found);
+          const std::string file = png_dir + "/people_" + std::to_string(sz.width) + "x" + std::to_string(sz.height) +
+                                   "_" + spec.name + "_" + std::to_string(k) + ".png";
+          if (cv::imwrite(file, shown)) pngs.push_back(file);
+        }
+      }
+      c.cpu_ms = cpu / std::max(1, c.frames);
+      cases.push_back(std::move(c));
+    }
+  }
+
+  // Real footage: no truth, detections per frame.
+  std::vector<VideoCase> vcases;
+  if (!video_path.empty() && video_frames > 0) {
+    cv::VideoCapture cap(video_path);
+    std::vector<cv::Mat> clip;
+    cv::Mat m;
+    while (static_cast<int>(clip.size()) < video_frames && cap.read(m)) clip.push_back(m.clone());
+    if (clip.empty()) {
+      std::fprintf(stderr, "bench_people: --video %s: no frame could be read\n", video_path.c_str());
+      return 1;
+    }
+    for (const double scale : {1.0, 0.5}) {
+      for (const auto& spec : specs) {
+        if (spec.name == "hog-x2" && scale == 1.0) continue;
+        std::optional<perception::PeopleDetector> det;
+        try {
+          det.emplace(spec.opt);
+        } catch (const std::exception&) {
+          continue;
+        }
+        VideoCase v;
+        v.detector = spec.name;
+        int with_box = 0;
+        uint64_t boxes = 0;
+        for (std::size_t i = 0; i < clip.size(); ++i) {
+          cv::Mat in;
+          if (scale != 1.0)
+            cv::resize(clip[i], in, cv::Size(), scale, scale, cv::INTER_AREA);
+          else
+            in = clip[i];
+          v.width = in.cols;
+          v.height = in.rows;
+          const auto t0 = Clock::now();
+          const auto found = det->detect(in);
+          v.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+          boxes += found.size();
+          if (!found.empty()) ++with_box;
+          if (!png_dir.empty() && (i == 0 || i == clip.size() / 2)) {
+            cv::Mat shown = in.clone();
+            drawBoxes(shown, nullptr, found);
+            const std::string file = png_dir + "/vtest_" + std::to_string(in.cols) + "_" + spec.name + "_" +
+                                     std::to_string(i) + ".png";
+            if (cv::imwrite(file, shown)) pngs.push_back(file);
+          }
+        }
+        v.frames = static_cast<int>(clip.size());
+        v.boxes_per_frame = static_cast<double>(boxes) / v.frames;
+        v.frames_with_box_pct = 100.0 * with_box / v.frames;
+        vcases.push_back(std::move(v));
+      }
+    }
+  }
+
+  // Tables.
+  std::printf("bench_people: %d pictures per case, seed %llu, noise %.1f grey levels, exposure %.0f ms; worlds warehouse,\n"
+              "narrow_aisle, gas_lab, square_room; camera %.0f deg wide at %.2f m, tilt %+.0f deg; OpenCV threads %d\n\n",
+              frames, static_cast<unsigned long long>(seed), noise, exposure_ms, robot.camera.hfov_deg, robot.camera.z_m,
+              tilt_deg, threads);
+  std::printf("| size | detector | people | recall | precision | false / picture | bearing err p50 / p90 deg | "
+              "range err p50 / p90 %% | ms p50 / p90 | CPU ms |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const auto& c : cases)
+    std::printf("| %dx%d | %s | %d | %s | %s | %s | %s / %s | %s / %s | %s / %s | %.1f |\n", c.width, c.height,
+                c.detector.c_str(), c.truths, cell(100 * c.recall(), "%.1f %%").c_str(),
+                cell(100 * c.precision(), "%.1f %%").c_str(),
+                cell(static_cast<double>(c.false_boxes) / std::max(1, c.frames), "%.3f").c_str(),
+                cell(quantile(c.bearing_err_deg, 0.5), "%.2f").c_str(), cell(quantile(c.bearing_err_deg, 0.9), "%.2f").c_str(),
+                cell(quantile(c.range_err_pct, 0.5), "%.1f").c_str(), cell(quantile(c.range_err_pct, 0.9), "%.1f").c_str(),
+                cell(quantile(c.ms, 0.5), "%.1f").c_str(), cell(quantile(c.ms, 0.9), "%.1f").c_str(), c.cpu_ms);
+  if (!cases.empty()) {
+    Case& first = cases.front();
+    for (std::size_t b = 0; b < first.all().size(); ++b) {
+      const Bins& head = *first.all()[b];
+      std::printf("\nrecall by %s (found / people)\n| size | detector |", head.name.c_str());
+      for (const auto& l : head.labels) std::printf(" %s |", l.c_str());
+      std::printf("\n|---|---|");
+      for (std::size_t i = 0; i < head.labels.size(); ++i) std::printf("---|");
+      std::printf("\n");
+      for (auto& c : cases) {
+        const Bins& bn = *c.all()[b];
+        std::printf("| %dx%d | %s |", c.width, c.height, c.detector.c_str());
+        for (std::size_t i = 0; i < bn.labels.size(); ++i)
+          std::printf(" %s (%d/%d) |", cell(bn.total[i] ? 100.0 * bn.found[i] / bn.total[i] : NAN, "%.0f %%").c_str(),
+                      bn.found[i], bn.total[i]);
+        std::printf("\n");
+      }
+    }
+  }
+  if (!vcases.empty()) {
+    std::printf("\nreal footage: %s (%d frames; no truth: boxes per frame, frames with a box)\n"
+                "| size | detector | boxes / frame | frames with a box | ms p50 / p90 |\n|---|---|---|---|---|\n",
+                video_path.c_str(), vcases.front().frames);
+    for (const auto& v : vcases)
+      std::printf("| %dx%d | %s | %.2f | %.1f %% | %.1f / %.1f |\n", v.width, v.height, v.detector.c_str(), v.boxes_per_frame,
+                  v.frames_with_box_pct, quantile(v.ms, 0.5), quantile(v.ms, 0.9));
+  }
+  std::printf("\nrecall = people found / people at least 30 %% visible (IoU >= 0.3 with the figure's box; upper-body\n"
+              "boxes against its top 35 %%). bearing err: box centre column through the intrinsics against the\n"
+              "body axis. range err: the box's bottom row as the feet on a flat floor (lens height, horizon)\n"
+              "against the true distance, where the feet are in the picture.\n");
+  for (const auto& p : pngs) std::printf("picture: %s\n", p.c_str());
+
+  if (!json_path.empty()) {
+    nlohmann::ordered_json j;
+    j["pictures_per_case"] = frames;
+    j["seed"] = seed;
+    j["noise_sigma"] = noise;
+    j["exposure_ms"] = exposure_ms;
+    j["tilt_deg"] = tilt_deg;
+    j["opencv_threads"] = threads;
+    auto& jc = j["cases"];
+    jc = nlohmann::ordered_json::array();
+    for (auto& c : cases) {
+      nlohmann::ordered_json o{{"size", std::to_string(c.width) + "x" + std::to_string(c.height)},
+                               {"detector", c.detector},
+                               {"settings", c.settings},
+                               {"people", c.truths},
+                               {"found", c.found},
+                               {"boxes", c.boxes},
+                               {"false_boxes", c.false_boxes},
+                               {"recall", numberOrNull(c.recall())},
+                               {"precision", numberOrNull(c.precision())},
+                               {"false_per_picture", static_cast<double>(c.false_boxes) / std::max(1, c.frames)},
+                               {"bearing_err_deg_p50", numberOrNull(quantile(c.bearing_err_deg, 0.5))},
+                               {"bearing_err_deg_p90", numberOrNull(quantile(c.bearing_err_deg, 0.9))},
+                               {"range_err_pct_p50", numberOrNull(quantile(c.range_err_pct, 0.5))},
+                               {"range_err_pct_p90", numberOrNull(quantile(c.range_err_pct, 0.9))},
+                               {"ms_p50", numberOrNull(quantile(c.ms, 0.5))},
+                               {"ms_p90", numberOrNull(quantile(c.ms, 0.9))},
+                               {"cpu_ms", c.cpu_ms}};
+      for (auto* b : c.all()) {
+        auto& jb = o["recall_by_" + b->name];
+        for (std::size_t i = 0; i < b->labels.size(); ++i)
+          jb[b->labels[i]] = {{"found", b->found[i]}, {"people", b->total[i]}};
+      }
+      jc.push_back(std::move(o));
+    }
+    auto& jv = j["video"];
+    jv = nlohmann::ordered_json::array();
+    for (const auto& v : vcases)
+      jv.push_back({{"file", video_path},
+                    {"size", std::to_string(v.width) + "x" + std::to_string(v.height)},
+                    {"detector", v.detector},
+                    {"frames", v.frames},
+                    {"boxes_per_frame", v.boxes_per_frame},
+                    {"frames_with_box_pct", v.frames_with_box_pct},
+                    {"ms_p50", numberOrNull(quantile(v.ms, 0.5))},
+                    {"ms_p90", numberOrNull(quantile(v.ms, 0.9))}});
+    std::ofstream out(json_path);
+    out << j.dump(2) << "\n";
+    if (!out) {
+      std::fprintf(stderr, "bench_people: cannot write %s\n", json_path.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}
