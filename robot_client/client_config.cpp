@@ -87,6 +87,21 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   vp.adapt_max_kbps = static_cast<int>(ad.integer("max_kbps", vp.adapt_max_kbps, 0, 50000));
   if (vp.adapt_max_kbps != 0 && vp.adapt_max_kbps < vp.adapt_min_kbps)
     ad.fail("max_kbps", std::to_string(vp.adapt_max_kbps) + " is below min_kbps " + std::to_string(vp.adapt_min_kbps));
+  const auto pe = root.optChild("perception");
+  auto& pp = c.perception;
+  pp.enabled = pe.boolean("enabled", pp.enabled);
+  pp.detector = pe.oneOf("detector", pp.detector, {"hog", "hog-daimler", "haar-fullbody", "haar-upperbody"});
+  pp.width = static_cast<int>(pe.integer("width", pp.width, 64, 4096));
+  pp.height = static_cast<int>(pe.integer("height", pp.height, 64, 4096));
+  pp.rate_hz = pe.number("rate_hz", pp.rate_hz, 0.1, 30);
+  pp.max_core_share = pe.number("max_core_share", pp.max_core_share, 0.05, 1.0);
+  pp.hit_threshold = pe.number("hit_threshold", pp.hit_threshold, -1.0, 3.0);
+  pp.group_threshold = static_cast<int>(pe.integer("group_threshold", pp.group_threshold, 0, 20));
+  pp.stale_s = pe.number("stale_s", pp.stale_s, 0.1, 10);
+  pp.ahead_deg = pe.number("ahead_deg", pp.ahead_deg, 1, 90);
+  pp.look_ahead = pe.boolean("look_ahead", pp.look_ahead);
+  pp.look_ahead_within_m = pe.number("look_ahead_within_m", pp.look_ahead_within_m, 0.5, 20);
+  pp.look_ahead_hold_s = pe.number("look_ahead_hold_s", pp.look_ahead_hold_s, 0, 60);
   return c;
 }
 

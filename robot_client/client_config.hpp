@@ -31,6 +31,24 @@ struct VideoParams {
   int adapt_max_kbps = 0;            // ceiling; 0 = bitrate_kbps
 };
 
+/// People detection on the camera's pictures (docs/human-awareness.md,
+/// "Detection on the robot"); becomes client::WatcherSettings.
+struct PerceptionParams {
+  bool enabled = true;               // runs when the video source can show people (not "synthetic")
+  std::string detector = "hog";      // hog | hog-daimler | haar-fullbody | haar-upperbody
+  int width = 640;                   // the picture is resized to this before detection
+  int height = 480;
+  double rate_hz = 5.0;              // detections per second at most
+  double max_core_share = 0.5;       // ...and never more than this share of one core
+  double hit_threshold = 0.0;        // HOG's SVM margin
+  int group_threshold = 2;           // windows that must agree
+  double stale_s = 1.0;              // detections older than this are not reported (sonar only)
+  double ahead_deg = 15.0;           // the camera counts as looking ahead within this pan
+  bool look_ahead = true;            // turn the camera ahead while people are near and the robot moves
+  double look_ahead_within_m = 4.0;  // ...a tracked person this near
+  double look_ahead_hold_s = 3.0;    // ...and give the PTZ back this long after nobody is near or it stops
+};
+
 /// Mutual TLS on the link (docs/security.md); relative paths are from the working directory.
 struct TlsParams {
   bool plaintext = false;            // only from --plaintext, never from a file
@@ -64,6 +82,7 @@ struct ClientConfig {
   int realtime_priority = 10;
   robot::SafetyParams safety;
   VideoParams video;
+  PerceptionParams perception;
   TlsParams tls;
   EventsParams events;
   std::string map_file;  // world file whose walls people tracking ignores ("" = no map); --map overrides

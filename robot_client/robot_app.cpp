@@ -42,6 +42,23 @@ video::SenderSettings senderSettings(const ClientConfig& cfg) {
   return s;
 }
 
+// A source that can show people: a camera, a file, the simulator's camera (not the synthetic test picture).
+bool showsPeople(const std::string& source) { return source != "synthetic"; }
+
+WatcherSettings watcherSettings(const PerceptionParams& p, const config::CameraMount& mount) {
+  WatcherSettings w;
+  if (!perception::parseDetectorMethod(p.detector, w.detector.method))
+    throw std::invalid_argument("perception.detector: '" + p.detector + "' is not known");
+  w.detector.hit_threshold = p.hit_threshold;
+  w.detector.group_threshold = p.group_threshold;
+  w.width = p.width;
+  w.height = p.height;
+  w.rate_hz = p.rate_hz;
+  w.max_core_share = p.max_core_share;
+  w.mount = mount;
+  return w;
+}
+
 v1::Ack ack(uint64_t id, v1::Ack::Status status, const std::string& reason = {}) {
   v1::Ack a;
   a.set_command_id(id);
@@ -77,6 +94,20 @@ RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::
     video_ = std::make_unique<video::VideoSender>(senderSettings(cfg));
   } catch (const video::VideoError& e) {
     log::error("video", e.what(), ": no video stream");
+  }
+  if (video_ && cfg.perception.enabled && showsPeople(cfg.video.source)) {
+    try {
+      watcher_ = std::make_unique<PeopleWatcher>(watcherSettings(cfg.perception, robot.camera));
+      video_->setPictureTap([w = watcher_.get()](const cv::Mat& bgr, uint64_t us) { w->offer(bgr, us); });
+      log::info("perception", "people detector ", watcher_->stats().detector, " at ", cfg.perception.width, "x",
+                cfg.perception.height, ", at most ", cfg.perception.rate_hz, " Hz and ",
+                cfg.perception.max_core_share * 100, " % of a core");
+    } catch (const std::exception& e) {
+      log::error("perception", e.what(), ": people are seen by the sonars only");
+      watcher_.reset();
+    }
+  } else if (cfg.perception.enabled && video_) {
+    log::info("perception", "video source ", cfg.video.source, " shows no people: no detection (sonars only)");
   }
 }
 
@@ -119,6 +150,7 @@ void RobotApp::start() {
   tick10ms();
   sendTelemetry();
   mcuHeartbeat();
+  if (watcher_) watcher_->start();
   if (video_) video_->start();
 }
 
@@ -127,6 +159,7 @@ void RobotApp::stop() {
   telemetry_timer_.cancel();
   mcu_hb_timer_.cancel();
   if (video_) video_->stop();
+  if (watcher_) watcher_->stop();
   // Leave the motors commanded to zero before going.
   if (serial_.isOpen()) sendWheels(serial::WheelCommand{});
   link_.stop();
@@ -193,11 +226,26 @@ v1::Ack RobotApp::onVideoCommand(const v1::Command& cmd) {
 }
 
 v1::Ack RobotApp::onPtzCommand(const v1::Command& cmd) {
-  if (const std::string why = applyPtz(cmd.ptz()); !why.empty()) return ack(cmd.id(), v1::Ack::REJECTED, why);
+  if (const std::string why = sendPtz(cmd.ptz()); !why.empty()) return ack(cmd.id(), v1::Ack::REJECTED, why);
+  // The operator points the camera: the look-ahead yields until nobody is near.
+  if (looking_ahead_) {
+    looking_ahead_ = false;
+    look_ahead_yielded_ = true;
+    log::info("perception", "the operator moved the camera: looking ahead for people yields");
+  }
   return ack(cmd.id(), v1::Ack::ACCEPTED);
 }
 
 std::string RobotApp::applyPtz(const v1::Ptz& p) {
+  // A route's camera preset while the camera looks ahead for people: given back afterwards.
+  if (looking_ahead_) {
+    ptz_before_look_ = p;
+    return "";
+  }
+  return sendPtz(p);
+}
+
+std::string RobotApp::sendPtz(const v1::Ptz& p) {
   if (!std::isfinite(p.pan_rad()) || !std::isfinite(p.tilt_rad()) || std::abs(p.pan_rad()) > M_PI ||
       std::abs(p.tilt_rad()) > M_PI / 2)
     return "ptz: pan must be within [-pi, pi] and tilt within [-pi/2, pi/2] rad";
@@ -213,7 +261,79 @@ std::string RobotApp::applyPtz(const v1::Ptz& p) {
     ptz_tilt_rad_ = p.tilt_rad();
   }
   serial_.send(c);
+  if (watcher_) watcher_->setPtz(ptz_pan_rad_, ptz_tilt_rad_);
   return "";
+}
+
+void RobotApp::lookAhead(double now_s) {
+  if (!watcher_ || !cfg_.perception.look_ahead) return;
+  const auto near = core_.nearestPersonM();
+  const auto tw = core_.commandedTwist();
+  const bool moving = std::abs(tw.v_m_s) > 0.02 || std::abs(tw.w_rad_s) > 0.1;
+  const bool want = near && *near <= cfg_.perception.look_ahead_within_m && moving;
+  if (want) look_last_s_ = now_s;
+  const bool held = now_s - look_last_s_ <= cfg_.perception.look_ahead_hold_s;
+  if (!held) look_ahead_yielded_ = false;
+  const bool ahead = std::abs(ptz_pan_rad_) <= cfg_.perception.ahead_deg * M_PI / 180 && std::abs(ptz_tilt_rad_) < 0.1;
+  if (want && !looking_ahead_ && !look_ahead_yielded_ && !ahead) {
+    ptz_before_look_.Clear();
+    ptz_before_look_.set_pan_rad(ptz_pan_rad_);
+    ptz_before_look_.set_tilt_rad(ptz_tilt_rad_);
+    v1::Ptz level;  // straight ahead, level
+    if (sendPtz(level).empty()) {
+      looking_ahead_ = true;
+      log::info("perception", "a person ", *near, " m away while moving: the camera looks ahead");
+    }
+  } else if (looking_ahead_ && !held) {
+    looking_ahead_ = false;
+    if (const auto why = sendPtz(ptz_before_look_); !why.empty())
+      log::warn("perception", "giving the camera back: ", why);
+    else
+      log::info("perception", "nobody near: the camera goes back to pan ", ptz_before_look_.pan_rad(), " tilt ",
+                ptz_before_look_.tilt_rad(), " rad");
+  }
+}
+
+void RobotApp::fillPerception(v1::Telemetry& t) const {
+  if (!watcher_) {
+    t.clear_perception();
+    return;
+  }
+  auto* p = t.mutable_perception();
+  const WatcherStats st = watcher_->stats();
+  p->set_detector(st.detector);
+  p->set_rate_hz(st.rate_hz);
+  p->set_detect_ms(st.detect_ms);
+  p->set_detections(st.detections);
+  p->set_error(st.error);
+  p->set_looking_ahead(looking_ahead_);
+  p->clear_people();
+  const auto view = watcher_->latest();
+  const uint64_t now_us = monoNowUs();
+  const bool fresh = view && now_us < view->capture_us + static_cast<uint64_t>(cfg_.perception.stale_s * 1e6);
+  const bool ahead = std::abs(ptz_pan_rad_) <= cfg_.perception.ahead_deg * M_PI / 180 && std::abs(ptz_tilt_rad_) <= M_PI / 6;
+  p->set_mode(!fresh ? v1::SONAR_ONLY : ahead ? v1::CAMERA_AND_SONAR : v1::CAMERA_ELSEWHERE);
+  if (!view) return;
+  p->set_capture_us(view->capture_us);
+  p->set_width(static_cast<uint32_t>(view->width));
+  p->set_height(static_cast<uint32_t>(view->height));
+  p->set_pan_rad(view->pan_rad);
+  p->set_tilt_rad(view->tilt_rad);
+  if (!fresh) return;
+  for (const auto& s : view->people) {
+    auto* q = p->add_people();
+    q->set_bearing_rad(s.at.bearing_rad);
+    if (s.at.range_m) {
+      q->set_range_m(*s.at.range_m);
+      q->set_x_m(s.at.x_m);
+      q->set_y_m(s.at.y_m);
+    }
+    q->set_score(s.box.score);
+    q->set_box_x(static_cast<uint32_t>(s.box.box.x));
+    q->set_box_y(static_cast<uint32_t>(s.box.box.y));
+    q->set_box_w(static_cast<uint32_t>(s.box.box.width));
+    q->set_box_h(static_cast<uint32_t>(s.box.box.height));
+  }
 }
 
 void RobotApp::fillVideoStatus(v1::Telemetry& t) const {
@@ -329,10 +449,12 @@ void RobotApp::tick10ms() {
 }
 
 void RobotApp::sendTelemetry() {
+  lookAhead(now());
   core_.setSerialCounters(serial_.rxCounters(), serial_.bytesTx(), serial_.framesTx());
   if (link_.isUp()) {
     core_.fillTelemetry(*telemetry_env_.mutable_telemetry(), now());
     fillVideoStatus(*telemetry_env_.mutable_telemetry());
+    fillPerception(*telemetry_env_.mutable_telemetry());
     fillOutboxStatus(*telemetry_env_.mutable_telemetry());
     link_.send(telemetry_env_);
   }

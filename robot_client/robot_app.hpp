@@ -10,6 +10,7 @@
 
 #include "robot_client/client_config.hpp"
 #include "robot_client/event_outbox.hpp"
+#include "robot_client/people_watcher.hpp"
 #include "shared/robot/robot_core.hpp"
 #include "robot_client/serial_link.hpp"
 #include "robot_client/server_link.hpp"
@@ -51,6 +52,12 @@ class RobotApp {
   /// Sends a camera set-point to the MCU; "" or why not.
   std::string applyPtz(const v1::Ptz& p);
   void fillVideoStatus(v1::Telemetry& t) const;
+  void fillPerception(v1::Telemetry& t) const;
+  /// Turns the camera ahead while a tracked person is near and the robot
+  /// moves, and gives the PTZ back look_ahead_hold_s after (perception.look_ahead).
+  void lookAhead(double now_s);
+  /// Sends a set-point to the MCU and tells the people watcher; "" or why not.
+  std::string sendPtz(const v1::Ptz& p);
 
   boost::asio::io_context& io_;
   ClientConfig cfg_;
@@ -66,6 +73,11 @@ class RobotApp {
   std::FILE* cmd_log_ = nullptr;
   std::unique_ptr<video::VideoSender> video_;  // null when the stream could not be set up
   double ptz_pan_rad_ = 0, ptz_tilt_rad_ = 0;
+  std::unique_ptr<PeopleWatcher> watcher_;  // null: no detection (off, no video, a synthetic source)
+  bool looking_ahead_ = false;       // the camera was turned ahead for people
+  bool look_ahead_yielded_ = false;  // the operator moved the camera: not again until nobody is near
+  double look_last_s_ = -1e9;        // last time people were near while moving
+  v1::Ptz ptz_before_look_;          // the set-point to give back
   v1::Envelope telemetry_env_;  // reused to avoid reallocating repeated fields
   std::vector<robot::CoreEvent> events_;  // flushEvents' buffer, swapped with the core's
   // Sensor frame read -> its wheel command handed to the serial port

@@ -132,7 +132,7 @@ CameraView::Lens CameraView::lens(const CameraScene& scene) const {
   const Vec2 at{r.x_m + c * mount_.x_m - s * mount_.y_m, r.y_m + s * mount_.x_m + c * mount_.y_m};
   const double yaw = r.theta_rad + scene.pan_rad;
   const Vec2 fwd = geometry::unitAt(yaw);
-  const double tilt = std::clamp(scene.tilt_rad, -kTiltLimit_rad, kTiltLimit_rad);
+  const double tilt = std::clamp(scene.tilt_rad + mount_.tilt_deg * kPi / 180.0, -kTiltLimit_rad, kTiltLimit_rad);
   return {at, fwd, {-fwd.y, fwd.x}, cy_ + f_ * std::tan(tilt)};
 }
 

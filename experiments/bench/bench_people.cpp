@@ -33,6 +33,7 @@
 #include "shared/config/config_node.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/geometry/vec2.hpp"
+#include "shared/perception/camera_geometry.hpp"
 #include "shared/perception/people_detector.hpp"
 #include "shared/util/cli_args.hpp"
 #include "shared/util/thread_cpu.hpp"
@@ -350,7 +351,6 @@ int main(int argc, char** argv) {
     // One view per world at this size.
     std::vector<sim::CameraView> views;
     for (const auto& w : worlds) views.emplace_back(w, robot.camera, sz.width, sz.height, style);
-    const double f = views.front().focalPx();
     for (const auto& spec : specs) {
       if (sz.width > spec.max_width) continue;
       std::optional<perception::PeopleDetector> det;
@@ -385,7 +385,11 @@ int main(int argc, char** argv) {
         for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
         std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return found[a].score > found[b].score; });
         std::vector<bool> taken(truth.size(), false);
-        const double horizon = view.horizonRow(fr.scene);
+        perception::CameraPose cam;
+        cam.width = sz.width;
+        cam.height = sz.height;
+        cam.mount = robot.camera;
+        cam.tilt_rad = fr.scene.tilt_rad;
         for (const std::size_t i : order) {
           const auto& d = found[i];
           ++c.boxes;
@@ -408,15 +412,11 @@ int main(int argc, char** argv) {
           taken[static_cast<std::size_t>(who)] = true;
           const auto& t = truth[static_cast<std::size_t>(who)];
           if (t.visible < 0.3) continue;  // neither found nor false
-          const double col = d.box.x + d.box.width / 2.0;
-          const double bearing = std::atan((sz.width / 2.0 - col) / f);
-          c.bearing_err_deg.push_back(std::abs(bearing - t.bearing_rad) * kDeg);
-          const int bottom = d.box.y + d.box.height;
-          if (!d.upper_body && t.feet_in_view && bottom < sz.height - 1 && bottom - horizon > 2) {
-            const double depth = f * robot.camera.z_m / (bottom - horizon);
-            const double range = depth / std::cos(bearing);
-            c.range_err_pct.push_back(100.0 * std::abs(range - t.distance_m) / t.distance_m);
-          }
+          // What the robot computes (shared/perception/camera_geometry), against the camera model's truth.
+          const perception::Sighting seen = perception::sightingOf(d.box, cam);
+          c.bearing_err_deg.push_back(std::abs(std::remainder(seen.bearing_rad - t.bearing_rad, 2 * kPi)) * kDeg);
+          if (!d.upper_body && t.feet_in_view && seen.range_m)
+            c.range_err_pct.push_back(100.0 * std::abs(*seen.range_m - t.distance_m) / t.distance_m);
         }
         for (std::size_t t = 0; t < truth.size(); ++t) {
           const auto& p = truth[t];

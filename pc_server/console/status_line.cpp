@@ -33,6 +33,25 @@ std::string rateNote(const v1::VideoStatus& tv) {
   return s + " (" + tv.rate_reason() + ")";
 }
 
+const char* perceptionName(v1::PerceptionMode m) {
+  switch (m) {
+    case v1::CAMERA_AND_SONAR: return "camera+sonar";
+    case v1::CAMERA_ELSEWHERE: return "camera elsewhere, sonar";
+    default: return "sonar only";
+  }
+}
+
+// The people the camera sees now: "2 seen: +5 deg 5.1 m, -12 deg".
+std::string seenPeople(const v1::Perception& p) {
+  std::string s = std::to_string(p.people_size()) + " seen";
+  for (int i = 0; i < p.people_size(); ++i) {
+    const auto& q = p.people(i);
+    s += (i ? ", " : ": ") + fmtSigned(q.bearing_rad() * 180.0 / M_PI, 0) + " deg";
+    if (q.has_range_m()) s += " " + fmtFixed(q.range_m(), 1) + " m";
+  }
+  return s;
+}
+
 std::string videoFigures(const RobotSnapshot& snap, const VideoHub* video) {
   if (!snap.telemetry.has_video()) return {};
   const auto& tv = snap.telemetry.video();
@@ -79,6 +98,17 @@ std::string videoReport(const std::string& robot_id, const std::optional<RobotSn
                                  std::to_string(v.not_in_history()));
     }
     if (!v.error().empty()) line("robot error", v.error());
+    if (snap->telemetry.has_perception()) {
+      const auto& p = snap->telemetry.perception();
+      line("robot people", std::string(perceptionName(p.mode())) + ", " + seenPeople(p) + "; " + p.detector() + " on " +
+                               std::to_string(p.width()) + "x" + std::to_string(p.height()) + ", " +
+                               fmtFixed(p.rate_hz(), 1) + " Hz, " + fmtFixed(p.detect_ms(), 1) + " ms, " +
+                               std::to_string(p.detections()) + " pictures" +
+                               (p.looking_ahead() ? ", looking ahead for people" : "") +
+                               (p.error().empty() ? "" : ", error: " + p.error()));
+    } else {
+      line("robot people", "sonar only (no detector on the robot)");
+    }
   } else {
     line("robot", "no video in telemetry");
   }
@@ -153,6 +183,7 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
     s += " | person " + fmtFixed(t.nearest_person_m(), 1) + " m " + (t.pattern() == v1::PATTERN_NONE ? "?" : pat) +
          " speed x" + known(t.has_speed_factor(), t.speed_factor(), fmtFixed, 2);
   }
+  if (t.has_perception()) s += std::string(" | ") + perceptionName(t.perception().mode()) + " " + seenPeople(t.perception());
   if (t.ultrasonic_m_size() > 0) {
     s += " | us";
     for (double r : t.ultrasonic_m()) s += r < 0 ? " --" : " " + fmtFixed(r);

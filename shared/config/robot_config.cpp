@@ -47,6 +47,7 @@ RobotConfig loadRobotConfig(const ConfigNode& root) {
   c.camera.y_m = cam.number("y_m", c.camera.y_m, -5.0, 5.0);
   c.camera.z_m = cam.number("z_m", c.camera.z_m, 0.05, 5.0);
   c.camera.hfov_deg = cam.number("hfov_deg", c.camera.hfov_deg, 10.0, 150.0);
+  c.camera.tilt_deg = cam.number("tilt_deg", c.camera.tilt_deg, -45.0, 45.0);
   c.gas = loadGasConfig(root.optChild("gas"), root.has("gas"));
   return c;
 }

@@ -68,6 +68,7 @@ struct CameraMount {
   double y_m = 0.0;       // left of the centre line
   double z_m = 0.60;      // lens height above the floor
   double hfov_deg = 60.0; // horizontal field of view (the vertical one follows from the picture's aspect)
+  double tilt_deg = 0.0;  // the head's own tilt on the robot, up positive; the PTZ's tilt adds to it
 };
 
 struct RobotConfig {

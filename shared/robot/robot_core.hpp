@@ -98,6 +98,11 @@ class RobotCore {
   uint32_t faults() const { return faults_; }
   const control::Pose2& pose() const { return estimate_.pose(); }
   control::Twist commandedTwist() const { return cmd_twist_; }
+  /// Distance to the nearest tracked person (centre), none without one or without awareness.
+  std::optional<double> nearestPersonM() const {
+    if (!awareness_ || !awareness_->last().person) return std::nullopt;
+    return awareness_->last().distance_m;
+  }
   /// The navigator of the current go_to command; null when none.
   const navigation::Navigator* navigator() const { return route_.navigator(); }
 

@@ -274,6 +274,7 @@ void VideoSender::captureLoop() {
       continue;
     }
     if (src->paced()) capture_us = monoNowUs();  // a camera's frame is ready when read() returns
+    if (tap_) tap_(frame, capture_us);
     lk.lock();
     if (slot_full_) ++st_.dropped;
     slot_ = std::move(frame);

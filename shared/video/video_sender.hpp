@@ -10,6 +10,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -112,6 +113,11 @@ class VideoSender {
   std::string apply(const SenderChange& c);
   /// The next encoded frame is an IDR with SPS/PPS.
   void requestKeyframe();
+  /// Called on the capture thread with every captured picture (BGR) and its
+  /// capture time, before it goes to the encoder; it must be quick (copy what
+  /// it needs). Set before start().
+  using PictureTap = std::function<void(const cv::Mat& bgr, uint64_t capture_us)>;
+  void setPictureTap(PictureTap tap) { tap_ = std::move(tap); }
   SenderStats stats() const;
   uint32_t ssrc() const { return ssrc_; }
 
@@ -141,6 +147,7 @@ class VideoSender {
   uint32_t ssrc_;
   uint32_t rtx_ssrc_;
   std::thread capture_thread_, encode_thread_, feedback_thread_;
+  PictureTap tap_;
   struct Net;
   std::unique_ptr<Net> net_;
 };

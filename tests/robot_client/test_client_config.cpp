@@ -72,3 +72,21 @@ TEST(ClientConfig, Video) {
                 .find("video.adapt.max_kbps: 400 is below min_kbps 500"),
             std::string::npos);
 }
+
+TEST(ClientConfig, Perception) {
+  const auto c = client::loadClientConfigFile(inspect::test::srcPath("config/client.yaml"));
+  EXPECT_TRUE(c.perception.enabled);
+  EXPECT_EQ(c.perception.detector, "hog");
+  EXPECT_EQ(c.perception.width, 640);
+  EXPECT_DOUBLE_EQ(c.perception.rate_hz, 5.0);
+  EXPECT_DOUBLE_EQ(c.perception.max_core_share, 0.5);
+  EXPECT_TRUE(c.perception.look_ahead);
+  EXPECT_NE(clientConfigError("perception:\n  detector: yolo\n").find("perception.detector: 'yolo' is not one of"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("perception:\n  rate_hz: 0\n").find("perception.rate_hz: 0 is out of range"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("perception:\n  max_core_share: 2\n").find("perception.max_core_share: 2 is out of range"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("perception:\n  lookahead: true\n").find("perception.lookahead: unknown key"),
+            std::string::npos);
+}

@@ -1,0 +1,66 @@
+// People seen by the camera through the real programs (docs/human-awareness.md,
+// "Detection on the robot"): mcu_sim renders its camera with a person standing
+// ahead, robot_client reads it as its video source (sim:PATH), detects on a
+// thread of its own and sends the person's bearing and foot-row range in
+// telemetry; the server's console shows them. Pointing the camera away
+// makes perception say so (sonar only ahead).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <regex>
+#include <string>
+
+#include "tests/support/stack.hpp"
+
+using namespace inspect::test;
+
+TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAway) {
+  Stack s("perception");
+  s.enableVideo();
+  // A person standing 5 m ahead of the lens and 0.5 m to the left (the robot
+  // at the origin facing +x, the lens 0.2 m ahead of the axle).
+  writeFile(s.dir() / "world.yaml",
+            "name: one_person\nstart: {x_m: 0, y_m: 0, theta_rad: 0}\n"
+            "walls:\n  - {points_m: [-2, -3,  12, -3,  12, 3,  -2, 3], closed: true}\n"
+            "pedestrians:\n  - {id: p, route_m: [5.2, 0.5]}\n");
+  writeFile(s.dir() / "server.yaml", "video:\n  window: off\n  forward_base_port: 0\n");
+  ASSERT_TRUE(s.startServer("expect robots >= 1 within 15\n"
+                            "wait 5\n"
+                            "video stats\n"
+                            "ptz 60 0\n"
+                            "wait 2\n"
+                            "video stats\n",
+                            {"--config", s.dir() / "server.yaml"}))
+      << s.logs();
+  const std::string slot = "/dev/shm/inspect-perception-" + std::to_string(::getpid());
+  auto& robot = s.startRobot("robot1", s.dir() / "world.yaml", {}, {"--camera", slot},
+                             {"--video-source", "sim:" + slot});
+  const auto rc = s.server().wait(60.0);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  const std::string out = s.serverOutput();
+  EXPECT_EQ(*rc, 0) << out;
+  robot.client.terminate();
+
+  std::vector<std::string> lines;
+  for (std::size_t at = out.find("  robot people: "); at != std::string::npos; at = out.find("  robot people: ", at + 1))
+    lines.push_back(out.substr(at, out.find('\n', at) - at));
+  ASSERT_EQ(lines.size(), 2u) << out;
+  // 1. Looking ahead: the person, at the bearing and range of the truth.
+  const double bearing = std::atan2(0.5, 5.0) * 180 / M_PI, range = std::hypot(5.0, 0.5);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(lines[0], m, std::regex(R"(camera\+sonar, 1 seen: ([-+0-9.]+) deg ([0-9.]+) m)")))
+      << lines[0] << "\n" << s.logs();
+  EXPECT_NEAR(std::stod(m[1]), bearing, 1.0) << lines[0];
+  EXPECT_NEAR(std::stod(m[2]), range, 0.3 * range) << lines[0];
+  ASSERT_TRUE(std::regex_search(lines[0], m, std::regex(R"(([0-9.]+) Hz, ([0-9.]+) ms, ([0-9]+) pictures)"))) << lines[0];
+  EXPECT_GE(std::stod(m[1]), 2.0) << "detections per second: " << lines[0];
+  EXPECT_GE(std::stoi(m[3]), 10) << lines[0];
+  // 2. The camera turned 60 degrees away: the robot says so; the person is out of the picture.
+  EXPECT_NE(lines[1].find("camera elsewhere, sonar, 0 seen"), std::string::npos) << lines[1];
+  robot.sim.terminate();
+  EXPECT_EQ(access(slot.c_str(), F_OK), -1) << "mcu_sim removes its frame slot";
+  std::printf("%s\n%s\n", lines[0].c_str(), lines[1].c_str());
+}
