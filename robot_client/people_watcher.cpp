@@ -1,5 +1,7 @@
 #include "robot_client/people_watcher.hpp"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -27,7 +29,10 @@ void PeopleWatcher::start() {
   std::lock_guard lk(mu_);
   if (running_ || thread_.joinable()) return;
   running_ = true;
-  thread_ = std::thread([this] { loop(); });
+  thread_ = std::thread([this] {
+    pthread_setname_np(pthread_self(), "people-detect");
+    loop();
+  });
 }
 
 void PeopleWatcher::stop() {

@@ -60,6 +60,7 @@ struct Options {
   double seconds = 600;
   int cpu = -1;  // -1: the last core
   bool smoke = false;
+  bool people = false;  // the simulated camera with people in view: the people detector runs too
   std::string json;
 };
 
@@ -158,6 +159,8 @@ encoder's time per frame, and the budget on a Raspberry Pi 4 and 5
   --quick       60 s
   --smoke       5 s, no sysbench (ctest's smoke run)
   --cpu N       the core for robot_client (default: the last one)
+  --people      the camera is mcu_sim's (sim:) with two people walking round the
+                robot's circle, so robot_client's people detector runs as well
   --json FILE   write the figures as JSON
   --help        this text
 )";
@@ -179,6 +182,8 @@ int main(int argc, char** argv) {
       o.smoke = true;
     } else if (a.is("--cpu")) {
       o.cpu = static_cast<int>(a.integer(0, 4095));
+    } else if (a.is("--people")) {
+      o.people = true;
     } else if (a.is("--json")) {
       o.json = a.path();
     } else {
@@ -203,7 +208,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_loop: pc_server did not start\n%s", s.logs().c_str());
     return 1;
   }
-  auto& robot = s.startRobot("robot1", "empty.yaml");
+  std::vector<std::string> sim_args, client_args;
+  std::string world = "empty.yaml";
+  if (o.people) {
+    // Two people walking round a 3 m square about the robot's 0.5 m circle: in view part of each turn.
+    world = s.dir() / "people.yaml";
+    writeFile(world, "name: loop_people\nstart: {x_m: 0, y_m: 0, theta_rad: 0}\npedestrians:\n"
+                     "  - {id: a, speed_m_s: 0.8, loop: true, route_m: [3, -2.5, 3, 3.5, -3, 3.5, -3, -2.5]}\n"
+                     "  - {id: b, speed_m_s: 1.1, loop: true, route_m: [-3, 3.5, -3, -2.5, 3, -2.5, 3, 3.5]}\n");
+    const std::string slot = "/dev/shm/inspect-bench-loop-" + std::to_string(::getpid());
+    sim_args = {"--camera", slot};
+    client_args = {"--video-source", "sim:" + slot};
+  }
+  auto& robot = s.startRobot("robot1", world, {}, sim_args, client_args);
   // Measure once the robot drives and the stream runs.
   if (!waitUntil([&] { return s.serverOutput().find("drive +0.20") != std::string::npos; }, 30.0)) {
     std::fprintf(stderr, "bench_loop: the robot never drove\n%s", s.logs().c_str());
