@@ -219,8 +219,14 @@ TEST(SenderFeedback, ReportsOfHeavyLossLowerTheRateThenTheFrameRateThenTheSizeAn
     rtcp::appendReceiverReport(fb, 0x5E55, std::span(&b, 1));
     peer.send(fb);
     ++reports;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    const SenderStats st = tx.stats();
+    // Sample once the sender has taken this report in (under the sanitizers
+    // its feedback thread can be late by more than a report interval, and a
+    // state sampled twice-removed loses a reason).
+    SenderStats st = tx.stats();
+    for (int w = 0; w < 500 && st.receiver_reports < static_cast<uint64_t>(reports); ++w) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      st = tx.stats();
+    }
     rates.emplace_back(st.rate_kbps, st.rate_level);
     if (reasons.empty() || reasons.back() != st.rate_reason) reasons.push_back(st.rate_reason);
     if (!clean_phase && st.rate_level == 2) {
