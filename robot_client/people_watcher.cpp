@@ -122,6 +122,7 @@ void PeopleWatcher::loop() {
                       ? static_cast<double>(recent_at_s_.size() - 1) / (recent_at_s_.back() - recent_at_s_.front())
                       : 0.0;
     latest_ = std::move(view);
+    latest_seq_.store(st_.detections);
     busy_.store(false);
   }
 }

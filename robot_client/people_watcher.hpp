@@ -81,6 +81,9 @@ class PeopleWatcher {
 
   /// The latest detection, if any.
   std::optional<PeopleView> latest() const;
+  /// Its sequence number (0 = none yet), without a lock or a copy: the loop
+  /// asks this every tick and copies the view only when it is new.
+  uint64_t latestSeq() const { return latest_seq_.load(); }
   WatcherStats stats() const;
 
  private:
@@ -91,6 +94,7 @@ class PeopleWatcher {
   std::atomic<double> pan_{0.0}, tilt_{0.0};
   std::atomic<int64_t> due_us_{0};     // the next detection may start from this monotonic time
   std::atomic<bool> busy_{false};      // a picture is waiting or being detected
+  std::atomic<uint64_t> latest_seq_{0};
   mutable std::mutex mu_;
   std::condition_variable cv_;
   bool running_ = false;               // guarded by mu_

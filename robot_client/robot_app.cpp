@@ -95,6 +95,7 @@ RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::
   } catch (const video::VideoError& e) {
     log::error("video", e.what(), ": no video stream");
   }
+  camera_mount_ = robot.camera;
   if (video_ && cfg.perception.enabled && showsPeople(cfg.video.source)) {
     try {
       watcher_ = std::make_unique<PeopleWatcher>(watcherSettings(cfg.perception, robot.camera));
@@ -181,6 +182,7 @@ void RobotApp::onSerialMessage(const serial::Message& m) {
   if (const auto* f = std::get_if<serial::SensorFrame>(&m)) {
     sendWheels(core_.onSensorFrame(*f, now()));
     frame_to_command_.record(monoNowNs() - serial_.lastReadNs());
+    feedCamera();
     flushEvents();
   }
   // Messages meant for the MCU (echoes on a loop-back) are ignored.
@@ -292,6 +294,24 @@ void RobotApp::lookAhead(double now_s) {
       log::info("perception", "nobody near: the camera goes back to pan ", ptz_before_look_.pan_rad(), " tilt ",
                 ptz_before_look_.tilt_rad(), " rad");
   }
+}
+
+void RobotApp::feedCamera() {
+  if (!watcher_ || watcher_->latestSeq() == camera_fed_seq_) return;
+  const auto view = watcher_->latest();
+  if (!view) return;
+  camera_fed_seq_ = view->seq;
+  // Old pictures, and pictures of the floor or the ceiling, say nothing of
+  // the people around now.
+  if (monoNowUs() > view->capture_us + static_cast<uint64_t>(cfg_.perception.stale_s * 1e6)) return;
+  if (std::abs(view->tilt_rad) > M_PI / 6) return;
+  behavior::CameraLook look;
+  look.lens_x_m = camera_mount_.x_m;
+  look.lens_y_m = camera_mount_.y_m;
+  look.axis_rad = view->pan_rad;
+  look.half_fov_rad = camera_mount_.hfov_deg * M_PI / 360.0;
+  for (const auto& s : view->people) look.add({s.at.bearing_rad, s.at.range_m.value_or(-1.0)});
+  core_.onCameraLook(look);
 }
 
 void RobotApp::fillPerception(v1::Telemetry& t) const {

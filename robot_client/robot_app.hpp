@@ -58,6 +58,8 @@ class RobotApp {
   void lookAhead(double now_s);
   /// Sends a set-point to the MCU and tells the people watcher; "" or why not.
   std::string sendPtz(const v1::Ptz& p);
+  /// Gives the people tracker the watcher's newest detection (once each).
+  void feedCamera();
 
   boost::asio::io_context& io_;
   ClientConfig cfg_;
@@ -78,6 +80,8 @@ class RobotApp {
   bool look_ahead_yielded_ = false;  // the operator moved the camera: not again until nobody is near
   double look_last_s_ = -1e9;        // last time people were near while moving
   v1::Ptz ptz_before_look_;          // the set-point to give back
+  config::CameraMount camera_mount_;
+  uint64_t camera_fed_seq_ = 0;      // the last detection given to the people tracker
   v1::Envelope telemetry_env_;  // reused to avoid reallocating repeated fields
   std::vector<robot::CoreEvent> events_;  // flushEvents' buffer, swapped with the core's
   // Sensor frame read -> its wheel command handed to the serial port

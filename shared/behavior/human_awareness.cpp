@@ -134,6 +134,37 @@ void HumanAwareness::predict(const control::Pose2& pose, const HumanTrack& n, Aw
   a.anticipating = best < a.distance_m && best < a.avoid_m;
 }
 
+namespace {
+CameraFusionParams readCameraFusion(const config::ConfigNode& n) {
+  CameraFusionParams c;
+  c.enabled = n.boolean("enabled", c.enabled);
+  c.bearing_sigma_deg = n.number("bearing_sigma_deg", c.bearing_sigma_deg, 0.01, 20);
+  c.range_sigma_frac = n.number("range_sigma_frac", c.range_sigma_frac, 0.01, 2);
+  c.gate_chi2 = n.number("gate_chi2", c.gate_chi2, 1, 100);
+  c.hit_logodds = n.number("hit_logodds", c.hit_logodds, 0, 10);
+  c.person_logodds = n.number("person_logodds", c.person_logodds, 0, 10);
+  c.deny_logodds = n.number("deny_logodds", c.deny_logodds, -10, 0);
+  c.max_logodds = n.number("max_logodds", c.max_logodds, 1, 20);
+  c.confirm_hits = static_cast<int>(n.integer("confirm_hits", c.confirm_hits, 1, 100));
+  c.bearing_hold_s = n.number("bearing_hold_s", c.bearing_hold_s, 0, 10);
+  c.max_new_range_m = n.number("max_new_range_m", c.max_new_range_m, 0, 50);
+  c.edge_margin_deg = n.number("edge_margin_deg", c.edge_margin_deg, 0, 30);
+  c.occluder_width_m = n.number("occluder_width_m", c.occluder_width_m, 0, 3);
+  if (n.has("recall_upto_m") || n.has("recall")) {
+    const auto upto = n.numbers("recall_upto_m", static_cast<int>(c.recall_upto_m.size()));
+    const auto recall = n.numbers("recall", static_cast<int>(c.recall.size()));
+    for (std::size_t i = 0; i < upto.size(); ++i) {
+      if (i > 0 && !(upto[i] > upto[i - 1])) n.fail("recall_upto_m", "distances must rise");
+      if (!(recall[i] >= 0 && recall[i] <= 1)) n.fail("recall", "each recall must be within [0, 1]");
+      c.recall_upto_m[i] = upto[i];
+      c.recall[i] = recall[i];
+    }
+  }
+  if (!(c.deny_logodds < c.person_logodds)) n.fail("deny_logodds", "must be below person_logodds");
+  return c;
+}
+}  // namespace
+
 AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::string& base_dir) {
   AwarenessConfig c;
   const auto a = root.optChild("awareness");
@@ -175,6 +206,7 @@ AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::s
   c.tracker.triangulate_front = t.boolean("triangulate_front", c.tracker.triangulate_front);
   c.tracker.wall_trace = t.boolean("wall_trace", c.tracker.wall_trace);
   c.tracker.new_track_margin_m = t.number("new_track_margin_m", c.tracker.new_track_margin_m, 0, 5);
+  c.tracker.camera = readCameraFusion(t.optChild("camera"));
   c.social_force = readSocialForceParams(root.optChild("social_force"));
   const auto p = root.optChild("pattern");
   c.pattern.min_speed_m_s = p.number("min_speed_m_s", c.pattern.min_speed_m_s, 0, 2);

@@ -111,6 +111,7 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     Eigen::Vector2d z;
     Eigen::Matrix2d r;
     double range = 0;
+    double yaw = 0;  // the beam's direction (odometry frame)
   };
   std::array<Echo, 4> echo{};
   for (std::size_t i = 0; i < 4; ++i) {
@@ -179,7 +180,7 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     // Measurement covariance: range noise along the beam, the cone's width across it.
     const double along = std::max(p_.range_sigma_m, 0.01);
     const double across = std::max(0.05, r * std::tan(sonar_.beam_width_rad / 2) / 2);
-    echo[i] = {true, Eigen::Vector2d(px, py), beamCovariance(yaw, along, across), r};
+    echo[i] = {true, Eigen::Vector2d(px, py), beamCovariance(yaw, along, across), r, yaw};
   }
   // 2a. Only one of the two front sensors hears the object: it is more likely
   // on that sensor's outer side (the other cone covers the inner side).
@@ -221,7 +222,16 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
       }
     }
     if (best) {
-      update(*best, z, echo[i].r, t_s);
+      // A track the camera saw lately has its bearing from the camera: the
+      // echo gives it range only (across the beam, the whole cone), or its
+      // 100 echoes a second, each placed on the beam's centre line, would
+      // outweigh the bearings and pull a crossing person back to the centre.
+      const bool camera_bearing = best->camera_seen_s >= 0 && t_s - best->camera_seen_s <= p_.camera.bearing_hold_s;
+      const Eigen::Matrix2d r =
+          camera_bearing ? beamCovariance(echo[i].yaw, std::max(p_.range_sigma_m, 0.01),
+                                          std::max(0.1, echo[i].range * std::tan(sonar_.beam_width_rad / 2)))
+                         : echo[i].r;
+      update(*best, z, r, t_s);
       ++counters_.associated;
       const bool person = best->isPerson();
       person_echo_[i] = person;
@@ -263,7 +273,8 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
   }
   // Confirm, reclassify, drop.
   for (auto& t : tracks_) {
-    if (!t.confirmed && t.hits >= p_.confirm_hits && t.last_seen_s - t.first_seen_s <= p_.confirm_window_s + 1e-9) {
+    const bool enough = t.hits >= p_.confirm_hits || t.camera_hits >= p_.camera.confirm_hits;
+    if (!t.confirmed && enough && t.last_seen_s - t.first_seen_s <= p_.confirm_window_s + 1e-9) {
       t.confirmed = true;
       ++counters_.tracks_confirmed;
     }
@@ -276,6 +287,9 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     }
     // Once a person, standing still keeps it one for person_hold_s.
     if (t.confirmed && t.moving_since_s >= 0 && t_s - t.moving_since_s >= p_.moving_for_s) t.person = true;
+    // What the camera confirms is a person, moving or not.
+    if (t.confirmed && t.camera_hits >= p_.camera.confirm_hits && t.person_logodds >= p_.camera.person_logodds)
+      t.person = true;
   }
   std::erase_if(tracks_, [&](const HumanTrack& t) {
     if (t.contradicted >= p_.contradiction_ticks) {
@@ -287,7 +301,8 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
       if (!t.confirmed) ++counters_.tracks_unconfirmed_dropped;
       return true;
     }
-    if (!t.confirmed && t_s - t.first_seen_s > p_.confirm_window_s && t.hits < p_.confirm_hits) {
+    if (!t.confirmed && t_s - t.first_seen_s > p_.confirm_window_s && t.hits < p_.confirm_hits &&
+        t.camera_hits < p_.camera.confirm_hits) {
       ++counters_.tracks_unconfirmed_dropped;
       return true;
     }

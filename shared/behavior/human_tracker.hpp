@@ -11,6 +11,12 @@
 // well, bearing only within its cone). Tracks are confirmed after a few hits
 // and dropped after a coasting time; tracks that never move are reclassified
 // as static. Deterministic; time enters as dt; no allocation per step.
+//
+// The camera (observeCamera, camera_fusion.cpp) adds bearings and foot-row
+// ranges as measurements of the same filter (an extended Kalman update, the
+// measurement being polar from the lens), starts tracks of its own, and keeps
+// each track's log-odds of being a person: what the camera confirms is a
+// person even standing still, what it looks at and never finds is not.
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -19,6 +25,7 @@
 
 #include <Eigen/Dense>
 
+#include "shared/behavior/camera_look.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/control/diff_drive.hpp"
 #include "shared/geometry/segment.hpp"
@@ -58,6 +65,7 @@ struct HumanTrackerParams {
   double wall_trace_s = 0.5;
   double wall_trace_width_m = 0.03;   // the points' RMS distance from their line
   double wall_trace_angle_deg = 10;   // the line within this of the robot's heading
+  CameraFusionParams camera;
 };
 
 /// One tracked object (odometry frame); a person once confirmed and moving.
@@ -72,7 +80,13 @@ struct HumanTrack {
   double moving_since_s = -1;  // time it became faster
   bool person = false;         // confirmed and moving for moving_for_s
   int contradicted = 0;        // ticks in a row a sensor looked through its position
-  bool isPerson() const { return person; }
+  // The camera's evidence (camera_fusion.cpp).
+  int camera_hits = 0;         // detections associated with this track
+  double camera_seen_s = -1;   // time of the last one
+  int camera_misses = 0;       // pictures in a row that should have shown it and did not
+  double person_logodds = 0;   // camera evidence that this is a person (0 = none either way)
+  bool camera_denied = false;  // person_logodds at or below the deny level: not a person
+  bool isPerson() const { return person && !camera_denied; }
   double speed() const { return std::hypot(x[2], x[3]); }
   double positionSigma() const { return std::sqrt(std::max(p(0, 0), p(1, 1))); }
 };
@@ -91,6 +105,13 @@ struct TrackerCounters {
   uint64_t static_wall_trace = 0;           // dropped: a side sensor sliding along a wall
   uint64_t static_learned = 0;              // dropped: on a wall learned that way (front cones' edges)
   uint64_t tracks_contradicted = 0;         // dropped: a sensor saw through them
+  uint64_t camera_looks = 0;                // pictures taken in
+  uint64_t camera_detections = 0;           // people in them
+  uint64_t camera_associated = 0;           // ...that updated a track
+  uint64_t camera_tracks_created = 0;       // ...that started one
+  uint64_t camera_merged = 0;               // sonar tracks found to be a detected person's, merged into its track
+  uint64_t camera_misses = 0;               // track-pictures that should have shown a track and did not
+  uint64_t camera_denials = 0;              // tracks that became not-a-person by the camera
 };
 
 class HumanTracker {
@@ -100,6 +121,9 @@ class HumanTracker {
 
   /// One tick: robot pose (odometry frame), the 4 ranges (< 0 = no echo), time.
   void step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s);
+  /// One camera picture's people, the robot at `pose` when it was taken;
+  /// `t_s` not before the last step's (the tracks are predicted to it).
+  void observeCamera(const control::Pose2& pose, const CameraLook& look, double t_s);
 
   const std::vector<HumanTrack>& tracks() const { return tracks_; }
   const TrackerCounters& counters() const { return counters_; }
@@ -122,6 +146,8 @@ class HumanTracker {
   std::optional<std::pair<Eigen::Vector2d, Eigen::Matrix2d>> triangulate(const control::Pose2& pose, double r0,
                                                                           double r1) const;
   void update(HumanTrack& t, const Eigen::Vector2d& z, const Eigen::Matrix2d& r, double t_s);
+  /// Camera evidence on a track's log-odds (and its denial).
+  void addPersonEvidence(HumanTrack& t, double logodds);
   /// Records sensor i's echo point and says whether its recent points trace a wall (wall_trace).
   bool tracesWall(std::size_t i, const Eigen::Vector2d& z, const control::Pose2& pose, double t_s);
   /// Echo points of one sensor over the last wall_trace_s (a ring), with the robot's position then.

@@ -2,7 +2,8 @@
 // "Detection on the robot"): mcu_sim renders its camera with a person standing
 // ahead, robot_client reads it as its video source (sim:PATH), detects on a
 // thread of its own and sends the person's bearing and foot-row range in
-// telemetry; the server's console shows them. Pointing the camera away
+// telemetry; the server's console shows them, and the robot's people
+// tracker has the person beyond its sonars' reach. Pointing the camera away
 // makes perception say so (sonar only ahead).
 #include <gtest/gtest.h>
 
@@ -30,6 +31,7 @@ TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAwa
   ASSERT_TRUE(s.startServer("expect robots >= 1 within 15\n"
                             "wait 5\n"
                             "video stats\n"
+                            "status\n"
                             "ptz 60 0\n"
                             "wait 2\n"
                             "video stats\n",
@@ -58,9 +60,14 @@ TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAwa
   ASSERT_TRUE(std::regex_search(lines[0], m, std::regex(R"(([0-9.]+) Hz, ([0-9.]+) ms, ([0-9]+) pictures)"))) << lines[0];
   EXPECT_GE(std::stod(m[1]), 2.0) << "detections per second: " << lines[0];
   EXPECT_GE(std::stoi(m[3]), 10) << lines[0];
+  // The people tracker took the sightings in: 5 m is beyond the sonars'
+  // 4.5 m, so the person the robot slows for is the camera's alone.
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(\| person ([0-9.]+) m)"))) << out;
+  EXPECT_NEAR(std::stod(m[1]), range + 0.2, 0.3 * range) << "from the axle; the foot-row range is long";
+  const std::string tracked = m[0];
   // 2. The camera turned 60 degrees away: the robot says so; the person is out of the picture.
   EXPECT_NE(lines[1].find("camera elsewhere, sonar, 0 seen"), std::string::npos) << lines[1];
   robot.sim.terminate();
   EXPECT_EQ(access(slot.c_str(), F_OK), -1) << "mcu_sim removes its frame slot";
-  std::printf("%s\n%s\n", lines[0].c_str(), lines[1].c_str());
+  std::printf("%s\n%s\nstatus: %s\n", lines[0].c_str(), lines[1].c_str(), tracked.c_str());
 }
