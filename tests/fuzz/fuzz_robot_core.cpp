@@ -14,8 +14,10 @@
 //   0 link bytes; 1 raw serial bytes; 2 a sensor-frame payload (40 bytes,
 //   zero-padded) framed with a valid CRC and sent (tag >> 5) + 1 times, 10 ms
 //   apart; 3 timer, body[0] ms later; 4 body[0] bits: link up/down, serial
-//   open/closed. Nothing arrives on a link that is down or a closed serial
-//   device.
+//   open/closed, and (bit 2) a camera picture's people for the tracker
+//   (onCameraLook): body[1] % 9 people, 4 bytes each (bearing, range; 0x7fff
+//   a NaN, negative ranges for feet out of view). Nothing arrives on a link
+//   that is down or a closed serial device.
 // Invariants: an Ack answers the command's id; while e-stop or failsafe is
 // latched every wheel command is zero; telemetry always serialises and
 // parses back.
@@ -226,6 +228,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
         if (open != r.serial_open) {
           r.core.onSerialState(open, r.t);
           r.serial_open = open;
+        }
+        if (bits & 4) {
+          behavior::CameraLook look;
+          const std::size_t n = rec.body.size() > 1 ? rec.body[1] % 9 : 0;
+          const auto i16 = [&](std::size_t at) {
+            return at + 1 < rec.body.size() ? static_cast<int16_t>(rec.body[at] | rec.body[at + 1] << 8) : int16_t{0};
+          };
+          for (std::size_t k = 0; k < n; ++k) {
+            const int16_t b = i16(2 + 4 * k), d = i16(4 + 4 * k);
+            look.add({b == 0x7fff ? std::nan("") : b * 1e-4, d == 0x7fff ? std::nan("") : d * 1e-3});
+          }
+          r.core.onCameraLook(look);
         }
         checkWheels(r.core, r.core.commandNow());
         break;

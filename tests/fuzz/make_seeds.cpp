@@ -411,6 +411,20 @@ void robotCoreSeeds() {
     fuzz::putRecord(s.b, 1, frameBytes(enc.encode(sensorFrame(5100, 100))));
     write("robot_core", "raw_serial", s.b);
   }
+  {
+    // People from the camera between sensor frames (tag 4, bit 2): one at
+    // +0.05 rad 5 m, one at -0.1 rad with the feet out of view.
+    CoreSeed s;
+    s.frames(3);
+    s.heartbeat();
+    s.command(teleopCmd(0.3, 0));
+    const Bytes look{7, 2, 0xf4, 0x01, 0x88, 0x13, 0x18, 0xfc, 0x18, 0xfc};
+    for (int i = 0; i < 6; ++i) {
+      s.frames(8);
+      fuzz::putRecord(s.b, 4, look);
+    }
+    write("robot_core", "camera_people", s.b);
+  }
 }
 
 // --- rtp_h264: the robot's camera stream -----------------------------------------

@@ -71,3 +71,50 @@ TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAwa
   EXPECT_EQ(access(slot.c_str(), F_OK), -1) << "mcu_sim removes its frame slot";
   std::printf("%s\n%s\nstatus: %s\n", lines[0].c_str(), lines[1].c_str(), tracked.c_str());
 }
+
+TEST(PerceptionStack, WithAPersonNearWhileMovingTheCameraLooksAheadAndIsGivenBackAfter) {
+  // docs/human-awareness.md, "Looking ahead": the operator has pointed the
+  // camera 60 degrees left; the robot drives toward a person walking to and
+  // fro across its way 3.5 m ahead (the sonars find them); the camera turns
+  // ahead while the person is within 4 m and the robot moves, and goes back
+  // to 60 degrees 3 s after the robot stopped.
+  Stack s("lookahead");
+  s.enableVideo();
+  writeFile(s.dir() / "world.yaml",
+            "name: crossing_ahead\nstart: {x_m: 0, y_m: 0, theta_rad: 0}\n"
+            "walls:\n  - {points_m: [-2, -4,  12, -4,  12, 4,  -2, 4], closed: true}\n"
+            "pedestrians:\n  - {id: p, speed_m_s: 0.6, route_m: [3.5, -1.5, 3.5, 1.5], loop: true}\n");
+  writeFile(s.dir() / "server.yaml", "video:\n  window: off\n  forward_base_port: 0\n");
+  ASSERT_TRUE(s.startServer("expect robots >= 1 within 15\n"
+                            "ptz 60 0\n"
+                            "wait 1\n"
+                            "drive 0.15 0\n"
+                            "wait 3\n"
+                            "video stats\n"
+                            "stop\n"
+                            "wait 5\n"
+                            "video stats\n",
+                            {"--config", s.dir() / "server.yaml"}))
+      << s.logs();
+  const std::string slot = "/dev/shm/inspect-lookahead-" + std::to_string(::getpid());
+  auto& robot = s.startRobot("robot1", s.dir() / "world.yaml", {}, {"--camera", slot},
+                             {"--video-source", "sim:" + slot});
+  const auto rc = s.server().wait(60.0);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  const std::string out = s.serverOutput();
+  EXPECT_EQ(*rc, 0) << out;
+  robot.client.terminate();
+  robot.sim.terminate();
+  std::vector<std::string> lines;
+  for (std::size_t at = out.find("  robot people: "); at != std::string::npos; at = out.find("  robot people: ", at + 1))
+    lines.push_back(out.substr(at, out.find('\n', at) - at));
+  ASSERT_EQ(lines.size(), 2u) << out;
+  EXPECT_NE(lines[0].find("looking ahead for people"), std::string::npos) << lines[0] << "\n" << s.logs();
+  EXPECT_EQ(lines[0].find("camera elsewhere"), std::string::npos) << lines[0];
+  EXPECT_EQ(lines[1].find("looking ahead for people"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[1].find("camera elsewhere"), std::string::npos) << "back at 60 degrees: " << lines[1];
+  const std::string client_log = readFile(s.dir() / "robot1-client.err");
+  EXPECT_NE(client_log.find("while moving: the camera looks ahead"), std::string::npos) << client_log;
+  EXPECT_NE(client_log.find("nobody near: the camera goes back to pan 1.047"), std::string::npos) << client_log;
+  std::printf("%s\n%s\n", lines[0].c_str(), lines[1].c_str());
+}
