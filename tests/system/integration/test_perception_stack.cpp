@@ -18,37 +18,57 @@
 
 using namespace inspect::test;
 
-TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAway) {
-  Stack s("perception");
+namespace {
+/// Runs the server's `script` with one robot in `world` whose video source
+/// is mcu_sim's camera (its frame slot /dev/shm/inspect-NAME-PID); the
+/// server's output, or "" (a failure added) when it did not end. The robot's
+/// programs are stopped.
+std::string runWithCamera(Stack& s, const std::string& name, const std::string& world, const std::string& script) {
   s.enableVideo();
-  // A person standing 5 m ahead of the lens and 0.5 m to the left (the robot
-  // at the origin facing +x, the lens 0.2 m ahead of the axle).
-  writeFile(s.dir() / "world.yaml",
-            "name: one_person\nstart: {x_m: 0, y_m: 0, theta_rad: 0}\n"
-            "walls:\n  - {points_m: [-2, -3,  12, -3,  12, 3,  -2, 3], closed: true}\n"
-            "pedestrians:\n  - {id: p, route_m: [5.2, 0.5]}\n");
+  writeFile(s.dir() / "world.yaml", world);
   writeFile(s.dir() / "server.yaml", "video:\n  window: off\n  forward_base_port: 0\n");
-  ASSERT_TRUE(s.startServer("expect robots >= 1 within 15\n"
-                            "wait 5\n"
-                            "video stats\n"
-                            "status\n"
-                            "ptz 60 0\n"
-                            "wait 2\n"
-                            "video stats\n",
-                            {"--config", s.dir() / "server.yaml"}))
-      << s.logs();
-  const std::string slot = "/dev/shm/inspect-perception-" + std::to_string(::getpid());
+  if (!s.startServer(script, {"--config", s.dir() / "server.yaml"})) {
+    ADD_FAILURE() << s.logs();
+    return "";
+  }
+  const std::string slot = "/dev/shm/inspect-" + name + "-" + std::to_string(::getpid());
   auto& robot = s.startRobot("robot1", s.dir() / "world.yaml", {}, {"--camera", slot},
                              {"--video-source", "sim:" + slot});
   const auto rc = s.server().wait(60.0);
-  ASSERT_TRUE(rc.has_value()) << s.logs();
-  const std::string out = s.serverOutput();
-  EXPECT_EQ(*rc, 0) << out;
   robot.client.terminate();
+  robot.sim.terminate();
+  const std::string out = s.serverOutput();
+  if (!rc) ADD_FAILURE() << "the server's script did not end\n" << s.logs();
+  else EXPECT_EQ(*rc, 0) << out;
+  EXPECT_EQ(access(slot.c_str(), F_OK), -1) << "mcu_sim removes its frame slot";
+  return rc ? out : "";
+}
 
+/// The `robot people:` lines of `video stats`.
+std::vector<std::string> peopleLines(const std::string& out) {
   std::vector<std::string> lines;
   for (std::size_t at = out.find("  robot people: "); at != std::string::npos; at = out.find("  robot people: ", at + 1))
     lines.push_back(out.substr(at, out.find('\n', at) - at));
+  return lines;
+}
+}  // namespace
+
+TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAway) {
+  Stack s("perception");
+  // A person standing 5 m ahead of the lens and 0.5 m to the left (the robot
+  // at the origin facing +x, the lens 0.2 m ahead of the axle).
+  const std::string out = runWithCamera(s, "perception",
+                                        "name: one_person\nstart: {x_m: 0, y_m: 0, theta_rad: 0}\n"
+                                        "walls:\n  - {points_m: [-2, -3,  12, -3,  12, 3,  -2, 3], closed: true}\n"
+                                        "pedestrians:\n  - {id: p, route_m: [5.2, 0.5]}\n",
+                                        "expect robots >= 1 within 15\n"
+                                        "wait 5\n"
+                                        "video stats\n"
+                                        "status\n"
+                                        "ptz 60 0\n"
+                                        "wait 2\n"
+                                        "video stats\n");
+  const auto lines = peopleLines(out);
   ASSERT_EQ(lines.size(), 2u) << out;
   // 1. Looking ahead: the person, at the bearing and range of the truth.
   const double bearing = std::atan2(0.5, 5.0) * 180 / M_PI, range = std::hypot(5.0, 0.5);
@@ -67,8 +87,6 @@ TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAwa
   const std::string tracked = m[0];
   // 2. The camera turned 60 degrees away: the robot says so; the person is out of the picture.
   EXPECT_NE(lines[1].find("camera elsewhere, sonar, 0 seen"), std::string::npos) << lines[1];
-  robot.sim.terminate();
-  EXPECT_EQ(access(slot.c_str(), F_OK), -1) << "mcu_sim removes its frame slot";
   std::printf("%s\n%s\nstatus: %s\n", lines[0].c_str(), lines[1].c_str(), tracked.c_str());
 }
 
@@ -79,35 +97,21 @@ TEST(PerceptionStack, WithAPersonNearWhileMovingTheCameraLooksAheadAndIsGivenBac
   // ahead while the person is within 4 m and the robot moves, and goes back
   // to 60 degrees 3 s after the robot stopped.
   Stack s("lookahead");
-  s.enableVideo();
-  writeFile(s.dir() / "world.yaml",
-            "name: crossing_ahead\nstart: {x_m: 0, y_m: 0, theta_rad: 0}\n"
-            "walls:\n  - {points_m: [-2, -4,  12, -4,  12, 4,  -2, 4], closed: true}\n"
-            "pedestrians:\n  - {id: p, speed_m_s: 0.6, route_m: [3.5, -1.5, 3.5, 1.5], loop: true}\n");
-  writeFile(s.dir() / "server.yaml", "video:\n  window: off\n  forward_base_port: 0\n");
-  ASSERT_TRUE(s.startServer("expect robots >= 1 within 15\n"
-                            "ptz 60 0\n"
-                            "wait 1\n"
-                            "drive 0.15 0\n"
-                            "wait 3\n"
-                            "video stats\n"
-                            "stop\n"
-                            "wait 5\n"
-                            "video stats\n",
-                            {"--config", s.dir() / "server.yaml"}))
-      << s.logs();
-  const std::string slot = "/dev/shm/inspect-lookahead-" + std::to_string(::getpid());
-  auto& robot = s.startRobot("robot1", s.dir() / "world.yaml", {}, {"--camera", slot},
-                             {"--video-source", "sim:" + slot});
-  const auto rc = s.server().wait(60.0);
-  ASSERT_TRUE(rc.has_value()) << s.logs();
-  const std::string out = s.serverOutput();
-  EXPECT_EQ(*rc, 0) << out;
-  robot.client.terminate();
-  robot.sim.terminate();
-  std::vector<std::string> lines;
-  for (std::size_t at = out.find("  robot people: "); at != std::string::npos; at = out.find("  robot people: ", at + 1))
-    lines.push_back(out.substr(at, out.find('\n', at) - at));
+  const std::string out =
+      runWithCamera(s, "lookahead",
+                    "name: crossing_ahead\nstart: {x_m: 0, y_m: 0, theta_rad: 0}\n"
+                    "walls:\n  - {points_m: [-2, -4,  12, -4,  12, 4,  -2, 4], closed: true}\n"
+                    "pedestrians:\n  - {id: p, speed_m_s: 0.6, route_m: [3.5, -1.5, 3.5, 1.5], loop: true}\n",
+                    "expect robots >= 1 within 15\n"
+                    "ptz 60 0\n"
+                    "wait 1\n"
+                    "drive 0.15 0\n"
+                    "wait 3\n"
+                    "video stats\n"
+                    "stop\n"
+                    "wait 5\n"
+                    "video stats\n");
+  const auto lines = peopleLines(out);
   ASSERT_EQ(lines.size(), 2u) << out;
   EXPECT_NE(lines[0].find("looking ahead for people"), std::string::npos) << lines[0] << "\n" << s.logs();
   EXPECT_EQ(lines[0].find("camera elsewhere"), std::string::npos) << lines[0];
