@@ -25,10 +25,12 @@ TruePerson truthOf(const behavior::Agent& a) {
 
 class ArenaObserver final : public sim::RunObserver {
  public:
-  ArenaObserver(const Episode& e, const sim::ScenarioContext& ctx, bool oracle)
-      : world_(e.spec.world), ctx_(ctx), oracle_(oracle), avoid_m_(ctx.awareness.speed.max_avoidance_m) {}
+  ArenaObserver(const Episode& e, const sim::ScenarioContext& ctx, bool oracle, const ArenaCamera& camera)
+      : world_(e.spec.world), ctx_(ctx), oracle_(oracle), avoid_m_(ctx.awareness.speed.max_avoidance_m),
+        camera_(camera), camera_rng_(e.seed * 7919 + 17) {}
 
-  void beforeFrame(const sim::Simulation& sim, behavior::HumanAwareness& aw, double) override {
+  void beforeFrame(const sim::Simulation& sim, behavior::HumanAwareness& aw, double t_s) override {
+    look(sim, aw, t_s);
     if (!oracle_) return;
     // The true nearest person the robot should react to: in line of sight and
     // sonar range, with a pattern (else the nearest, who needs no reaction).
@@ -142,10 +144,31 @@ class ArenaObserver final : public sim::RunObserver {
   EpisodeMetrics m;
 
  private:
+  /// A camera picture every 1 / rate_hz (the detector model on the true
+  /// scene; the tracker places it at the true pose: the odometry's drift over
+  /// a 9 m run is centimetres).
+  void look(const sim::Simulation& sim, behavior::HumanAwareness& aw, double t_s) {
+    if (!camera_.enabled || t_s + 1e-9 < next_look_s_) return;
+    next_look_s_ = t_s + 1.0 / camera_.rate_hz;
+    discs_.clear();
+    const auto& crowd = sim.pedestrians();
+    for (std::size_t i = 0; i < crowd.size(); ++i)
+      if (crowd.present(i)) {
+        const auto& a = crowd.agent(i);
+        discs_.push_back({a.position_m.x(), a.position_m.y(), a.radius_m});
+      }
+    aw.observeCamera(sim.state().pose,
+                     sim::detectPeople(world_, sim.state().pose, ctx_.robot.camera, 0.0, discs_, camera_.model, camera_rng_));
+  }
+
   const world::World& world_;
   const sim::ScenarioContext& ctx_;
   bool oracle_;
   double avoid_m_;
+  const ArenaCamera& camera_;
+  std::mt19937_64 camera_rng_;
+  double next_look_s_ = 0.0;
+  std::vector<sim::PersonDisc> discs_;
   std::vector<bool> in_contact_;
   std::map<int, bool> judged_;
   control::Pose2 last_;
@@ -193,8 +216,8 @@ behavior::SpeedPolicy speedPolicy(Policy p) {
 }
 
 EpisodeMetrics runEpisode(const Episode& e, const sim::ScenarioContext& ctx, Policy p, double reference_s,
-                          bool site_map, sim::ScenarioRun* series) {
-  ArenaObserver obs(e, ctx, p == Policy::kOracle);
+                          const ArenaCamera& camera, bool site_map, sim::ScenarioRun* series) {
+  ArenaObserver obs(e, ctx, p == Policy::kOracle, camera);
   sim::RunOptions opt;
   opt.policy = speedPolicy(p);
   opt.people = true;
@@ -208,8 +231,9 @@ EpisodeMetrics runEpisode(const Episode& e, const sim::ScenarioContext& ctx, Pol
   return m;
 }
 
-EpisodeMetrics runReference(const Episode& e, const sim::ScenarioContext& ctx, bool site_map) {
-  ArenaObserver obs(e, ctx, false);
+EpisodeMetrics runReference(const Episode& e, const sim::ScenarioContext& ctx, const ArenaCamera& camera,
+                            bool site_map) {
+  ArenaObserver obs(e, ctx, false, camera);
   sim::RunOptions opt;
   opt.policy = behavior::SpeedPolicy::kNone;
   opt.people = false;

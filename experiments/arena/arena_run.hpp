@@ -10,6 +10,7 @@
 
 #include "experiments/arena/episode.hpp"
 #include "experiments/arena/ground_truth.hpp"
+#include "sim/detector_model.hpp"
 
 namespace inspect::arena {
 
@@ -56,14 +57,25 @@ struct EpisodeMetrics {
   uint32_t false_people = 0;        // person tracks that appeared where nobody was (> 1 m from everyone)
 };
 
+/// The robot's camera in the arena: its people detections drawn from the
+/// detector model (sim/detector_model.hpp) at `rate_hz`, the camera looking
+/// ahead, fed to the people tracker as robot_client feeds the real
+/// detector's. Off: the sonars alone.
+struct ArenaCamera {
+  bool enabled = true;
+  double rate_hz = 5.0;
+  sim::DetectorModelParams model;
+};
+
 /// Runs `e` with `p`. `reference_s` is the time to goal of the same episode
 /// without people (time lost); `site_map` false runs the robot without its map.
 /// `series` (may be null) receives the scenario runner's samples (plots).
 EpisodeMetrics runEpisode(const Episode& e, const sim::ScenarioContext& ctx, Policy p, double reference_s,
-                          bool site_map = true, sim::ScenarioRun* series = nullptr);
+                          const ArenaCamera& camera, bool site_map = true, sim::ScenarioRun* series = nullptr);
 
 /// The reference run: nobody in the world, plain tracking (time to goal), and
 /// the false people the robot tracks along the walls (with or without the map).
-EpisodeMetrics runReference(const Episode& e, const sim::ScenarioContext& ctx, bool site_map);
+EpisodeMetrics runReference(const Episode& e, const sim::ScenarioContext& ctx, const ArenaCamera& camera,
+                            bool site_map);
 
 }  // namespace inspect::arena

@@ -49,6 +49,8 @@ sim time with the robot's decision core over the serial codec.
   --robot-config FILE     default config/robot.yaml
   --control-config FILE   default config/control.yaml
   --behavior-config FILE  default config/behavior.yaml
+  --camera model|none     the robot's camera people detections: drawn from the detector
+                          model calibrated on bench_people (default), or none (sonars alone)
   --quiet                 no progress bar
   --help                  print this help
 Exit status: 0 when the run finished (the targets are reported, not enforced),
@@ -65,6 +67,7 @@ struct Options {
   std::string plots, json, csv;
   std::string robot = "config/robot.yaml", control = "config/control.yaml", behavior = "config/behavior.yaml";
   bool quiet = false;
+  arena::ArenaCamera camera;
 };
 
 [[noreturn]] void usageError(const std::string& msg) {
@@ -104,6 +107,8 @@ Options parse(int argc, char** argv) {
         o.control = a.path();
       } else if (a.is("--behavior-config")) {
         o.behavior = a.path();
+      } else if (a.is("--camera")) {
+        o.camera.enabled = a.choice({"model", "none"}) == "model";
       } else if (a.is("--quiet")) {
         o.quiet = true;
       } else {
@@ -292,10 +297,10 @@ int main(int argc, char** argv) {
       try {
         EpisodeResult r;
         r.episode = arena::generateEpisode(o.seed, indices[i]);
-        r.reference = arena::runReference(r.episode, ctx, true);
-        r.reference_no_map = arena::runReference(r.episode, ctx, false);
+        r.reference = arena::runReference(r.episode, ctx, o.camera, true);
+        r.reference_no_map = arena::runReference(r.episode, ctx, o.camera, false);
         for (std::size_t k = 0; k < kP; ++k)
-          r.by_policy[k] = arena::runEpisode(r.episode, ctx, arena::kPolicies[k], r.reference.time_to_goal_s);
+          r.by_policy[k] = arena::runEpisode(r.episode, ctx, arena::kPolicies[k], r.reference.time_to_goal_s, o.camera);
         results[i] = std::move(r);
       } catch (const std::exception& e) {
         std::lock_guard<std::mutex> lk(err_mu);
@@ -419,7 +424,7 @@ int main(int argc, char** argv) {
       std::vector<sim::ScenarioRun> runs;
       for (Policy p : {Policy::kStrategy, Policy::kPlain, Policy::kStopAndWait}) {
         sim::ScenarioRun run;
-        (void)arena::runEpisode(r.episode, contexts[0], p, r.reference.time_to_goal_s, true, &run);
+        (void)arena::runEpisode(r.episode, contexts[0], p, r.reference.time_to_goal_s, o.camera, true, &run);
         runs.push_back(std::move(run));
       }
       err = sim::plotScenario(o.plots, r.episode.spec, runs);

@@ -192,14 +192,19 @@ struct Case {
   std::string detector, settings;
   int width = 0, height = 0, frames = 0;
   int truths = 0, found = 0, boxes = 0, false_boxes = 0;
-  std::vector<double> bearing_err_deg, range_err_pct, ms;
+  std::vector<double> bearing_err_deg, range_err_pct, range_signed_pct, ms;
   double cpu_ms = 0;
   Bins by_distance{"distance m", {1, 2, 3, 4, 6, 8, 11}, {"1-2", "2-3", "3-4", "4-6", "6-8", "8-10"}, {}, {}};
   Bins by_bearing{"|bearing| deg", {0, 10, 20, 40}, {"0-10", "10-20", "20-33"}, {}, {}};
   Bins by_visible{"visible", {0.3, 0.6, 0.9, 1.01}, {"30-60%", "60-90%", "90-100%"}, {}, {}};
+  // The arena's detector model is calibrated from these two (sim/detector_model).
+  Bins by_distance_clear{"distance m (90-100% visible)", {1, 2, 3, 4, 6, 8, 11}, {"1-2", "2-3", "3-4", "4-6", "6-8", "8-10"}, {}, {}};
+  Bins by_distance_part{"distance m (30-90% visible)", {1, 2, 3, 4, 6, 8, 11}, {"1-2", "2-3", "3-4", "4-6", "6-8", "8-10"}, {}, {}};
   Bins by_view{"view", {0, 45, 135, 181}, {"front", "side", "back"}, {}, {}};
   Bins by_motion{"motion", {0, 0.1, 10}, {"standing", "walking"}, {}, {}};
-  std::vector<Bins*> all() { return {&by_distance, &by_bearing, &by_visible, &by_view, &by_motion}; }
+  std::vector<Bins*> all() {
+    return {&by_distance, &by_bearing, &by_visible, &by_view, &by_motion, &by_distance_clear, &by_distance_part};
+  }
   double recall() const { return truths ? static_cast<double>(found) / truths : NAN; }
   double precision() const { return boxes ? static_cast<double>(boxes - false_boxes) / boxes : NAN; }
 };
@@ -416,7 +421,10 @@ int main(int argc, char** argv) {
           const perception::Sighting seen = perception::sightingOf(d.box, cam);
           c.bearing_err_deg.push_back(std::abs(std::remainder(seen.bearing_rad - t.bearing_rad, 2 * kPi)) * kDeg);
           if (!d.upper_body && t.feet_in_view && seen.range_m)
+          {
             c.range_err_pct.push_back(100.0 * std::abs(*seen.range_m - t.distance_m) / t.distance_m);
+            c.range_signed_pct.push_back(100.0 * (*seen.range_m - t.distance_m) / t.distance_m);
+          }
         }
         for (std::size_t t = 0; t < truth.size(); ++t) {
           const auto& p = truth[t];
@@ -432,6 +440,7 @@ int main(int argc, char** argv) {
           for (const auto& q : fr.scene.people)
             if (q.index == p.index) speed = q.speed_m_s;
           c.by_motion.add(speed, hit);
+          (p.visible >= 0.9 ? c.by_distance_clear : c.by_distance_part).add(p.distance_m, hit);
         }
         if (!png_dir.empty() && (k % std::max(1, frames / 4)) == 0 && &spec == &specs.front()) {
           cv::Mat shown = pic.clone();
@@ -533,6 +542,13 @@ int main(int argc, char** argv) {
       }
     }
   }
+  std::printf("\nrange from the foot row, signed (long > 0): p10 / p50 / p90 %%\n| size | detector | p10 | p50 | p90 |\n"
+              "|---|---|---|---|---|\n");
+  for (const auto& c : cases)
+    std::printf("| %dx%d | %s | %s | %s | %s |\n", c.width, c.height, c.detector.c_str(),
+                cell(quantile(c.range_signed_pct, 0.1), "%+.1f").c_str(),
+                cell(quantile(c.range_signed_pct, 0.5), "%+.1f").c_str(),
+                cell(quantile(c.range_signed_pct, 0.9), "%+.1f").c_str());
   if (!vcases.empty()) {
     std::printf("\nreal footage: %s (%d frames; no truth: boxes per frame, frames with a box)\n"
                 "| size | detector | boxes / frame | frames with a box | ms p50 / p90 |\n|---|---|---|---|---|\n",
@@ -572,6 +588,9 @@ int main(int argc, char** argv) {
                                {"bearing_err_deg_p90", numberOrNull(quantile(c.bearing_err_deg, 0.9))},
                                {"range_err_pct_p50", numberOrNull(quantile(c.range_err_pct, 0.5))},
                                {"range_err_pct_p90", numberOrNull(quantile(c.range_err_pct, 0.9))},
+                               {"range_signed_pct_p10", numberOrNull(quantile(c.range_signed_pct, 0.1))},
+                               {"range_signed_pct_p50", numberOrNull(quantile(c.range_signed_pct, 0.5))},
+                               {"range_signed_pct_p90", numberOrNull(quantile(c.range_signed_pct, 0.9))},
                                {"ms_p50", numberOrNull(quantile(c.ms, 0.5))},
                                {"ms_p90", numberOrNull(quantile(c.ms, 0.9))},
                                {"cpu_ms", c.cpu_ms}};

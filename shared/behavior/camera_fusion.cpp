@@ -80,13 +80,10 @@ void HumanTracker::addPersonEvidence(HumanTrack& t, double logodds) {
   t.camera_denied = denied;
 }
 
-void HumanTracker::observeCamera(const control::Pose2& pose, const CameraLook& look, double t_s) {
+void HumanTracker::observeCamera(const control::Pose2& pose, const CameraLook& look) {
   const CameraFusionParams& c = p_.camera;
-  if (!c.enabled) return;
-  if (have_time_ && t_s > last_t_s_) {
-    predict(std::min(t_s - last_t_s_, 0.5));
-    last_t_s_ = t_s;
-  }
+  if (!c.enabled || !have_time_) return;
+  const double t_s = last_t_s_;  // the tracks as of the last step (at most a tick old)
   ++counters_.camera_looks;
   const control::Pose2 lp = config::mountPose(pose, {look.lens_x_m, look.lens_y_m, 0.0});
   const Eigen::Vector2d lens(lp.x_m, lp.y_m);

@@ -46,7 +46,7 @@ struct CameraFusionParams {
   double person_logodds = 2.0;      // a camera-confirmed track at or above this is a person, moving or not
   double deny_logodds = -2.5;       // a track at or below this is not a person, whatever its motion
   double max_logodds = 6.0;         // evidence saturates both ways
-  int confirm_hits = 2;             // detections to confirm a camera-only track (within tracker.confirm_window_s)
+  int confirm_hits = 3;             // detections to confirm a camera-only track (within tracker.confirm_window_s)
   double bearing_hold_s = 1.0;      // this long after a detection, a track's echoes give it range only
   double max_new_range_m = 10.0;    // new tracks only from detections this close
   double edge_margin_deg = 3.0;     // a track this near the picture's edge is not counted as missed

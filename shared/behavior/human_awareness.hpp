@@ -91,9 +91,7 @@ class HumanAwareness {
   /// One tick (pose in the odometry frame, ranges in m with < 0 = no echo).
   const Awareness& step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s);
   /// A camera picture's people (HumanTracker::observeCamera); the next step() uses them.
-  void observeCamera(const control::Pose2& pose, const CameraLook& look, double t_s) {
-    tracker_.observeCamera(pose, look, t_s);
-  }
+  void observeCamera(const control::Pose2& pose, const CameraLook& look) { tracker_.observeCamera(pose, look); }
   const Awareness& last() const { return last_; }
   /// The next step() feeds `in` to the speed policy in place of the tracked
   /// nearest person (distance, speed, pattern; no passing or anticipation);

@@ -121,9 +121,10 @@ class HumanTracker {
 
   /// One tick: robot pose (odometry frame), the 4 ranges (< 0 = no echo), time.
   void step(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s);
-  /// One camera picture's people, the robot at `pose` when it was taken;
-  /// `t_s` not before the last step's (the tracks are predicted to it).
-  void observeCamera(const control::Pose2& pose, const CameraLook& look, double t_s);
+  /// One camera picture's people, the robot at `pose` when it was taken,
+  /// against the tracks as of the last step (nothing before the first step;
+  /// the tracker's time is the steps' alone).
+  void observeCamera(const control::Pose2& pose, const CameraLook& look);
 
   const std::vector<HumanTrack>& tracks() const { return tracks_; }
   const TrackerCounters& counters() const { return counters_; }

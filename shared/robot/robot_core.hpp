@@ -56,10 +56,10 @@ class RobotCore {
   /// Turns on human awareness (people tracking and the Eq 9 speed factor).
   void setAwareness(std::unique_ptr<behavior::HumanAwareness> a) { awareness_ = std::move(a); }
 
-  /// A camera picture's people (the robot at its present pose and the MCU's
-  /// clock: the picture's ~0.1 s age is in the fusion's bearing noise).
+  /// A camera picture's people (the robot at its present pose: the
+  /// picture's ~0.1 s age is in the fusion's bearing noise).
   void onCameraLook(const behavior::CameraLook& look) {
-    if (awareness_) awareness_->observeCamera(estimate_.pose(), look, estimate_.clock().control_s);
+    if (awareness_) awareness_->observeCamera(estimate_.pose(), look);
   }
 
   /// The TCP link came up (handshake accepted) / went down.

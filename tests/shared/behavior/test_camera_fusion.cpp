@@ -53,7 +53,7 @@ TEST(CameraFusion, ACrossingPersonBeyondTheSonarsIsTrackedByTheCameraWithItsVelo
     const double t = k * 0.01;
     const Circle p{6.0, 1.5 - 1.0 * t, 0.25};
     tr.step(robot, echoes(u, robot, {p}, {}, &rng), t);
-    if (k % 20 == 0) tr.observeCamera(robot, look(robot, {p}, rng), t);
+    if (k % 20 == 0) tr.observeCamera(robot, look(robot, {p}, rng));
   }
   const auto* n = only(tr);
   ASSERT_NE(n, nullptr) << tr.tracks().size() << " tracks";
@@ -81,7 +81,7 @@ TEST(CameraFusion, TheCameraTellsCrossingFromRadialMotionWhereTheSonarsCannot) {
     const Circle p{3.5, -0.8 + 0.8 * t, 0.25};
     sonar_only.step(robot, echoes(u, robot, {p}, {}, &rng_a), t);
     fused.step(robot, echoes(u, robot, {p}, {}, &rng_b), t);
-    if (k % 20 == 0) fused.observeCamera(robot, look(robot, {p}, rng_c), t);
+    if (k % 20 == 0) fused.observeCamera(robot, look(robot, {p}, rng_c));
     if (k >= 120 && k % 10 == 0) {  // the last 0.8 s, the person inside the cones
       const auto* a = sonar_only.nearest(robot);
       const auto* b = fused.nearest(robot);
@@ -113,7 +113,7 @@ TEST(CameraFusion, AMovingEchoTheCameraLooksAtAndNeverFindsIsNotAPerson) {
     const Circle cart{4.3 - 0.4 * t, 0.0, 0.3};
     sonar_only.step(robot, echoes(u, robot, {cart}, {}, &rng_a), t);
     fused.step(robot, echoes(u, robot, {cart}, {}, &rng_b), t);
-    if (k % 20 == 0) fused.observeCamera(robot, CameraLook{}, t);  // looking ahead, nobody found
+    if (k % 20 == 0) fused.observeCamera(robot, CameraLook{});  // looking ahead, nobody found
     if (k == 250) {
       sonar_person = sonar_only.nearest(robot) != nullptr;
       fused_person_late = fused.nearest(robot) != nullptr;
@@ -138,7 +138,7 @@ TEST(CameraFusion, AStandingPersonTheCameraFindsIsAPersonAndOneHiddenBehindIsNot
     tr.step(robot, echoes(u, robot, {}, {}, &rng), t);
     if (k % 20 != 0) continue;
     // First both are found; from 1 s on the one behind is hidden by the one in front.
-    tr.observeCamera(robot, k < 100 ? look(robot, {front, behind}, rng) : look(robot, {front}, rng), t);
+    tr.observeCamera(robot, k < 100 ? look(robot, {front, behind}, rng) : look(robot, {front}, rng));
   }
   ASSERT_EQ(tr.tracks().size(), 2u);
   for (const auto& t : tr.tracks()) {
@@ -162,7 +162,7 @@ TEST(CameraFusion, ABearingWithoutARangeMovesTheTrackSideways) {
     tr.step(robot, echoes(u, robot, {}, {}, &rng), t);
     if (k % 20 != 0) continue;
     const Circle p{5.0, k < 100 ? 0.0 : 0.5 * (t - 1.0), 0.25};
-    tr.observeCamera(robot, look(robot, {p}, rng, k < 100), t);
+    tr.observeCamera(robot, look(robot, {p}, rng, k < 100));
   }
   const auto* n = only(tr);
   ASSERT_NE(n, nullptr) << tr.tracks().size() << " tracks, " << tr.counters().camera_associated << " detections associated";
@@ -183,7 +183,7 @@ TEST(CameraFusion, BadDetectionsAndAFullTableAreHarmless) {
   for (int i = 0; i < 6; ++i) l.add({-0.4 + 0.15 * i, 4.0 + i});
   EXPECT_FALSE(l.add({0.0, 5.0})) << "8 people a picture at most";
   tr.step(robot, {-1, -1, -1, -1}, 0.0);
-  tr.observeCamera(robot, l, 0.0);
+  tr.observeCamera(robot, l);
   EXPECT_EQ(tr.tracks().size(), 3u);
   for (const auto& t : tr.tracks()) EXPECT_TRUE(t.x.allFinite());
   EXPECT_EQ(tr.counters().camera_detections, 6u) << "the two non-finite ones are not detections";
