@@ -149,11 +149,12 @@ TEST(VideoStack, StreamsDecodesRecoversAndPlaysFromTheSdp) {
   // tail probe's answer, retries sent twice: 7 in a run here); of the media
   // packets it took, the history (20) repairs the newest 18-20.
   EXPECT_GE(counters[1], 8) << "the relay's burst was seen as lost, beyond the history\n" << out;
-  const auto repair = statsNumbers(out, "repair", 0);  // NACKs, packets, retransmissions, unneeded, PLIs, RTT
-  ASSERT_GE(repair.size(), 5u) << out;
+  // NACKs, packets, retransmissions, unneeded, tail probes, PLIs, RTT
+  const auto repair = statsNumbers(out, "repair", 0);
+  ASSERT_GE(repair.size(), 6u) << out;
   EXPECT_GE(repair[0], 1) << "NACKs sent\n" << out;
   EXPECT_GE(repair[2], 1) << "retransmissions taken\n" << out;
-  EXPECT_GE(repair[4], 1) << "a PLI with the keyframe request\n" << out;
+  EXPECT_GE(repair[5], 1) << "a PLI with the keyframe request\n" << out;
   EXPECT_NE(out.find("| video "), std::string::npos) << out;
   EXPECT_NE(out.find("fps"), std::string::npos) << out;
   EXPECT_TRUE(exists(snap)) << out;
