@@ -351,13 +351,15 @@ void RobotSession::acceptHello(const v1::Hello& hello) {
   peer_.wall_known = hello.wall_time_us() > 0;
   if (peer_.wall_known)
     peer_.wall_offset_us = static_cast<int64_t>(wallNowNs() / 1000) - static_cast<int64_t>(hello.wall_time_us());
-  registry_.onConnected(peer_.robot_id, address_, serial_, hello, monoNowNs());
   std::string caps;
   for (const auto& c : hello.capabilities()) caps += (caps.empty() ? "" : ",") + c;
   log::info(log::tag::kLink, peer_.robot_id, " connected from ", address_, " (software '", hello.software_version(),
             "', capabilities [", caps, "])");
+  // Attached before the registry says "connected": a console that sees the robot in `robots`
+  // (e.g. a script's `expect robots >= 1`) must find its session for the next command.
   server_.attach(peer_.robot_id, shared_from_this());
   if (closed_) return;
+  registry_.onConnected(peer_.robot_id, address_, serial_, hello, monoNowNs());
   v1::Envelope env;
   auto* r = env.mutable_hello_reply();
   r->set_accepted(true);
