@@ -26,7 +26,7 @@ constexpr auto kRefusalDebounce = std::chrono::seconds(1);
 }  // namespace
 
 std::vector<uint32_t> FoxgloveBridge::RobotChannels::all() const {
-  std::vector<uint32_t> ids{telemetry, events, acks, alarms, camera, tf, scene, log, video_stats};
+  std::vector<uint32_t> ids{telemetry, events, acks, alarms, camera, camera_people, tf, scene, log, video_stats};
   for (const auto& [name, id] : grids) ids.push_back(id);
   std::erase(ids, 0u);
   return ids;
@@ -99,6 +99,7 @@ void FoxgloveBridge::advertiseRobot(const std::string& robot, RobotState& r) {
   c.acks = addChannel(p + "acks", v1::Ack::descriptor(), WsServer::Kind::kData);
   c.alarms = addChannel(p + "alarms", v1::GasAlarm::descriptor(), WsServer::Kind::kData);
   c.camera = addChannel(p + "camera", ::foxglove::CompressedVideo::descriptor(), WsServer::Kind::kVideo);
+  c.camera_people = addChannel(p + "camera_people", ::foxglove::ImageAnnotations::descriptor(), WsServer::Kind::kData);
   c.tf = addChannel(p + "tf", ::foxglove::FrameTransforms::descriptor(), WsServer::Kind::kData);
   c.scene = addChannel(p + "scene", ::foxglove::SceneUpdate::descriptor(), WsServer::Kind::kData);
   c.log = addChannel(p + "log", ::foxglove::Log::descriptor(), WsServer::Kind::kData);
@@ -131,11 +132,19 @@ void FoxgloveBridge::onEnvelope(const std::string& robot, const v1::Envelope& en
   }
   switch (env.body_case()) {
     case v1::Envelope::kHello: r.scene->onHello(env.hello()); break;
-    case v1::Envelope::kTelemetry:
-      r.scene->onTelemetry(env.telemetry());
-      publishMessage(r.ch.telemetry, ns, env.telemetry());
+    case v1::Envelope::kTelemetry: {
+      const auto& t = env.telemetry();
+      r.scene->onTelemetry(t);
+      publishMessage(r.ch.telemetry, ns, t);
+      const int64_t link_offset_us = static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us());
+      if (const auto capture_ns = r.people_clock.fresh(t, link_offset_us, monoUsToWallNs);
+          capture_ns && server_.subscribed(r.ch.camera_people)) {
+        publishMessage(r.ch.camera_people, *capture_ns,
+                       scene::cameraPeople(t.perception(), t.video().width(), t.video().height(), *capture_ns));
+      }
       if (server_.subscribed(r.ch.tf)) publishMessage(r.ch.tf, ns, r.scene->transforms(ns));
       break;
+    }
     case v1::Envelope::kEvent: {
       const auto& e = env.event();
       r.scene->onEvent(e);
@@ -151,14 +160,15 @@ void FoxgloveBridge::onEnvelope(const std::string& robot, const v1::Envelope& en
 
 void FoxgloveBridge::onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us) {
   uint32_t channel = 0;
+  const uint64_t ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
   {
     std::lock_guard lk(mu_);
     const auto it = robots_.find(robot);
     if (it == robots_.end() || !it->second.connected) return;
+    it->second.people_clock.onAccessUnit(frame, capture_us, ns);
     channel = it->second.ch.camera;
   }
   if (!server_.subscribed(channel)) return;
-  const uint64_t ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
   const auto v = scene::RobotScene::cameraFrame(robot, frame, ns);
   server_.publish(channel, ns, std::make_shared<const std::string>(v.SerializeAsString()), frame.keyframe);
 }

@@ -22,6 +22,7 @@
 #include "pc_server/console/console.hpp"
 #include "pc_server/foxglove/client_operator.hpp"
 #include "pc_server/foxglove/ws_server.hpp"
+#include "pc_server/scene/camera_people.hpp"
 #include "pc_server/scene/robot_scene.hpp"
 #include "pc_server/scene/site_maps.hpp"
 #include "shared/video/rtp_h264.hpp"
@@ -72,12 +73,14 @@ class FoxgloveBridge : public WsServer::Handler {
 
  private:
   struct RobotChannels {
-    uint32_t telemetry = 0, events = 0, acks = 0, alarms = 0, camera = 0, tf = 0, scene = 0, log = 0, video_stats = 0;
+    uint32_t telemetry = 0, events = 0, acks = 0, alarms = 0, camera = 0, camera_people = 0, tf = 0, scene = 0, log = 0,
+             video_stats = 0;
     std::map<std::string, uint32_t> grids;  // gas channel -> channel id
     std::vector<uint32_t> all() const;
   };
   struct RobotState {
     std::unique_ptr<scene::RobotScene> scene;
+    scene::CameraPeopleClock people_clock;  // detected pictures on the camera channel's clock
     RobotChannels ch;
     uint64_t map_version = 0;
     bool connected = false;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "foxglove/CompressedVideo.pb.h"
+#include "pc_server/scene/camera_people.hpp"
 #include "shared/record/mcap_writer.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
@@ -57,7 +58,8 @@ struct Recorder::Run {
   uint16_t ch_telemetry = 0, ch_command = 0, ch_ack = 0, ch_event = 0, ch_server = 0, ch_camera = 0, ch_info = 0;
   // The 3-D scene (the live bridge's, so that the run replays the same view).
   std::unique_ptr<scene::RobotScene> scene;
-  uint16_t ch_tf = 0, ch_scene = 0, ch_log = 0;
+  uint16_t ch_tf = 0, ch_scene = 0, ch_log = 0, ch_camera_people = 0;
+  scene::CameraPeopleClock people_clock;  // detected pictures on the camera channel's clock
   std::map<std::string, uint16_t> ch_grid;
   uint64_t last_tf_ns = 0, last_scene_ns = 0, last_grid_ns = 0, map_version = 0;
   std::unique_ptr<video::Mp4Writer> mp4;
@@ -204,6 +206,7 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
     run->ch_event = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/event");
     run->ch_server = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/server_event");
     run->ch_camera = run->mcap.addProtobufChannel(::foxglove::CompressedVideo::descriptor(), "/camera");
+    run->ch_camera_people = run->mcap.addProtobufChannel(::foxglove::ImageAnnotations::descriptor(), "/camera_people");
     run->ch_info = run->mcap.addProtobufChannel(v1::Hello::descriptor(), "/robot_info");
     run->ch_tf = run->mcap.addProtobufChannel(::foxglove::FrameTransforms::descriptor(), "/tf");
     run->ch_scene = run->mcap.addProtobufChannel(::foxglove::SceneUpdate::descriptor(), "/scene");
@@ -387,6 +390,13 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
         }
         r.mcap.write(r.ch_telemetry, log_ns, publish_ns, env.telemetry());
         r.scene->onTelemetry(env.telemetry());
+        if (const auto capture_ns = r.people_clock.fresh(
+                env.telemetry(), static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us()),
+                monoUsToWallNs)) {
+          const auto& t = env.telemetry();
+          r.mcap.write(r.ch_camera_people, log_ns, *capture_ns,
+                       scene::cameraPeople(t.perception(), t.video().width(), t.video().height(), *capture_ns));
+        }
         writeScene(r, robot, log_ns, true);
         break;
       case v1::Envelope::kCommand:
@@ -447,6 +457,7 @@ void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame,
   Run& r = *it->second;
   ++r.video_frames;
   const uint64_t capture_wall_ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
+  r.people_clock.onAccessUnit(frame, capture_us, capture_wall_ns);
   const auto v = scene::RobotScene::cameraFrame(robot, frame, capture_wall_ns);
   try {
     r.mcap.write(r.ch_camera, wallNowNs(), capture_wall_ns, v);

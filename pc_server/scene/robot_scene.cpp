@@ -5,6 +5,7 @@
 #include <cstring>
 #include <numbers>
 
+#include "pc_server/scene/foxglove_fields.hpp"
 #include "shared/world/world.hpp"
 
 namespace inspect::server::scene {
@@ -28,10 +29,6 @@ Quat operator*(const Quat& a, const Quat& b) {
 Quat yawQ(double yaw) { return {std::cos(yaw / 2), 0, 0, std::sin(yaw / 2)}; }
 Quat pitchQ(double pitch) { return {std::cos(pitch / 2), 0, std::sin(pitch / 2), 0}; }
 
-void setTime(google::protobuf::Timestamp* t, uint64_t ns) {
-  t->set_seconds(static_cast<int64_t>(ns / 1'000'000'000ULL));
-  t->set_nanos(static_cast<int32_t>(ns % 1'000'000'000ULL));
-}
 void setQ(::foxglove::Quaternion* q, const Quat& v) {
   q->set_w(v.w);
   q->set_x(v.x);
@@ -43,12 +40,6 @@ void setPose(::foxglove::Pose* p, double x, double y, double z, const Quat& q = 
   p->mutable_position()->set_y(y);
   p->mutable_position()->set_z(z);
   setQ(p->mutable_orientation(), q);
-}
-void setColor(::foxglove::Color* c, double r, double g, double b, double a) {
-  c->set_r(r);
-  c->set_g(g);
-  c->set_b(b);
-  c->set_a(a);
 }
 void setVec(::foxglove::Vector3* v, double x, double y, double z) {
   v->set_x(x);
@@ -352,6 +343,7 @@ void RobotScene::onEvent(const v1::Event& e) {
     }
     std::string label = "person " + std::to_string(p.id()) + " " + fmt(speed) + " m/s";
     if (const auto n = patternName(p.pattern()); !n.empty()) label += " " + n;
+    if (p.camera_seen()) label += " (camera)";
     addText(people, label, p.x_m(), p.y_m(), 2.1, 0.15);
     for (std::size_t k = 0; k < kProxemicM.size(); ++k) {
       auto* ring = people->add_lines();
@@ -364,6 +356,28 @@ void RobotScene::onEvent(const v1::Event& e) {
         const double a = 2 * std::numbers::pi * j / kN;
         addPoint(ring, kProxemicM[k] * std::cos(a), kProxemicM[k] * std::sin(a), 0);
       }
+    }
+  }
+
+  // The camera's detections of the latest picture (robot frame): a ray along each bearing from
+  // the lens, to the feet when the range is known, else dimmed to kBearingRayM.
+  auto* seen = entity(u, "camera_people", frame("base_link"), ns);
+  if (t.has_perception()) {
+    constexpr double kBearingRayM = 8.0;
+    for (const auto& s : t.perception().people()) {
+      const bool ranged = s.has_range_m();
+      const double x1 = ranged ? s.x_m() : g_.camera_x_m + kBearingRayM * std::cos(s.bearing_rad());
+      const double y1 = ranged ? s.y_m() : g_.camera_y_m + kBearingRayM * std::sin(s.bearing_rad());
+      auto* ray = seen->add_lines();
+      ray->set_type(::foxglove::LinePrimitive::LINE_STRIP);
+      setPose(ray->mutable_pose(), 0, 0, 0.05);
+      ray->set_thickness(0.03);
+      setColor(ray->mutable_color(), 1.0, 0.55, 0.1, ranged ? 0.9 : 0.45);
+      addPoint(ray, g_.camera_x_m, g_.camera_y_m, 0);
+      addPoint(ray, x1, y1, 0);
+      const double deg = s.bearing_rad() * 180 / std::numbers::pi;
+      addText(seen, "camera " + std::string(deg >= 0 ? "+" : "") + fmt(deg, 0) + " deg" + (ranged ? " " + fmt(s.range_m()) + " m" : ""),
+              x1, y1, 0.3, 0.14);
     }
   }
 

@@ -133,6 +133,10 @@ class HumanTracker {
   /// Per sensor, last step: its echo went to a track that is a person (such
   /// echoes are people, not obstacles to steer round: they get the Eq 9 factor).
   const std::array<bool, 4>& personEchoes() const { return person_echo_; }
+  /// The camera detected this track within camera.bearing_hold_s of the last step.
+  bool cameraSeen(const HumanTrack& t) const {
+    return t.camera_seen_s >= 0 && last_t_s_ - t.camera_seen_s <= p_.camera.bearing_hold_s;
+  }
 
  private:
   void predict(double dt);

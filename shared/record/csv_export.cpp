@@ -180,11 +180,13 @@ std::string fileBase(std::string_view topic) {
 }
 
 /// The 3-D scene's channels (docs/foxglove.md) are drawings of what the other
-/// channels hold (walls, beams, rings; pixels of the gas maps): no table.
+/// channels hold (walls, beams, rings; pixels of the gas maps; the telemetry's
+/// people as boxes on the camera image): no table.
 bool drawing(const pb::Descriptor* d) {
   if (!d) return false;
   const std::string& n = d->full_name();
-  return n == "foxglove.SceneUpdate" || n == "foxglove.FrameTransforms" || n == "foxglove.Grid";
+  return n == "foxglove.SceneUpdate" || n == "foxglove.FrameTransforms" || n == "foxglove.Grid" ||
+         n == "foxglove.ImageAnnotations";
 }
 
 }  // namespace

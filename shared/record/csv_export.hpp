@@ -27,7 +27,8 @@ struct CsvExportResult {
 };
 
 /// Writes `out_dir`/<topic>.csv for every channel of the MCAP file but the 3-D
-/// scene's (foxglove.SceneUpdate, FrameTransforms, Grid: drawings of the others' data) (topic
+/// scene's and the image's (foxglove.SceneUpdate, FrameTransforms, Grid, ImageAnnotations:
+/// drawings of the others' data) (topic
 /// without its leading '/', other '/' as '_'; "_<channel id>" appended when
 /// two channels would share a name, and then the key is "<topic>#<id>" for a
 /// topic seen twice). Creates `out_dir`. A file cut off (no footer) exports

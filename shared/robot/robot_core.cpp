@@ -487,6 +487,8 @@ void RobotCore::fillTelemetry(v1::Telemetry& t, double now_s) const {
       p->set_vy_m_s(tr.x[3]);
       const bool is_nearest = &tr == nearest;
       p->set_nearest(is_nearest);
+      p->set_camera_seen(awareness_->tracker().cameraSeen(tr));
+      p->set_camera_hits(static_cast<uint32_t>(tr.camera_hits));
       p->set_pattern(is_nearest ? static_cast<v1::HumanPattern>(static_cast<int>(a.pattern)) : v1::PATTERN_NONE);
     }
   } else {

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -134,5 +135,16 @@ int64_t nowNs() {
 }
 
 void sleepS(double s) { std::this_thread::sleep_for(std::chrono::duration<double>(s)); }
+
+std::string captureOutput(const std::string& cmd, int timeout_s) {
+  std::string out;
+  if (FILE* p = ::popen(("timeout " + std::to_string(timeout_s) + " " + cmd + " 2>&1").c_str(), "r")) {
+    char buf[4096];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+    ::pclose(p);
+  }
+  return out;
+}
 
 }  // namespace inspect::test

@@ -53,6 +53,8 @@ class TempDir {
 std::string readFile(const std::string& path);
 void writeFile(const std::string& path, const std::string& text);
 bool exists(const std::string& path);
+/// stdout and stderr of a shell command, bounded by `timeout timeout_s`.
+std::string captureOutput(const std::string& cmd, int timeout_s = 60);
 /// Polls `pred` every 10 ms until it holds or timeout_s passes.
 bool waitUntil(const std::function<bool()>& pred, double timeout_s);
 /// Monotonic clock, ns (the same clock mcu_sim writes in its truth log).

@@ -222,11 +222,11 @@ async function main() {
   // 2. A client that subscribes to every channel and decodes everything.
   const a = new Session("A");
   await a.opened;
-  await until(() => a.serverInfo && a.channels.size >= 9 && a.services.size > 0, 5000);
+  await until(() => a.serverInfo && a.channels.size >= 10 && a.services.size > 0, 5000);
   check(a.serverInfo && a.serverInfo.capabilities.includes("clientPublish") && a.serverInfo.capabilities.includes("services"),
         `serverInfo capabilities: ${JSON.stringify(a.serverInfo && a.serverInfo.capabilities)}`);
   check(a.serverInfo && a.serverInfo.sessionId, "serverInfo has no sessionId");
-  for (const t of ["telemetry", "events", "acks", "alarms", "camera", "tf", "scene", "log", "video_stats"])
+  for (const t of ["telemetry", "events", "acks", "alarms", "camera", "camera_people", "tf", "scene", "log", "video_stats"])
     check([...a.channels.values()].some((c) => c.topic === `/${robot}/${t}`), `no channel /${robot}/${t}`);
   for (const s of ["/stop", "/estop", "/resume", "/goto", "/route", "/inspect", "/record_start", "/record_stop",
                    "/control_take", "/control_release"])

@@ -22,17 +22,6 @@ using namespace inspect::test;
 
 namespace {
 
-/// stdout of a shell command (bounded by `timeout`).
-std::string capture(const std::string& cmd) {
-  std::string out;
-  if (FILE* p = ::popen(("timeout 60 " + cmd + " 2>&1").c_str(), "r")) {
-    char buf[4096];
-    std::size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-    ::pclose(p);
-  }
-  return out;
-}
 
 /// {"/telemetry": n, ...} from tests/tools/mcap_reader (path in INSPECT_MCAP_READER).
 int topicCount(const std::string& json, const std::string& topic) {
@@ -42,7 +31,7 @@ int topicCount(const std::string& json, const std::string& topic) {
 }
 
 int ffprobeFrames(const std::string& mp4) {
-  const auto out = capture("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames "
+  const auto out = captureOutput("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames "
                            "-of csv=p=0 " + mp4);
   return std::atoi(out.c_str());
 }
@@ -98,7 +87,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
 
   // 1. The first run, ended normally: every reader opens it.
   const std::string first = runDir(runs, ids[0]);
-  const auto counts = capture(std::string("node ") + reader + " " + first + "/run.mcap");
+  const auto counts = captureOutput(std::string("node ") + reader + " " + first + "/run.mcap");
   EXPECT_GT(topicCount(counts, "/telemetry"), 150) << counts;  // 50 Hz for ~5 s
   EXPECT_GT(topicCount(counts, "/camera"), 90) << counts;      // 30 fps (~150, less the stream's start)
   EXPECT_GT(topicCount(counts, "/command"), 20) << counts;     // teleop re-sent at 20 Hz
@@ -156,7 +145,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
     ASSERT_TRUE(d.has_value());
     EXPECT_EQ(d->info.outcome, "incomplete");
     // Seconds of telemetry lost: from the last message kept to the kill.
-    const auto counts2 = capture(std::string("node ") + reader + " " + second + "/run.mcap");
+    const auto counts2 = captureOutput(std::string("node ") + reader + " " + second + "/run.mcap");
     const int telemetry = topicCount(counts2, "/telemetry");
     const double recorded_s = std::chrono::duration<double>(kill_time - d->info.start).count();
     const double lost_s = recorded_s - telemetry / 50.0;

@@ -8,6 +8,11 @@
 // embedded schema (protobuf: protobufjs from the FileDescriptorSet, as
 // Foxglove does); any failure is an error, and "decoded" gives the count.
 //
+// --annotations TOPIC IMAGE_TOPIC (with --decode): the foxglove.ImageAnnotations
+// on TOPIC against the pictures on IMAGE_TOPIC, as Foxglove's Image panel pairs
+// them (by time): "annotations": {messages, boxes, on_a_picture (messages whose
+// time is a picture's publish time), labels (the first few texts)}.
+//
 // A file that ends with the MCAP magic is opened with McapIndexedReader (footer,
 // summary, chunk indexes, every chunk's CRC) and then read again from start to
 // end with McapStreamReader, which must agree; the data-section CRC in DataEnd
@@ -47,7 +52,7 @@ function makeDecoder(schema) {
   return (data) => type.decode(data);
 }
 
-async function readIndexed(path, decode) {
+async function readIndexed(path, decode, annotations) {
   const handle = await fs.promises.open(path, "r");
   try {
     const readable = {
@@ -63,13 +68,21 @@ async function readIndexed(path, decode) {
     const counts = {};
     const decoders = new Map();
     let decoded = 0;
+    const pictures = new Set();
+    const annotated = [];
     for await (const message of reader.readMessages({ validateCrcs: true })) {
       const channel = reader.channelsById.get(message.channelId);
       addCount(counts, channel.topic);
       if (!decode) continue;
       if (!decoders.has(channel.schemaId)) decoders.set(channel.schemaId, makeDecoder(reader.schemasById.get(channel.schemaId)));
       try {
-        decoders.get(channel.schemaId)(message.data);
+        const m = decoders.get(channel.schemaId)(message.data);
+        if (annotations && channel.topic === annotations[1]) pictures.add(message.publishTime);
+        if (annotations && channel.topic === annotations[0]) {
+          const ts = m.timestamp ? BigInt(m.timestamp.seconds) * 1000000000n + BigInt(m.timestamp.nanos) : 0n;
+          if (ts !== message.publishTime) throw new Error(`timestamp ${ts} is not the publish time ${message.publishTime}`);
+          annotated.push({ time: message.publishTime, boxes: m.points.length, texts: m.texts.map((t) => t.text) });
+        }
       } catch (e) {
         throw new Error(`${channel.topic}: a message at ${message.logTime} does not decode with its schema: ${e.message}`);
       }
@@ -95,7 +108,17 @@ async function readIndexed(path, decode) {
     } else {
       process.stderr.write("read_mcap: this node has no zlib.crc32, data section CRC not checked\n");
     }
-    return { counts, schemas: reader.schemasById.size, chunks: reader.chunkIndexes.length, decoded };
+    const result = { counts, schemas: reader.schemasById.size, chunks: reader.chunkIndexes.length, decoded };
+    if (annotations) {
+      const labels = annotated.flatMap((a) => a.texts);
+      result.annotations = {
+        messages: annotated.length,
+        boxes: annotated.reduce((n, a) => n + a.boxes, 0),
+        on_a_picture: annotated.filter((a) => pictures.has(a.time)).length,
+        labels: labels.slice(0, 3),
+      };
+    }
+    return result;
   } finally {
     await handle.close();
   }
@@ -154,11 +177,13 @@ async function main() {
   let stream = false;
   let decode = false;
   let expectPath;
+  let annotations;
   let path;
   for (let i = 0; i < args.length; i++) {
     if (args[i] === "--stream") stream = true;
     else if (args[i] === "--decode") decode = true;
     else if (args[i] === "--expect") expectPath = args[++i];
+    else if (args[i] === "--annotations") annotations = [args[++i], args[++i]];
     else if (!path) path = args[i];
     else throw new Error(`unexpected argument ${args[i]}`);
   }
@@ -166,7 +191,8 @@ async function main() {
 
   let result;
   if (!stream && endsWithMagic(path)) {
-    result = await readIndexed(path, decode);
+    if (annotations && !decode) throw new Error("--annotations needs --decode");
+    result = await readIndexed(path, decode, annotations);
     const linear = readStream(path, true);
     if (!sameJson(result.counts, linear.counts) || linear.schemas !== result.schemas || linear.chunks !== result.chunks) {
       throw new Error(`indexed and stream readers disagree: ${JSON.stringify(result)} vs ${JSON.stringify(linear)}`);
@@ -179,6 +205,7 @@ async function main() {
     if (result.decoded === undefined) throw new Error("--decode needs a complete (indexed) file");
     out.decoded = result.decoded;
   }
+  if (result.annotations) out.annotations = result.annotations;
   process.stdout.write(JSON.stringify(out) + "\n");
   if (expectPath) {
     const expected = JSON.parse(fs.readFileSync(expectPath, "utf8"));
