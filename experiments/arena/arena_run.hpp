@@ -10,6 +10,7 @@
 
 #include "experiments/arena/episode.hpp"
 #include "experiments/arena/ground_truth.hpp"
+#include "shared/perception/people_detector.hpp"
 #include "sim/detector_model.hpp"
 
 namespace inspect::arena {
@@ -60,11 +61,19 @@ struct EpisodeMetrics {
 /// The robot's camera in the arena: its people detections drawn from the
 /// detector model (sim/detector_model.hpp) at `rate_hz`, the camera looking
 /// ahead, fed to the people tracker as robot_client feeds the real
-/// detector's. Off: the sonars alone.
+/// detector's. Off: the sonars alone. `real`: the model's cross-check
+/// (docs/scenarios.md, "The camera's cross-check"): each picture rendered by
+/// the simulator's camera (sim/camera_view, with bench_people's sensor noise
+/// and blur) and the robot's people detector run on it, its boxes turned into
+/// bearings and foot-row ranges as robot_client does (about 70 ms a picture).
 struct ArenaCamera {
   bool enabled = true;
   double rate_hz = 5.0;
   sim::DetectorModelParams model;
+  bool real = false;
+  int width = 640, height = 480;
+  double noise_sigma = 3.0, exposure_ms = 8.0;  // bench_people's defaults
+  perception::PeopleDetectorOptions detector;   // robot_client's default (config/client.yaml)
 };
 
 /// Runs `e` with `p`. `reference_s` is the time to goal of the same episode
