@@ -99,9 +99,11 @@ void HumanTracker::observeCamera(const control::Pose2& pose, const CameraLook& l
     if (!std::isfinite(seen.bearing_rad) || !std::isfinite(seen.range_m)) continue;
     ++counters_.camera_detections;
     const bool ranged = seen.range_m > 0;
+    // The foot row reads long by the detector's median (its boxes end above the soles).
+    const double range = ranged ? seen.range_m / (1.0 + c.range_bias_frac) : 0.0;
     const double bearing = wrapAngle(pose.theta_rad + seen.bearing_rad);
-    const double sr = std::max(0.05, c.range_sigma_frac * seen.range_m);
-    const Converted m = convert(lens, bearing, std::max(seen.range_m, 0.0), sr, sb);
+    const double sr = std::max(0.05, c.range_sigma_frac * range);
+    const Converted m = convert(lens, bearing, range, sr, sb);
     // 1. The nearest track by normalised innovation.
     std::size_t best = kMaxMatched;
     double best_d2 = c.gate_chi2;
@@ -168,7 +170,7 @@ void HumanTracker::observeCamera(const control::Pose2& pose, const CameraLook& l
       continue;
     }
     // 3. A camera-only track, at the detection with its covariance.
-    if (!ranged || seen.range_m > c.max_new_range_m || static_cast<int>(tracks_.size()) >= p_.max_tracks) continue;
+    if (!ranged || range > c.max_new_range_m || static_cast<int>(tracks_.size()) >= p_.max_tracks) continue;
     HumanTrack t;
     t.id = next_id_++;
     t.x << m.z.x(), m.z.y(), 0, 0;

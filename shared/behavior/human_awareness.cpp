@@ -140,6 +140,7 @@ CameraFusionParams readCameraFusion(const config::ConfigNode& n) {
   c.enabled = n.boolean("enabled", c.enabled);
   c.bearing_sigma_deg = n.number("bearing_sigma_deg", c.bearing_sigma_deg, 0.01, 20);
   c.range_sigma_frac = n.number("range_sigma_frac", c.range_sigma_frac, 0.01, 2);
+  c.range_bias_frac = n.number("range_bias_frac", c.range_bias_frac, -0.5, 1);
   c.gate_chi2 = n.number("gate_chi2", c.gate_chi2, 1, 100);
   c.hit_logodds = n.number("hit_logodds", c.hit_logodds, 0, 10);
   c.person_logodds = n.number("person_logodds", c.person_logodds, 0, 10);

@@ -221,12 +221,39 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
         best = &t;
       }
     }
+    // 3b. A track the camera placed (its range from the foot row, +-25 %) may
+    // be metres off along its bearing, and a front echo's lateral place (one
+    // cone, or the two ranges' trilateration) a metre off across it: an echo
+    // within a detection's error of a track the camera saw in the last
+    // bearing_hold_s is that person, not a second one. The gate is one
+    // detection's error, not the track's covariance: a person's foot-row error
+    // is much the same picture after picture, so averaging does not shrink it.
+    if (!best) {
+      double best_d2 = p_.camera.gate_chi2;
+      for (auto& t : tracks_) {
+        if (!cameraSeenAt(t, t_s)) continue;
+        const Eigen::Vector2d v = z - t.x.head<2>();
+        const double r = std::hypot(t.x[0] - pose.x_m, t.x[1] - pose.y_m);
+        const double yaw = std::atan2(t.x[1] - pose.y_m, t.x[0] - pose.x_m);
+        const Eigen::Matrix2d s =
+            beamCovariance(yaw, std::max(0.05, p_.camera.range_sigma_frac * r),
+                           std::max(0.05, r * p_.camera.bearing_sigma_deg * M_PI / 180.0)) +
+            beamCovariance(echo[i].yaw, std::max(p_.range_sigma_m, 0.01),
+                           std::max(0.1, echo[i].range * std::tan(sonar_.beam_width_rad / 2)));
+        const double d2 = v.dot(s.ldlt().solve(v));
+        if (d2 < best_d2) {
+          best_d2 = d2;
+          best = &t;
+        }
+      }
+      if (best) ++counters_.camera_echo_joins;
+    }
     if (best) {
       // A track the camera saw lately has its bearing from the camera: the
       // echo gives it range only (across the beam, the whole cone), or its
       // 100 echoes a second, each placed on the beam's centre line, would
       // outweigh the bearings and pull a crossing person back to the centre.
-      const bool camera_bearing = best->camera_seen_s >= 0 && t_s - best->camera_seen_s <= p_.camera.bearing_hold_s;
+      const bool camera_bearing = cameraSeenAt(*best, t_s);
       const Eigen::Matrix2d r =
           camera_bearing ? beamCovariance(echo[i].yaw, std::max(p_.range_sigma_m, 0.01),
                                           std::max(0.1, echo[i].range * std::tan(sonar_.beam_width_rad / 2)))

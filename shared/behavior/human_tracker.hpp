@@ -112,6 +112,7 @@ struct TrackerCounters {
   uint64_t camera_merged = 0;               // sonar tracks found to be a detected person's, merged into its track
   uint64_t camera_misses = 0;               // track-pictures that should have shown a track and did not
   uint64_t camera_denials = 0;              // tracks that became not-a-person by the camera
+  uint64_t camera_echo_joins = 0;           // echoes beyond the gate put on a camera track within its range uncertainty
 };
 
 class HumanTracker {
@@ -134,11 +135,12 @@ class HumanTracker {
   /// echoes are people, not obstacles to steer round: they get the Eq 9 factor).
   const std::array<bool, 4>& personEchoes() const { return person_echo_; }
   /// The camera detected this track within camera.bearing_hold_s of the last step.
-  bool cameraSeen(const HumanTrack& t) const {
-    return t.camera_seen_s >= 0 && last_t_s_ - t.camera_seen_s <= p_.camera.bearing_hold_s;
-  }
+  bool cameraSeen(const HumanTrack& t) const { return cameraSeenAt(t, last_t_s_); }
 
  private:
+  bool cameraSeenAt(const HumanTrack& t, double t_s) const {
+    return t.camera_seen_s >= 0 && t_s - t.camera_seen_s <= p_.camera.bearing_hold_s;
+  }
   void predict(double dt);
   bool nearMap(double x, double y) const;
   /// Persistence cell: first and last time it was hit (< 0: never).

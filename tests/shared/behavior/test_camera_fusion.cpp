@@ -66,6 +66,49 @@ TEST(CameraFusion, ACrossingPersonBeyondTheSonarsIsTrackedByTheCameraWithItsVelo
   EXPECT_EQ(tr.counters().echoes, 0u) << "no echo from 6 m";
 }
 
+TEST(CameraFusion, APersonTheCameraFoundFarOffKeepsOneTrackWhenTheSonarsHearThem) {
+  // Walking straight at the robot from 6.5 m at 0.5 m/s; the foot row reads
+  // 35 % long (the bench's p90 is +41 %), so the camera's track is about 1 m
+  // beyond the person when the front sonars first hear them at 4.2 m, and
+  // the two front ranges put them up to 0.9 m to a side: their echoes must go
+  // to that track (range only), not start a second person.
+  const config::UltrasonicConfig u;
+  HumanTracker tr(u, {});
+  std::mt19937 rng(4);
+  const control::Pose2 robot{0, 0, 0};
+  for (int k = 0; k <= 600; ++k) {
+    const double t = k * 0.01;
+    const Circle p{6.5 - 0.5 * t, 0.0, 0.25};
+    tr.step(robot, echoes(u, robot, {p}, {}, &rng), t);
+    if (k % 20 == 0) {
+      CameraLook l;
+      const double d = std::hypot(p.x - l.lens_x_m, p.y - l.lens_y_m);
+      l.add({std::atan2(p.y - l.lens_y_m, p.x - l.lens_x_m), d * 1.35});
+      tr.observeCamera(robot, l);
+    }
+  }
+  const auto* n = only(tr);
+  ASSERT_NE(n, nullptr) << tr.tracks().size() << " tracks: the sonars started a second person";
+  EXPECT_EQ(tr.counters().tracks_created, 0u) << "no sonar track (merged into the camera's: "
+                                               << tr.counters().camera_merged << ")";
+  EXPECT_GE(tr.counters().camera_echo_joins, 1u);
+  EXPECT_GT(tr.counters().associated, 100u) << "the echoes went to the camera's track";
+  EXPECT_NEAR(n->x[0], 6.5 - 0.5 * 6.0, 0.4) << "the echoes fixed the range";
+  EXPECT_TRUE(n->isPerson());
+}
+
+TEST(CameraFusion, TheFootRowsKnownBiasIsDividedOut) {
+  const config::UltrasonicConfig u;
+  behavior::HumanTrackerParams params;
+  HumanTracker tr(u, params);
+  tr.step({0, 0, 0}, {-1, -1, -1, -1}, 0.0);  // the tracker's time starts with a step
+  CameraLook l;
+  l.add({0.0, 7.0 * (1.0 + params.camera.range_bias_frac)});
+  tr.observeCamera({0, 0, 0}, l);
+  ASSERT_EQ(tr.tracks().size(), 1u);
+  EXPECT_NEAR(tr.tracks()[0].x[0], l.lens_x_m + 7.0, 1e-6);
+}
+
 TEST(CameraFusion, TheCameraTellsCrossingFromRadialMotionWhereTheSonarsCannot) {
   // A person 3.5 m ahead crossing right to left at 0.8 m/s through both
   // front cones: the sonars see the range change little and the lateral
