@@ -9,9 +9,20 @@
 #include <opencv2/imgproc.hpp>
 
 #include "shared/video/timecode.hpp"
+#include "sim/pedestrian_crowd.hpp"
 #include "sim/person_figure.hpp"
 
 namespace inspect::sim {
+
+void peopleInView(const PedestrianCrowd& crowd, std::vector<PersonInView>& out) {
+  out.clear();
+  for (std::size_t i = 0; i < crowd.size(); ++i) {
+    if (!crowd.present(i)) continue;
+    const auto& a = crowd.agent(i);
+    out.push_back({{a.position_m.x(), a.position_m.y()}, a.radius_m, static_cast<int>(i), crowd.facingRad(i),
+                   a.velocity_m_s.norm(), crowd.walkedM(i)});
+  }
+}
 
 namespace {
 

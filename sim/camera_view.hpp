@@ -55,6 +55,12 @@ struct PersonTruth {
   bool head_in_view = false; // the top of the head is inside the picture
 };
 
+class PedestrianCrowd;
+/// Replaces `out` with the crowd's present pedestrians as the camera draws
+/// them (body, look index, facing, speed, walked distance). No allocation
+/// once `out` has the capacity.
+void peopleInView(const PedestrianCrowd& crowd, std::vector<PersonInView>& out);
+
 /// One instant of the world's truth, as the camera shows it.
 struct CameraScene {
   control::Pose2 robot;              // true pose of the axle midpoint

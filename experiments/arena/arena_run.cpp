@@ -5,9 +5,7 @@
 #include <map>
 #include <memory>
 
-#include "shared/perception/camera_geometry.hpp"
 #include "shared/world/world.hpp"
-#include "sim/camera_view.hpp"
 #include "sim/simulation.hpp"
 
 namespace inspect::arena {
@@ -26,67 +24,14 @@ TruePerson truthOf(const behavior::Agent& a) {
   return {{a.position_m.x(), a.position_m.y()}, {a.velocity_m_s.x(), a.velocity_m_s.y()}, a.radius_m};
 }
 
-/// The simulator's camera and the robot's people detector (ArenaCamera::real).
-class RealCamera {
- public:
-  RealCamera(const world::World& w, const config::CameraMount& mount, const ArenaCamera& c, uint64_t seed)
-      : view_(w, mount, c.width, c.height, style(c, seed)), detector_(c.detector) {
-    cam_.width = c.width;
-    cam_.height = c.height;
-    cam_.mount = mount;
-  }
-
-  /// One picture of the robot's view now (the camera ahead), detected.
-  behavior::CameraLook look(const sim::Simulation& sim, double t_s) {
-    const auto& crowd = sim.pedestrians();
-    scene_.robot = sim.state().pose;
-    scene_.sim_time_s = t_s;
-    scene_.people.clear();
-    for (std::size_t i = 0; i < crowd.size(); ++i) {
-      if (!crowd.present(i)) continue;
-      const auto& a = crowd.agent(i);
-      scene_.people.push_back({{a.position_m.x(), a.position_m.y()}, a.radius_m, static_cast<int>(i),
-                               crowd.facingRad(i), a.velocity_m_s.norm(), crowd.walkedM(i)});
-    }
-    view_.render(scene_, static_cast<uint64_t>(t_s * 1e6), frame_index_++, frame_);
-    behavior::CameraLook look;
-    look.lens_x_m = cam_.mount.x_m;
-    look.lens_y_m = cam_.mount.y_m;
-    look.axis_rad = 0.0;
-    look.half_fov_rad = cam_.mount.hfov_deg * M_PI / 360.0;
-    for (const auto& b : detector_.detect(frame_)) {
-      const auto s = perception::sightingOf(b.box, cam_);
-      look.add({s.bearing_rad, s.range_m.value_or(-1.0)});
-    }
-    return look;
-  }
-
- private:
-  static sim::CameraViewStyle style(const ArenaCamera& c, uint64_t seed) {
-    sim::CameraViewStyle s;
-    s.look_seed = static_cast<uint32_t>(seed);
-    s.noise_sigma = c.noise_sigma;
-    s.exposure_ms = c.exposure_ms;
-    return s;
-  }
-  sim::CameraView view_;
-  perception::PeopleDetector detector_;
-  perception::CameraPose cam_;
-  sim::CameraScene scene_;
-  cv::Mat frame_;
-  uint32_t frame_index_ = 0;
-};
-
 class ArenaObserver final : public sim::RunObserver {
  public:
   ArenaObserver(const Episode& e, const sim::ScenarioContext& ctx, bool oracle, const ArenaCamera& camera)
       : world_(e.spec.world), ctx_(ctx), oracle_(oracle), avoid_m_(ctx.awareness.speed.max_avoidance_m),
-        camera_(camera), camera_rng_(e.seed * 7919 + 17) {
-    if (camera.enabled && camera.real) real_ = std::make_unique<RealCamera>(world_, ctx.robot.camera, camera, e.seed);
-  }
+        camera_(world_, ctx.robot.camera, camera, e.seed) {}
 
   void beforeFrame(const sim::Simulation& sim, behavior::HumanAwareness& aw, double t_s) override {
-    look(sim, aw, t_s);
+    camera_.beforeFrame(sim, aw, t_s);
     if (!oracle_) return;
     // The true nearest person the robot should react to: in line of sight and
     // sonar range, with a pattern (else the nearest, who needs no reaction).
@@ -200,36 +145,11 @@ class ArenaObserver final : public sim::RunObserver {
   EpisodeMetrics m;
 
  private:
-  /// A camera picture every 1 / rate_hz (the detector model on the true
-  /// scene; the tracker places it at the true pose: the odometry's drift over
-  /// a 9 m run is centimetres).
-  void look(const sim::Simulation& sim, behavior::HumanAwareness& aw, double t_s) {
-    if (!camera_.enabled || t_s + 1e-9 < next_look_s_) return;
-    next_look_s_ = t_s + 1.0 / camera_.rate_hz;
-    if (real_) {
-      aw.observeCamera(sim.state().pose, real_->look(sim, t_s));
-      return;
-    }
-    discs_.clear();
-    const auto& crowd = sim.pedestrians();
-    for (std::size_t i = 0; i < crowd.size(); ++i)
-      if (crowd.present(i)) {
-        const auto& a = crowd.agent(i);
-        discs_.push_back({a.position_m.x(), a.position_m.y(), a.radius_m});
-      }
-    aw.observeCamera(sim.state().pose,
-                     sim::detectPeople(world_, sim.state().pose, ctx_.robot.camera, 0.0, discs_, camera_.model, camera_rng_));
-  }
-
   const world::World& world_;
   const sim::ScenarioContext& ctx_;
   bool oracle_;
   double avoid_m_;
-  const ArenaCamera& camera_;
-  std::mt19937_64 camera_rng_;
-  std::unique_ptr<RealCamera> real_;
-  double next_look_s_ = 0.0;
-  std::vector<sim::PersonDisc> discs_;
+  sim::CameraLooks camera_;
   std::vector<bool> in_contact_;
   std::map<int, bool> judged_;
   control::Pose2 last_;

@@ -10,8 +10,7 @@
 
 #include "experiments/arena/episode.hpp"
 #include "experiments/arena/ground_truth.hpp"
-#include "shared/perception/people_detector.hpp"
-#include "sim/detector_model.hpp"
+#include "experiments/scenarios/scenario_camera.hpp"
 
 namespace inspect::arena {
 
@@ -58,23 +57,10 @@ struct EpisodeMetrics {
   uint32_t false_people = 0;        // person tracks that appeared where nobody was (> 1 m from everyone)
 };
 
-/// The robot's camera in the arena: its people detections drawn from the
-/// detector model (sim/detector_model.hpp) at `rate_hz`, the camera looking
-/// ahead, fed to the people tracker as robot_client feeds the real
-/// detector's. Off: the sonars alone. `real`: the model's cross-check
-/// (docs/scenarios.md, "The camera's cross-check"): each picture rendered by
-/// the simulator's camera (sim/camera_view, with bench_people's sensor noise
-/// and blur) and the robot's people detector run on it, its boxes turned into
-/// bearings and foot-row ranges as robot_client does (about 70 ms a picture).
-struct ArenaCamera {
-  bool enabled = true;
-  double rate_hz = 5.0;
-  sim::DetectorModelParams model;
-  bool real = false;
-  int width = 640, height = 480;
-  double noise_sigma = 3.0, exposure_ms = 8.0;  // bench_people's defaults
-  perception::PeopleDetectorOptions detector;   // robot_client's default (config/client.yaml)
-};
+/// The robot's camera in the arena (experiments/scenarios/scenario_camera.hpp):
+/// the detector model by default, `real` for the model's cross-check
+/// (docs/scenarios.md, "The camera's cross-check"); off: the sonars alone.
+using ArenaCamera = sim::ScenarioCamera;
 
 /// Runs `e` with `p`. `reference_s` is the time to goal of the same episode
 /// without people (time lost); `site_map` false runs the robot without its map.

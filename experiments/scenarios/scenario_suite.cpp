@@ -18,6 +18,7 @@
 #include "shared/util/cli_args.hpp"
 #include "shared/config/config_node.hpp"
 #include "experiments/scenarios/scenario.hpp"
+#include "experiments/scenarios/scenario_camera.hpp"
 
 using namespace inspect;
 
@@ -36,6 +37,9 @@ a run without people as the reference for time lost.
   --control-config FILE   default config/control.yaml
   --behavior-config FILE  default config/behavior.yaml
   --seed N                sensor-noise seed (default 1)
+  --camera none|model|real  the robot's camera people detections (docs/scenarios.md, "Paper
+                          timings"): none (the sonars alone, default), the detector model
+                          calibrated on bench_people, or the rendered camera and HOG detector
   --plots DIR             write DIR/<scenario>.png (paths, speed, distance with zones)
   --json FILE             write every figure as JSON
   --help                  print this help
@@ -54,6 +58,24 @@ struct Options {
   uint32_t seed = 1;
   std::string plots;
   std::string json;
+  sim::ScenarioCamera camera = [] {
+    sim::ScenarioCamera c;
+    c.enabled = false;
+    return c;
+  }();
+};
+
+/// The camera's pictures for one run.
+class CameraObserver final : public sim::RunObserver {
+ public:
+  CameraObserver(const sim::ScenarioSpec& s, const sim::ScenarioContext& ctx, const sim::ScenarioCamera& c, uint64_t seed)
+      : looks_(s.world, ctx.robot.camera, c, seed) {}
+  void beforeFrame(const sim::Simulation& sim, behavior::HumanAwareness& aw, double t_s) override {
+    looks_.beforeFrame(sim, aw, t_s);
+  }
+
+ private:
+  sim::CameraLooks looks_;
 };
 
 [[noreturn]] void usageError(const std::string& msg) {
@@ -90,6 +112,10 @@ Options parse(int argc, char** argv) {
         o.behavior = a.path();
       } else if (a.is("--seed")) {
         o.seed = static_cast<uint32_t>(a.integer(0, 4294967295LL));
+      } else if (a.is("--camera")) {
+        const std::string c = a.choice({"none", "model", "real"});
+        o.camera.enabled = c != "none";
+        o.camera.real = c == "real";
       } else if (a.is("--plots")) {
         o.plots = a.path();
       } else if (a.is("--json")) {
@@ -243,13 +269,15 @@ int main(int argc, char** argv) {
   for (const auto& s : suite) {
     std::vector<sim::ScenarioRun> runs;
     progress(done, total, s.name + " without people", tty);
-    sim::RunOptions ref_opt{behavior::SpeedPolicy::kFuzzy, false, o.seed, false};
+    CameraObserver ref_camera(s, ctx, o.camera, o.seed);
+    sim::RunOptions ref_opt{behavior::SpeedPolicy::kFuzzy, false, o.seed, false, &ref_camera};
     const sim::ScenarioRun ref = sim::runScenario(s, ctx, ref_opt);
     sim_seconds += ref.metrics.duration_s;
     ++done;
     for (const auto p : o.policies) {
       progress(done, total, s.name + " " + behavior::toString(p), tty);
-      sim::ScenarioRun r = sim::runScenario(s, ctx, {p, true, o.seed, !o.plots.empty()});
+      CameraObserver camera(s, ctx, o.camera, o.seed);
+      sim::ScenarioRun r = sim::runScenario(s, ctx, {p, true, o.seed, !o.plots.empty(), &camera});
       if (r.metrics.time_to_goal_s >= 0 && ref.metrics.time_to_goal_s >= 0)
         r.metrics.time_lost_s = r.metrics.time_to_goal_s - ref.metrics.time_to_goal_s;
       sim_seconds += r.metrics.duration_s;

@@ -41,13 +41,7 @@ void CameraFeed::publish(const Simulation& sim) {
   snapshot_.pan_rad = ptz.pan_0p1mrad * 1e-4;
   snapshot_.tilt_rad = ptz.tilt_0p1mrad * 1e-4;
   snapshot_.sim_time_s = sim.timeS();
-  snapshot_.people.clear();
-  for (std::size_t i = 0; i < crowd.size(); ++i) {
-    if (!crowd.present(i)) continue;
-    const auto& a = crowd.agent(i);
-    snapshot_.people.push_back({{a.position_m.x(), a.position_m.y()}, a.radius_m, static_cast<int>(i),
-                                crowd.facingRad(i), a.velocity_m_s.norm(), crowd.walkedM(i)});
-  }
+  peopleInView(crowd, snapshot_.people);
 }
 
 CameraScene CameraFeed::snapshot() const {

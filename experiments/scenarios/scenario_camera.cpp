@@ -1,0 +1,82 @@
+#include "experiments/scenarios/scenario_camera.hpp"
+
+#include <cmath>
+
+#include "shared/perception/camera_geometry.hpp"
+#include "sim/camera_view.hpp"
+#include "sim/simulation.hpp"
+
+namespace inspect::sim {
+
+/// The simulator's camera and the robot's people detector.
+class CameraLooks::Real {
+ public:
+  Real(const World& w, const config::CameraMount& mount, const ScenarioCamera& c, uint64_t seed)
+      : view_(w, mount, c.width, c.height, style(c, seed)), detector_(c.detector) {
+    cam_.width = c.width;
+    cam_.height = c.height;
+    cam_.mount = mount;
+  }
+
+  /// One picture of the robot's view now (the camera ahead), detected.
+  behavior::CameraLook look(const Simulation& sim, double t_s) {
+    scene_.robot = sim.state().pose;
+    scene_.sim_time_s = t_s;
+    peopleInView(sim.pedestrians(), scene_.people);
+    view_.render(scene_, static_cast<uint64_t>(t_s * 1e6), frame_index_++, frame_);
+    behavior::CameraLook look;
+    look.lens_x_m = cam_.mount.x_m;
+    look.lens_y_m = cam_.mount.y_m;
+    look.axis_rad = 0.0;
+    look.half_fov_rad = cam_.mount.hfov_deg * M_PI / 360.0;
+    for (const auto& b : detector_.detect(frame_)) {
+      const auto s = perception::sightingOf(b.box, cam_);
+      look.add({s.bearing_rad, s.range_m.value_or(-1.0)});
+    }
+    return look;
+  }
+
+ private:
+  static CameraViewStyle style(const ScenarioCamera& c, uint64_t seed) {
+    CameraViewStyle s;
+    s.look_seed = static_cast<uint32_t>(seed);
+    s.noise_sigma = c.noise_sigma;
+    s.exposure_ms = c.exposure_ms;
+    return s;
+  }
+  CameraView view_;
+  perception::PeopleDetector detector_;
+  perception::CameraPose cam_;
+  CameraScene scene_;
+  cv::Mat frame_;
+  uint32_t frame_index_ = 0;
+};
+
+CameraLooks::CameraLooks(const World& world, const config::CameraMount& mount, const ScenarioCamera& camera,
+                         uint64_t seed)
+    : world_(world), mount_(mount), camera_(camera), rng_(seed * 7919 + 17) {
+  if (camera.enabled && camera.real) real_ = std::make_unique<Real>(world, mount, camera, seed);
+}
+
+CameraLooks::~CameraLooks() = default;
+
+void CameraLooks::beforeFrame(const Simulation& sim, behavior::HumanAwareness& aw, double t_s) {
+  if (!camera_.enabled || t_s + 1e-9 < next_look_s_) return;
+  next_look_s_ = t_s + 1.0 / camera_.rate_hz;
+  if (real_) {
+    aw.observeCamera(sim.state().pose, real_->look(sim, t_s));
+    return;
+  }
+  // The model on the true scene; the tracker places it at the true pose (the
+  // odometry's drift over a 9 m run is centimetres).
+  discs_.clear();
+  const auto& crowd = sim.pedestrians();
+  for (std::size_t i = 0; i < crowd.size(); ++i)
+    if (crowd.present(i)) {
+      const auto& a = crowd.agent(i);
+      discs_.push_back({a.position_m.x(), a.position_m.y(), a.radius_m});
+    }
+  aw.observeCamera(sim.state().pose, detectPeople(world_, sim.state().pose, mount_, 0.0, discs_, camera_.model, rng_));
+}
+
+}  // namespace inspect::sim
