@@ -212,6 +212,12 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
   for (std::size_t i = 0; i < 4; ++i) {
     if (!echo[i].use) continue;
     const Eigen::Vector2d& z = echo[i].z;
+    // The echo as a range only (across the beam, the whole cone): what it tells
+    // a track whose bearing the camera gives.
+    const auto range_only = [&] {
+      return beamCovariance(echo[i].yaw, std::max(p_.range_sigma_m, 0.01),
+                            std::max(0.1, echo[i].range * std::tan(sonar_.beam_width_rad / 2)));
+    };
     HumanTrack* best = nullptr;
     double best_d = p_.gate_m;
     for (auto& t : tracks_) {
@@ -229,6 +235,7 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     // detection's error, not the track's covariance: a person's foot-row error
     // is much the same picture after picture, so averaging does not shrink it.
     if (!best) {
+      const Eigen::Matrix2d echo_r = range_only();
       double best_d2 = p_.camera.gate_chi2;
       for (auto& t : tracks_) {
         if (!cameraSeenAt(t, t_s)) continue;
@@ -238,8 +245,7 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
         const Eigen::Matrix2d s =
             beamCovariance(yaw, std::max(0.05, p_.camera.range_sigma_frac * r),
                            std::max(0.05, r * p_.camera.bearing_sigma_deg * M_PI / 180.0)) +
-            beamCovariance(echo[i].yaw, std::max(p_.range_sigma_m, 0.01),
-                           std::max(0.1, echo[i].range * std::tan(sonar_.beam_width_rad / 2)));
+            echo_r;
         const double d2 = v.dot(s.ldlt().solve(v));
         if (d2 < best_d2) {
           best_d2 = d2;
@@ -250,14 +256,10 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     }
     if (best) {
       // A track the camera saw lately has its bearing from the camera: the
-      // echo gives it range only (across the beam, the whole cone), or its
-      // 100 echoes a second, each placed on the beam's centre line, would
-      // outweigh the bearings and pull a crossing person back to the centre.
-      const bool camera_bearing = cameraSeenAt(*best, t_s);
-      const Eigen::Matrix2d r =
-          camera_bearing ? beamCovariance(echo[i].yaw, std::max(p_.range_sigma_m, 0.01),
-                                          std::max(0.1, echo[i].range * std::tan(sonar_.beam_width_rad / 2)))
-                         : echo[i].r;
+      // echo gives it range only, or its 100 echoes a second, each placed on
+      // the beam's centre line, would outweigh the bearings and pull a
+      // crossing person back to the centre.
+      const Eigen::Matrix2d r = cameraSeenAt(*best, t_s) ? range_only() : echo[i].r;
       update(*best, z, r, t_s);
       ++counters_.associated;
       const bool person = best->isPerson();
