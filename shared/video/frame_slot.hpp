@@ -102,7 +102,8 @@ class FrameSlotReader {
 
   /// Waits (at most `timeout`) for a frame newer than `after`, then copies the
   /// newest one into `dst` (height rows of width x 3 bytes, `step` apart).
-  /// nullopt when none came in time or the slot was closed. Never a torn
+  /// nullopt when none came in time or the slot was closed with no frame newer
+  /// than `after` (frames written before the close stay readable). Never a torn
   /// picture: a copy overtaken by the writer is taken again.
   std::optional<SlotFrame> readNewer(uint64_t after, uint8_t* dst, std::size_t step,
                                      std::chrono::milliseconds timeout);
