@@ -117,9 +117,22 @@ class ArenaObserver final : public sim::RunObserver {
           nearest = std::min(nearest, std::hypot(crowd.agent(i).position_m.x() - tr.x[0],
                                                  crowd.agent(i).position_m.y() - tr.x[1]));
       judged_[tr.id] = nearest > kFalseTrack_m;
-      if (nearest > kFalseTrack_m) ++m.false_people;
+      if (nearest > kFalseTrack_m) {
+        ++m.false_people;
+        ++m.false_where[static_cast<std::size_t>(falseWhere(pose, tr))];
+      }
     }
     (void)t_s;
+  }
+
+  FalseWhereKind falseWhere(const control::Pose2& pose, const behavior::HumanTrack& tr) const {
+    const auto& mount = ctx_.robot.camera;
+    const control::Pose2 lens = config::mountPose(pose, {mount.x_m, mount.y_m, 0.0});
+    const double dx = tr.x[0] - lens.x_m, dy = tr.x[1] - lens.y_m;
+    const double bearing = std::abs(control::wrapAngle(std::atan2(dy, dx) - pose.theta_rad));
+    if (bearing <= mount.hfov_deg * M_PI / 360.0)
+      return ctx_.awareness.tracker.camera.recallAt(std::hypot(dx, dy)) > 0 ? kFalseInViewReached : kFalseInViewNear;
+    return bearing <= 2 * M_PI / 3 ? kFalseBeside : kFalseBehind;
   }
 
   void finish() {
@@ -173,6 +186,12 @@ EpisodeMetrics finishRun(ArenaObserver& obs, const sim::ScenarioRun& run, double
 }
 
 }  // namespace
+
+const char* falseWhereName(int k) {
+  static constexpr std::array<const char*, kFalseWhereKinds> kNames{"in view, reached", "in view, near", "beside",
+                                                                     "behind"};
+  return k >= 0 && k < kFalseWhereKinds ? kNames[static_cast<std::size_t>(k)] : "?";
+}
 
 const char* toString(Policy p) {
   switch (p) {

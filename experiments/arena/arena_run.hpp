@@ -34,6 +34,14 @@ constexpr int kPatterns = 5;
 constexpr int kUnseen = 5;
 using Confusion = std::array<std::array<uint64_t, kPatterns + 1>, kPatterns>;
 
+/// Where a false person was, seen from the robot, when it became a person:
+/// in the camera's view at a distance its detector reaches (recall > 0), in
+/// its view but nearer, beside the robot (outside the view, within 120 deg
+/// of the heading), behind.
+enum FalseWhereKind { kFalseInViewReached, kFalseInViewNear, kFalseBeside, kFalseBehind, kFalseWhereKinds };
+using FalseWhere = std::array<uint32_t, kFalseWhereKinds>;
+const char* falseWhereName(int k);
+
 struct EpisodeMetrics {
   bool success = false;
   bool timeout = false;
@@ -55,6 +63,7 @@ struct EpisodeMetrics {
   int true_dominant = -1;           // most frequent true pattern other than none over those ticks (-1: none)
   int reported_dominant = -1;       // most frequent reported pattern other than none over them (-1: none)
   uint32_t false_people = 0;        // person tracks that appeared where nobody was (> 1 m from everyone)
+  FalseWhere false_where{};         // ...by where they were when they became people
 };
 
 /// The robot's camera in the arena (experiments/scenarios/scenario_camera.hpp):

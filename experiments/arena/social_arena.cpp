@@ -537,16 +537,26 @@ int main(int argc, char** argv) {
 
   uint32_t false_map = 0, false_nomap = 0;
   double min_map = 0, min_nomap = 0;
+  arena::FalseWhere where_nomap{}, where_people{};
   for (const auto& r : results) {
     false_map += r.reference.false_people;
     min_map += r.reference.duration_s / 60.0;
     false_nomap += r.reference_no_map.false_people;
     min_nomap += r.reference_no_map.duration_s / 60.0;
+    for (int k = 0; k < arena::kFalseWhereKinds; ++k) {
+      where_nomap[static_cast<std::size_t>(k)] += r.reference_no_map.false_where[static_cast<std::size_t>(k)];
+      where_people[static_cast<std::size_t>(k)] += r.by_policy[0].false_where[static_cast<std::size_t>(k)];
+    }
   }
   std::printf("\nfalse people (nobody in the world, driving the aisles): with the site map %u in %.1f min "
               "(%.3f/min), without %u in %.1f min (%.3f/min); with people, strategy: %u in %.1f min\n",
               false_map, min_map, min_map > 0 ? false_map / min_map : 0.0, false_nomap, min_nomap,
               min_nomap > 0 ? false_nomap / min_nomap : 0.0, sums[0].false_people, sums[0].minutes);
+  std::printf("false people by where they were (the camera's view: +-hfov/2 of the heading; reached: its detector's "
+              "recall > 0 there)\n  %-18s %10s %18s\n", "where", "no map", "with people (strategy)");
+  for (int k = 0; k < arena::kFalseWhereKinds; ++k)
+    std::printf("  %-18s %10u %18u\n", arena::falseWhereName(k), where_nomap[static_cast<std::size_t>(k)],
+                where_people[static_cast<std::size_t>(k)]);
 
   const auto& st = sums[0];
   const auto& sw = sums[2];
@@ -659,6 +669,10 @@ int main(int argc, char** argv) {
     }
     j["false_people"] = {{"with_map", false_map},       {"with_map_min", min_map},
                          {"without_map", false_nomap}, {"without_map_min", min_nomap}};
+    for (int k = 0; k < arena::kFalseWhereKinds; ++k) {
+      j["false_people"]["without_map_where"][arena::falseWhereName(k)] = where_nomap[static_cast<std::size_t>(k)];
+      j["false_people"]["strategy_where"][arena::falseWhereName(k)] = where_people[static_cast<std::size_t>(k)];
+    }
     std::ofstream f(o.json);
     f << j.dump(2) << "\n";
     if (!f) std::fprintf(stderr, "social_arena: cannot write %s\n", o.json.c_str());

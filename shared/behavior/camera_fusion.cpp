@@ -78,6 +78,7 @@ void HumanTracker::addPersonEvidence(HumanTrack& t, double logodds) {
   const bool denied = t.person_logodds <= c.deny_logodds;
   if (denied && !t.camera_denied) ++counters_.camera_denials;
   t.camera_denied = denied;
+  t.camera_doubted = t.camera_hits == 0 && t.person_logodds < 0 && t.person_logodds <= c.doubt_logodds;
 }
 
 void HumanTracker::observeCamera(const control::Pose2& pose, const CameraLook& look) {

@@ -46,6 +46,7 @@ struct CameraFusionParams {
   double hit_logodds = 2.5;         // a detection (precision ~0.94: ln(0.94 / 0.06) = 2.75, a little less)
   double person_logodds = 2.0;      // a camera-confirmed track at or above this is a person, moving or not
   double deny_logodds = -2.5;       // a track at or below this is not a person, whatever its motion
+  double doubt_logodds = -0.5;      // a track the camera never found, at or below this, is not a person yet
   double max_logodds = 6.0;         // evidence saturates both ways
   int confirm_hits = 3;             // detections to confirm a camera-only track (within tracker.confirm_window_s)
   double bearing_hold_s = 1.0;      // this long after a detection, a track's echoes give it range only

@@ -145,6 +145,7 @@ CameraFusionParams readCameraFusion(const config::ConfigNode& n) {
   c.hit_logodds = n.number("hit_logodds", c.hit_logodds, 0, 10);
   c.person_logodds = n.number("person_logodds", c.person_logodds, 0, 10);
   c.deny_logodds = n.number("deny_logodds", c.deny_logodds, -10, 0);
+  c.doubt_logodds = n.number("doubt_logodds", c.doubt_logodds, -10, 0);
   c.max_logodds = n.number("max_logodds", c.max_logodds, 1, 20);
   c.confirm_hits = static_cast<int>(n.integer("confirm_hits", c.confirm_hits, 1, 100));
   c.bearing_hold_s = n.number("bearing_hold_s", c.bearing_hold_s, 0, 10);
@@ -162,6 +163,7 @@ CameraFusionParams readCameraFusion(const config::ConfigNode& n) {
     }
   }
   if (!(c.deny_logodds < c.person_logodds)) n.fail("deny_logodds", "must be below person_logodds");
+  if (!(c.deny_logodds <= c.doubt_logodds)) n.fail("doubt_logodds", "must be at or above deny_logodds");
   return c;
 }
 }  // namespace

@@ -86,7 +86,8 @@ struct HumanTrack {
   int camera_misses = 0;       // pictures in a row that should have shown it and did not
   double person_logodds = 0;   // camera evidence that this is a person (0 = none either way)
   bool camera_denied = false;  // person_logodds at or below the deny level: not a person
-  bool isPerson() const { return person && !camera_denied; }
+  bool camera_doubted = false; // never detected and person_logodds at or below the doubt level: not a person yet
+  bool isPerson() const { return person && !camera_denied && !camera_doubted; }
   double speed() const { return std::hypot(x[2], x[3]); }
   double positionSigma() const { return std::sqrt(std::max(p(0, 0), p(1, 1))); }
 };

@@ -232,6 +232,41 @@ TEST(CameraFusion, BadDetectionsAndAFullTableAreHarmless) {
   EXPECT_EQ(tr.counters().camera_detections, 6u) << "the two non-finite ones are not detections";
 }
 
+TEST(CameraFusion, AnEchoTheCameraMissedIsNotAPersonUntilTheCameraFindsIt) {
+  // The cart of the test above, 4.5 m ahead: a picture without it (recall
+  // 0.55 there: -0.8, below doubt_logodds) keeps it from becoming a person
+  // while its evidence is still above the deny level; a detection ends the
+  // doubt. The sonars alone make it a person within a second.
+  const config::UltrasonicConfig u;
+  HumanTracker sonar_only(u, {}), fused(u, {});
+  std::mt19937 rng_a(4), rng_b(4), rng_c(5);
+  const control::Pose2 robot{0, 0, 0};
+  bool sonar_person = false, fused_person = true, fused_person_found = false;
+  for (int k = 0; k <= 150; ++k) {
+    const double t = k * 0.01;
+    const Circle cart{4.5 - 0.4 * t, 0.0, 0.3};
+    sonar_only.step(robot, echoes(u, robot, {cart}, {}, &rng_a), t);
+    fused.step(robot, echoes(u, robot, {cart}, {}, &rng_b), t);
+    if (k == 10 || k == 90) fused.observeCamera(robot, CameraLook{});  // looking ahead, nobody found
+    if (k == 100) {
+      sonar_person = sonar_only.nearest(robot) != nullptr;
+      fused_person = fused.nearest(robot) != nullptr;
+      ASSERT_FALSE(fused.tracks().empty());
+      int doubted_people = 0;
+      for (const auto& tr : fused.tracks()) {
+        EXPECT_FALSE(tr.camera_denied) << "two misses are doubt, not denial";
+        if (tr.person && tr.camera_doubted) ++doubted_people;
+      }
+      EXPECT_GE(doubted_people, 1) << "the sonars' rule holds, the camera's doubt overrides it";
+      fused.observeCamera(robot, look(robot, {cart}, rng_c));
+    }
+    if (k == 150) fused_person_found = fused.nearest(robot) != nullptr;
+  }
+  EXPECT_TRUE(sonar_person);
+  EXPECT_FALSE(fused_person) << "pictures without it: not a person yet";
+  EXPECT_TRUE(fused_person_found) << "the camera found it: a person";
+}
+
 TEST(CameraFusion, ConfigReadsTheRecallTableAndNamesWhatIsWrong) {
   const auto load = [](const std::string& camera) {
     const auto root = config::ConfigNode::loadString("tracker:\n  camera: " + camera + "\n", "b.yaml");
@@ -255,5 +290,6 @@ TEST(CameraFusion, ConfigReadsTheRecallTableAndNamesWhatIsWrong) {
   fails("{recall_upto_m: [2, 4, 3, 8, 12], recall: [0.1, 0.4, 0.6, 0.7, 0.5]}", "recall_upto_m");
   fails("{recall_upto_m: [2, 4, 6, 8, 12], recall: [0.1, 1.4, 0.6, 0.7, 0.5]}", "recall");
   fails("{deny_logodds: 0, person_logodds: 0}", "deny_logodds");
+  fails("{deny_logodds: -2, doubt_logodds: -3}", "doubt_logodds");
   fails("{bearing_sigma: 1}", "bearing_sigma");
 }
