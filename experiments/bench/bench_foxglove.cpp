@@ -47,7 +47,7 @@ namespace {
 /// Commands are not what is measured: the sink takes them and sends nothing.
 struct NullSink : CommandSink {
   std::atomic<uint64_t> next{1};
-  uint64_t setTeleop(const std::string&, double, double) override { return next++; }
+  uint64_t setTeleop(const std::string&, double, double, double) override { return next++; }
   void clearTeleop(const std::string&) override {}
   uint64_t sendCommand(const std::string&, v1::Command) override { return next++; }
   void consoleAlive() override {}

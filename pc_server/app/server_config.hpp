@@ -50,7 +50,7 @@ struct FoxgloveServerConfig {
   std::vector<std::string> allowed_origins;  // browsers' Origin header must be one of these; empty = any
   double scene_hz = 10;                    // SceneUpdate rate per robot, Hz
   double grid_hz = 1;                      // gas grids per robot and channel, Hz
-  double teleop_timeout_s = 0.5;           // a teleop set-point not refreshed this long stops the robot
+  double teleop_timeout_s = 0.3;           // a client's teleop set-point not renewed this long lapses to zero
   int max_clients = 32;
 };
 

@@ -32,7 +32,7 @@ bool Console::cmdDrive(const Args& args, const std::string&, int) {
                              fmtShort(options_.max_w_rad_s) + "]");
   const auto robot = connectedRobot("drive");
   if (!robot || !mayMove(*robot, "drive")) return false;
-  const uint64_t id = sink_.setTeleop(*robot, *v, *w);
+  const uint64_t id = sink_.setTeleop(*robot, *v, *w, 0.0);  // held until stop (docs/failsafes.md)
   if (id == 0) return fail("drive", *robot + " is not connected");
   const std::string what = "drive " + fmtSigned(*v) + " m/s " + fmtSigned(*w) + " rad/s";
   const auto ack = waitAck(*robot, id);

@@ -396,7 +396,9 @@ void FoxgloveBridge::teleop(uint64_t client, const std::string& topic_robot, std
     refuse(client, "teleop refused: " + d.reason);
     return;
   }
-  if (sink_.setTeleop(robot, *v, *w) == 0) {
+  // The set-point lapses to zero in the robot's session teleop_timeout_s after
+  // this message unless the next one renews it (the deadman below only tells the client).
+  if (sink_.setTeleop(robot, *v, *w, options_.teleop_timeout_s) == 0) {
     refuse(client, "teleop: " + robot + " is not connected");
     return;
   }

@@ -35,7 +35,7 @@ class FoxgloveBridge : public WsServer::Handler {
     WsServer::Options server;
     double scene_hz = 10;          // SceneUpdate per robot
     double grid_hz = 1;            // gas grids per robot and channel
-    double teleop_timeout_s = 0.5; // a set-point not refreshed this long lapses: the robot is stopped
+    double teleop_timeout_s = 0.3; // a set-point not renewed this long lapses to zero (the session's lease)
     double max_v_m_s = 1.0;        // teleop limits (the console's)
     double max_w_rad_s = 2.0;
     /// The server's receive figures of a robot's stream (VideoHub), for

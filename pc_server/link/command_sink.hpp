@@ -12,8 +12,11 @@ class CommandSink {
  public:
   virtual ~CommandSink() = default;
   /// Sets the robot's teleop set-point: sends it at once and re-sends it at the
-  /// configured rate until cleared. Returns the id of the first Command, 0 if the robot is not connected.
-  virtual uint64_t setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s) = 0;
+  /// configured rate until cleared. With `lease_s` > 0 it lapses that long
+  /// after this call unless set again: a zero set-point goes out (the robot
+  /// ramps down) and the re-send stops (operator silence, docs/failsafes.md).
+  /// 0: held until cleared. Returns the id of the first Command, 0 if the robot is not connected.
+  virtual uint64_t setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s, double lease_s) = 0;
   /// Stops re-sending the set-point (sends nothing).
   virtual void clearTeleop(const std::string& robot_id) = 0;
   /// Assigns a new id to `cmd` and sends it; Stop and EStop also clear the set-point.

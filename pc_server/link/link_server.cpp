@@ -147,11 +147,11 @@ bool LinkServer::consoleResponsive() const {
   return wd <= 0 || monoNowNs() - console_alive_ns_ <= wd;
 }
 
-uint64_t LinkServer::setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s) {
+uint64_t LinkServer::setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s, double lease_s) {
   const auto s = find(robot_id);
   if (!s) return 0;
   const uint64_t id = nextCommandId();
-  s->setTeleop(v_m_s, w_rad_s, id);
+  s->setTeleop(v_m_s, w_rad_s, id, lease_s);
   return id;
 }
 

@@ -49,7 +49,7 @@ class LinkServer : public CommandSink {
   void setLogEvents(bool on) { log_events_ = on; }
   bool logEvents() const { return log_events_; }
 
-  uint64_t setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s) override;
+  uint64_t setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s, double lease_s) override;
   void clearTeleop(const std::string& robot_id) override;
   uint64_t sendCommand(const std::string& robot_id, v1::Command cmd) override;
   void consoleAlive() override;

@@ -154,18 +154,35 @@ void RobotSession::sendCommand(v1::Command cmd) {
   });
 }
 
-void RobotSession::setTeleop(double v_m_s, double w_rad_s, uint64_t first_id) {
-  asio::post(strand_, [self = shared_from_this(), v_m_s, w_rad_s, first_id] {
+void RobotSession::setTeleop(double v_m_s, double w_rad_s, uint64_t first_id, double lease_s) {
+  const auto lapse_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(seconds(std::max(0.0, lease_s)));
+  asio::post(strand_, [self = shared_from_this(), v_m_s, w_rad_s, first_id, lease_s, lapse_at] {
     if (self->closed_ || !self->peer_.accepted) return;
     self->teleop_.active = true;
     self->teleop_.v_m_s = v_m_s;
     self->teleop_.w_rad_s = w_rad_s;
+    self->teleop_.lease_s = lease_s > 0 ? lease_s : 0.0;
+    self->teleop_.lapse_at = lapse_at;
     const uint64_t gen = ++self->teleop_.generation;
     self->teleop_timer_.cancel();
     self->sendTeleopNow(first_id);
-    self->teleop_timer_.expires_after(seconds(1.0 / self->config_.teleop_resend_hz));
+    self->teleop_timer_.expires_at(self->nextTeleopAt(Clock::now() + seconds(1.0 / self->config_.teleop_resend_hz)));
     self->armTeleop(gen);
   });
+}
+
+RobotSession::Clock::time_point RobotSession::nextTeleopAt(Clock::time_point resend_at) const {
+  return teleop_.lease_s > 0 ? std::min(resend_at, teleop_.lapse_at) : resend_at;
+}
+
+void RobotSession::lapseTeleop() {
+  const double lease_s = teleop_.lease_s;
+  teleop_.active = false;
+  ++teleop_.generation;
+  teleop_.v_m_s = teleop_.w_rad_s = 0.0;
+  log::info(log::tag::kLink, who(), ": teleop set-point not renewed for ", fmtShort(lease_s),
+            " s: zero set-point sent, re-send stopped");
+  sendTeleopNow(server_.nextCommandId());
 }
 
 void RobotSession::clearTeleop() {
@@ -444,12 +461,16 @@ void RobotSession::armTeleop(uint64_t generation) {
       log::warn(log::tag::kLink, self->who(), ": console unresponsive: teleop set-point cleared, re-send stopped");
       return;
     }
+    if (self->teleop_.lease_s > 0 && Clock::now() >= self->teleop_.lapse_at) {
+      self->lapseTeleop();
+      return;
+    }
     self->sendTeleopNow(self->server_.nextCommandId());
     if (self->closed_) return;
     const auto period = seconds(1.0 / self->config_.teleop_resend_hz);
     auto next = self->teleop_timer_.expiry() + period;
     if (next < Clock::now()) next = Clock::now() + period;
-    self->teleop_timer_.expires_at(next);
+    self->teleop_timer_.expires_at(self->nextTeleopAt(next));
     self->armTeleop(generation);
   });
 }

@@ -48,8 +48,9 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   void close(std::string reason);
   /// Sends a command (id already set); Stop/EStop also clear the set-point. Thread-safe.
   void sendCommand(v1::Command cmd);
-  /// Sends the set-point now with `first_id`, then re-sends it at teleop_resend_hz. Thread-safe.
-  void setTeleop(double v_m_s, double w_rad_s, uint64_t first_id);
+  /// Sends the set-point now with `first_id`, then re-sends it at teleop_resend_hz;
+  /// with `lease_s` > 0, until it lapses unrenewed (then a zero set-point). Thread-safe.
+  void setTeleop(double v_m_s, double w_rad_s, uint64_t first_id, double lease_s);
   /// Stops re-sending the set-point. Thread-safe.
   void clearTeleop();
 
@@ -75,6 +76,10 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   void armHeartbeat();
   void armTeleop(uint64_t generation);
   void sendTeleopNow(uint64_t id);
+  /// When the set-point's timer fires next: the re-send at `resend_at`, or its lapse if sooner.
+  Clock::time_point nextTeleopAt(Clock::time_point resend_at) const;
+  /// The lease ran out: a zero set-point goes out and the re-send stops.
+  void lapseTeleop();
   void closeNow(const std::string& reason, log::Level level);
   /// The per-robot limits (robot_limits): false = drop this frame of `bytes`
   /// (throttled); closes a session that keeps on (then closed_).
@@ -142,6 +147,8 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
     double v_m_s = 0;
     double w_rad_s = 0;
     uint64_t generation = 0;  // bumps on every change, so stale timer chains end
+    double lease_s = 0;       // > 0: lapses at lapse_at unless renewed
+    std::chrono::steady_clock::time_point lapse_at{};
   } teleop_;
 };
 

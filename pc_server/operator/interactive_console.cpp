@@ -106,7 +106,7 @@ bool InteractiveConsole::teleop(KeyboardTeleop::Mode mode, const std::string& ro
     std::cout.flush();
   };
   auto apply = [&] {
-    last_id = sink.setTeleop(robot_id, kt.v(), kt.w());
+    last_id = sink.setTeleop(robot_id, kt.v(), kt.w(), 0.0);  // the keyboard's own deadman (hold mode)
     note = last_id == 0 ? "  (not connected)" : "";
   };
   gauge();

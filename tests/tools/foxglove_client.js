@@ -59,6 +59,16 @@ function truthNow() {
   return null;
 }
 
+/// Every truth row: CLOCK_MONOTONIC ns (the clock of process.hrtime), the wheels' set-points.
+function truthRows() {
+  const rows = [];
+  for (const line of fs.readFileSync(args.truth, "utf8").split("\n")) {
+    const f = line.split(",");
+    if (f[0] === "T" && f.length >= 11) rows.push({ mono_ns: Number(f[1]), setL: +f[8], setR: +f[9] });
+  }
+  return rows;
+}
+
 /// A connection that refuses: resolves with the error text (or "" when it opened).
 function tryConnect(u, protocols) {
   return new Promise((resolve) => {
@@ -299,8 +309,10 @@ async function main() {
   const cmd = a.client.advertise({ topic: `/${robot}/cmd_vel`, encoding: "json", schemaName: "geometry_msgs/Twist" });
   const twist = (v, w) => new Uint8Array(Buffer.from(JSON.stringify({ linear: { x: v, y: 0, z: 0 }, angular: { x: 0, y: 0, z: w } })));
   let sawTeleop = false;
+  let lastSendNs = 0;
   for (let i = 0; i < 20; ++i) {
     a.client.sendMessage(cmd, twist(0.3, 0.0));
+    lastSendNs = Number(process.hrtime.bigint());
     await sleep(100);
     sawTeleop ||= a.mode() === MODE.TELEOP;
   }
@@ -317,6 +329,21 @@ async function main() {
   }, 3000, 50);
   figures.deadman_stop_ms = Date.now() - lapseStart;
   check(stopped, "the robot did not stop within 3 s after the client stopped sending teleop");
+  // From the last message, in the ground truth (same monotonic clock): the
+  // set-points start down when the 0.3 s lease lapses and reach zero after
+  // the ramp (0.3 m/s = 1.5 rad/s at 10 rad/s^2: 0.15 s).
+  await sleep(200);  // the truth log is written every few tens of ms
+  const after = truthRows().filter((r) => r.mono_ns > lastSendNs);
+  const driving = after.length ? Math.max(Math.abs(after[0].setL), Math.abs(after[0].setR)) : 0;
+  const down = after.find((r) => Math.max(Math.abs(r.setL), Math.abs(r.setR)) < driving - 1e-6);
+  const zero = after.find((r) => r.setL === 0 && r.setR === 0);
+  figures.deadman_ramp_start_ms = down ? +((down.mono_ns - lastSendNs) / 1e6).toFixed(1) : -1;
+  figures.deadman_setpoints_zero_ms = zero ? +((zero.mono_ns - lastSendNs) / 1e6).toFixed(1) : -1;
+  check(driving > 1.0, `the set-points were not driving after the last message (${driving} rad/s)`);
+  check(down && figures.deadman_ramp_start_ms <= 380,
+        `the stop started ${figures.deadman_ramp_start_ms} ms after the last teleop message (lease 300 ms)`);
+  check(zero && figures.deadman_setpoints_zero_ms <= 560,
+        `the set-points reached zero ${figures.deadman_setpoints_zero_ms} ms after the last teleop message (lease 300 + ramp 150 ms)`);
   check(a.statuses.some((s) => /teleop: no set-point/.test(s.message)), "no status saying the teleop set-point lapsed");
 
   // 4. A second client: observes; its motion is refused with the holder's name; stop always works.

@@ -36,7 +36,7 @@ constexpr uint64_t kSerial = 1;
 class FakeSink : public CommandSink {
  public:
   FakeSink(RobotRegistry& r, ConsoleClock& clock) : registry_(r), clock_(clock) {}
-  uint64_t setTeleop(const std::string& robot, double v, double w) override {
+  uint64_t setTeleop(const std::string& robot, double v, double w, double) override {
     if (!connected(robot)) return 0;
     teleop_active = true;
     last_v = v;

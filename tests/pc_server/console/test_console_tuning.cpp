@@ -44,7 +44,7 @@ class CoreSink : public CommandSink {
     h.set_fis_name("fuzzy_pid");
     registry_.onConnected("robot1", "127.0.0.1:1", kTuningSerial, h, monoNowNs());
   }
-  uint64_t setTeleop(const std::string&, double, double) override { return 0; }
+  uint64_t setTeleop(const std::string&, double, double, double) override { return 0; }
   void clearTeleop(const std::string&) override {}
   void consoleAlive() override {}
   uint64_t sendCommand(const std::string& robot, v1::Command cmd) override {

@@ -256,7 +256,7 @@ TEST_F(LinkServerTest, DriveResendsTeleopAt20Hz) {
   r.startPump(0);
   ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
   const auto t0 = Clock::now();
-  const uint64_t first = link_->setTeleop("robot1", 0.3, -0.2);
+  const uint64_t first = link_->setTeleop("robot1", 0.3, -0.2, 0.0);
   EXPECT_GT(first, 0u);
   std::this_thread::sleep_for(1050ms);
   const auto t1 = Clock::now();
@@ -285,7 +285,7 @@ TEST_F(LinkServerTest, StopEndsTheResend) {
   ASSERT_TRUE(r.hello("robot1"));
   r.startPump(0);
   ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
-  link_->setTeleop("robot1", 0.2, 0);
+  link_->setTeleop("robot1", 0.2, 0, 0.0);
   std::this_thread::sleep_for(200ms);
   v1::Command stop;
   stop.mutable_stop();
@@ -301,7 +301,7 @@ TEST_F(LinkServerTest, StopEndsTheResend) {
   EXPECT_GE(teleopsBetween(r, Clock::time_point{}, stop_seen), 3);
 
   // clearTeleop stops it too, without sending anything.
-  link_->setTeleop("robot1", 0.1, 0);
+  link_->setTeleop("robot1", 0.1, 0, 0.0);
   std::this_thread::sleep_for(100ms);
   link_->clearTeleop("robot1");
   // A set-point sent just before the clear may reach the robot's pump late on a
@@ -310,6 +310,47 @@ TEST_F(LinkServerTest, StopEndsTheResend) {
   const auto after_clear = Clock::now();
   std::this_thread::sleep_for(250ms);
   EXPECT_EQ(teleopsBetween(r, after_clear, Clock::now()), 0);
+}
+
+TEST_F(LinkServerTest, ALeasedSetPointLapsesToZeroWhenTheOperatorFallsSilent) {
+  startServer();
+  ScriptedRobot r;
+  ASSERT_TRUE(r.connect(port_));
+  ASSERT_TRUE(r.hello("robot1"));
+  r.startPump(0);
+  ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
+  // A front end renewing every 100 ms (a Foxglove pad at 10 Hz) with a 0.3 s lease.
+  const auto t0 = Clock::now();
+  Clock::time_point last{};
+  for (int k = 0; k < 8; ++k) {
+    last = Clock::now();
+    ASSERT_GT(link_->setTeleop("robot1", 0.3, 0.1, 0.3), 0u);
+    std::this_thread::sleep_for(100ms);
+  }
+  // Silent now: a zero set-point 0.3 s after the last one, then nothing.
+  std::this_thread::sleep_for(900ms);
+  Clock::time_point zero_at{};
+  int moving_before = 0, moving_after_zero = 0, zeros = 0;
+  for (const auto& m : commandsOf(r)) {
+    if (!m.env.command().has_teleop()) continue;
+    const auto& tp = m.env.command().teleop();
+    if (tp.v_m_s() == 0.0 && tp.w_rad_s() == 0.0) {
+      if (++zeros == 1) zero_at = m.t;
+    } else if (zeros == 0) {
+      ++moving_before;
+    } else {
+      ++moving_after_zero;
+    }
+  }
+  EXPECT_EQ(zeros, 1) << "one zero set-point";
+  EXPECT_EQ(moving_after_zero, 0);
+  EXPECT_GE(moving_before, 14) << "renewed and re-sent at 20 Hz for 0.8 s";
+  ASSERT_NE(zero_at, Clock::time_point{});
+  const auto lapse_ms = std::chrono::duration_cast<std::chrono::milliseconds>(zero_at - last).count();
+  EXPECT_GE(lapse_ms, 290) << "not before the lease ran out";
+  EXPECT_LT(lapse_ms, 600) << "the lease, not a re-send period late (a loaded machine's room)";
+  EXPECT_LT(zero_at - t0, 2s);
+  EXPECT_TRUE(connected("robot1")) << "only the set-point lapses, not the session";
 }
 
 TEST_F(LinkServerTest, HungConsoleStopsTheResend) {
@@ -322,7 +363,7 @@ TEST_F(LinkServerTest, HungConsoleStopsTheResend) {
   ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
   const auto t0 = Clock::now();
   link_->consoleAlive();
-  link_->setTeleop("robot1", 0.2, 0);
+  link_->setTeleop("robot1", 0.2, 0, 0.0);
   // A live console keeps it going (20 Hz: about 8 in the 400 ms counted)...
   while (Clock::now() - t0 < 700ms) {
     link_->consoleAlive();
@@ -346,11 +387,11 @@ TEST_F(LinkServerTest, ClosingTheSessionClearsTheSetPoint) {
     ASSERT_TRUE(r.hello("robot1"));
     r.startPump(0);
     ASSERT_TRUE(eventually([&] { return connected("robot1"); }));
-    link_->setTeleop("robot1", 0.2, 0);
+    link_->setTeleop("robot1", 0.2, 0, 0.0);
     std::this_thread::sleep_for(150ms);
   }
   ASSERT_TRUE(eventually([&] { return !connected("robot1"); }));
-  EXPECT_EQ(link_->setTeleop("robot1", 0.2, 0), 0u) << "not connected: nothing to send to";
+  EXPECT_EQ(link_->setTeleop("robot1", 0.2, 0, 0.0), 0u) << "not connected: nothing to send to";
   ScriptedRobot again;
   ASSERT_TRUE(again.connect(port_));
   ASSERT_TRUE(again.hello("robot1"));

@@ -118,7 +118,7 @@ TEST(Recorder, ConsoleRunAndTrackRunAreRecordedAndListed) {
     // The console lists and shows them.
     RobotRegistry registry;
     struct NullSink : CommandSink {
-      uint64_t setTeleop(const std::string&, double, double) override { return 0; }
+      uint64_t setTeleop(const std::string&, double, double, double) override { return 0; }
       void clearTeleop(const std::string&) override {}
       uint64_t sendCommand(const std::string&, v1::Command) override { return 0; }
       void consoleAlive() override {}
