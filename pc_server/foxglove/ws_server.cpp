@@ -1,7 +1,5 @@
 #include "pc_server/foxglove/ws_server.hpp"
 
-#include <openssl/crypto.h>
-
 #include <array>
 #include <chrono>
 #include <optional>
@@ -15,6 +13,7 @@
 #include <boost/beast/websocket/ssl.hpp>
 
 #include "pc_server/app/startup_error.hpp"
+#include "pc_server/foxglove/ws_upgrade.hpp"
 #include "shared/util/token_bucket.hpp"
 #include "shared/util/log.hpp"
 
@@ -34,27 +33,6 @@ constexpr const char* kTag = "foxglove";
 
 std::string endpointText(const tcp::endpoint& e) { return e.address().to_string() + ":" + std::to_string(e.port()); }
 
-/// The token of a request: `?token=...` in the target, or "Authorization: Bearer ...".
-std::string requestToken(const http::request<http::string_body>& req) {
-  const auto auth = req[http::field::authorization];
-  if (auth.starts_with("Bearer ")) return std::string(auth.substr(7));
-  const std::string_view target(req.target().data(), req.target().size());
-  const auto q = target.find('?');
-  if (q == std::string_view::npos) return "";
-  std::string_view query = target.substr(q + 1);
-  while (!query.empty()) {
-    const auto amp = query.find('&');
-    const std::string_view kv = query.substr(0, amp);
-    if (kv.starts_with("token=")) return std::string(kv.substr(6));
-    if (amp == std::string_view::npos) break;
-    query.remove_prefix(amp + 1);
-  }
-  return "";
-}
-
-bool sameSecret(const std::string& a, const std::string& b) {
-  return a.size() == b.size() && CRYPTO_memcmp(a.data(), b.data(), a.size()) == 0;
-}
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -154,34 +132,6 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
   std::optional<OutMessage> nextOut() {
     std::lock_guard lk(mu_);
     return queue_.pop();
-  }
-
-  /// Checks the upgrade request; "" = fine, else the HTTP status and text to refuse with.
-  std::pair<http::status, std::string> vet(const http::request<http::string_body>& req) {
-    const auto& o = server_.options();
-    if (!websocket::is_upgrade(req))
-      return {http::status::bad_request, "this is the Foxglove WebSocket bridge: connect with a WebSocket client"};
-    if (!o.allowed_origins.empty()) {
-      const auto origin = req[http::field::origin];
-      if (!origin.empty()) {
-        bool ok = false;
-        for (const auto& a : o.allowed_origins) ok = ok || origin == a;
-        if (!ok) return {http::status::forbidden, "origin '" + std::string(origin) + "' is not allowed"};
-      }
-    }
-    if (!o.token.empty()) {
-      const std::string t = requestToken(req);
-      if (t.empty())
-        return {http::status::unauthorized, "a token is needed: ws://host:port/?token=<token> (docs/foxglove.md)"};
-      if (!sameSecret(t, o.token)) return {http::status::unauthorized, "wrong token"};
-    }
-    std::string offered;
-    for (const auto& f : req)
-      if (f.name() == http::field::sec_websocket_protocol) offered += std::string(f.value()) + ",";
-    subprotocol_ = chooseSubprotocol(offered);
-    if (subprotocol_.empty())
-      return {http::status::bad_request, "no supported subprotocol offered (foxglove.websocket.v1 or foxglove.sdk.v1)"};
-    return {http::status::ok, ""};
   }
 
   /// After the upgrade: the server sends serverInfo, the channels and the
@@ -433,15 +383,16 @@ class Session final : public ClientSession {
   }
 
   void onRequest(http::request<http::string_body> req) {
-    const auto [status, why] = vet(req);
-    if (status != http::status::ok) {
-      log::warn(kTag, "client ", peer_, " refused: ", why);
+    const auto& o = server_.options();
+    const UpgradeVerdict verdict = vetUpgrade(req, o.token, o.allowed_origins);
+    if (!verdict.accepted()) {
+      log::warn(kTag, "client ", peer_, " refused: ", verdict.reason);
       server_.noteRefused();
       endHandshake();
-      auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
+      auto res = std::make_shared<http::response<http::string_body>>(verdict.status, req.version());
       res->set(http::field::content_type, "text/plain");
       res->set(http::field::connection, "close");
-      res->body() = why + "\n";
+      res->body() = verdict.reason + "\n";
       res->prepare_payload();
       http::async_write(ws_.next_layer(), *res, [self = self(), res](beast::error_code, std::size_t) {
         beast::error_code ignored;
@@ -450,6 +401,7 @@ class Session final : public ClientSession {
       });
       return;
     }
+    subprotocol_ = verdict.subprotocol;
     beast::get_lowest_layer(ws_).expires_never();
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
     ws_.set_option(websocket::stream_base::decorator([p = subprotocol_](websocket::response_type& res) {
