@@ -105,184 +105,185 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
   last_t_s_ = t_s;
   if (dt > 0) predict(dt);
   person_echo_.fill(false);
-  // 1. Echoes to points; drop those explained by the map or by persistence.
-  struct Echo {
-    bool use = false;
-    Eigen::Vector2d z;
-    Eigen::Matrix2d r;
-    double range = 0;
-    double yaw = 0;  // the beam's direction (odometry frame)
-  };
-  std::array<Echo, 4> echo{};
-  for (std::size_t i = 0; i < 4; ++i) {
-    const double r = ranges_m[i];
-    if (!(r > 0) || !std::isfinite(r) || r >= sonar_.max_range_m) continue;
-    ++counters_.echoes;
-    const control::Pose2 sensor = config::mountPose(pose, sonar_.mounts[i]);
-    const double bx = sensor.x_m, by = sensor.y_m, yaw = sensor.theta_rad;
-    const double px = bx + r * std::cos(yaw), py = by + r * std::sin(yaw);
-    // An echo is explained by the map when any point of its range arc within
-    // the cone touches known structure (a corridor's side walls reach the
-    // front sensors through the cone's edges).
-    bool explained = false;
-    for (int k = -3; k <= 3 && !explained && !map_.empty(); ++k) {
-      const double a = yaw + k * sonar_.beam_width_rad / 6.0;
-      explained = nearMap(bx + r * std::cos(a), by + r * std::sin(a));
-    }
-    if (explained) {
-      ++counters_.static_map;
-      continue;
-    }
-    // The same for the walls the side sensors traced (no map needed): a
-    // corridor's walls reach the front cones' edges at a range that slides
-    // along with the robot, as a leading person's would.
-    const bool side_sensor = std::abs(std::remainder(sonar_.mounts[i].yaw_rad, M_PI)) > M_PI / 4;
-    for (int k = -3; k <= 3 && !explained && p_.wall_trace && !side_sensor; k += 6) {
-      const double a = yaw + k * sonar_.beam_width_rad / 6.0;
-      explained = nearLearned(bx + r * std::cos(a), by + r * std::sin(a), t_s);
-    }
-    if (explained) {
-      ++counters_.static_learned;
-      // A track started on this echo before the wall was learned (the first
-      // few tenths of a second of driving) goes: the echo that fed it is the wall's.
-      std::erase_if(tracks_, [&](const HumanTrack& t) {
-        const bool wall = std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m;
-        if (wall && !t.confirmed) ++counters_.tracks_unconfirmed_dropped;
-        return wall;
-      });
-      continue;
-    }
-    // Persistence: a person passes through a 0.2 m cell in well under a
-    // second; structure keeps being hit in the same place for longer. Echoes
-    // at a tracked person are exempt: a person who stops is still a person.
-    bool at_person = false;
-    for (const auto& t : tracks_)
-      at_person = at_person || (t.isPerson() && std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m);
-    if (Cell* ce = cell(px, py); ce && !at_person) {
-      const auto now = static_cast<float>(t_s);
-      if (ce->last_s < 0 || now - ce->last_s > p_.grid_forget_s) ce->first_s = now;
-      ce->last_s = now;
-      if (now - ce->first_s > p_.grid_static_s) {
-        ++counters_.static_grid;
-        continue;
-      }
-    }
-    if (p_.wall_trace && side_sensor && tracesWall(i, Eigen::Vector2d(px, py), pose, t_s)) {
-      ++counters_.static_wall_trace;
-      // A track started on this wall before the trace was long enough goes too.
-      std::erase_if(tracks_, [&](const HumanTrack& t) {
-        const bool wall = !t.isPerson() && std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m;
-        if (wall && !t.confirmed) ++counters_.tracks_unconfirmed_dropped;
-        return wall;
-      });
-      continue;
-    }
-    // Measurement covariance: range noise along the beam, the cone's width across it.
-    const double along = std::max(p_.range_sigma_m, 0.01);
-    const double across = std::max(0.05, r * std::tan(sonar_.beam_width_rad / 2) / 2);
-    echo[i] = {true, Eigen::Vector2d(px, py), beamCovariance(yaw, along, across), r, yaw};
+  SonarEchoes echo{};
+  for (std::size_t i = 0; i < 4; ++i)
+    if (const auto e = echoOf(i, pose, ranges_m[i], t_s)) echo[i] = *e;
+  placeLoneFrontEcho(pose, ranges_m, echo);
+  triangulateFrontPair(pose, echo);
+  for (std::size_t i = 0; i < 4; ++i)
+    if (echo[i].use) associate(i, pose, ranges_m, echo, t_s);
+  markContradicted(pose, ranges_m, t_s);
+  classifyTracks(t_s);
+  dropTracks(t_s);
+}
+
+std::optional<SonarEcho> HumanTracker::echoOf(std::size_t i, const control::Pose2& pose, double r, double t_s) {
+  if (!(r > 0) || !std::isfinite(r) || r >= sonar_.max_range_m) return std::nullopt;
+  ++counters_.echoes;
+  const control::Pose2 sensor = config::mountPose(pose, sonar_.mounts[i]);
+  const double bx = sensor.x_m, by = sensor.y_m, yaw = sensor.theta_rad;
+  const double px = bx + r * std::cos(yaw), py = by + r * std::sin(yaw);
+  // An echo is explained by the map when any point of its range arc within
+  // the cone touches known structure (a corridor's side walls reach the
+  // front sensors through the cone's edges).
+  bool explained = false;
+  for (int k = -3; k <= 3 && !explained && !map_.empty(); ++k) {
+    const double a = yaw + k * sonar_.beam_width_rad / 6.0;
+    explained = nearMap(bx + r * std::cos(a), by + r * std::sin(a));
   }
-  // 2a. Only one of the two front sensors hears the object: it is more likely
-  // on that sensor's outer side (the other cone covers the inner side).
-  if (p_.triangulate_front && echo[0].use != echo[1].use && !(ranges_m[0] > 0 && ranges_m[1] > 0)) {
-    const std::size_t i = echo[0].use ? 0 : 1, o = 1 - i;
-    const auto& mi = sonar_.mounts[i];
-    const auto& mo = sonar_.mounts[o];
-    if (std::abs(mi.yaw_rad - mo.yaw_rad) < 1e-6) {
-      const double side = (mi.y_m - mo.y_m) * std::cos(mi.yaw_rad) - (mi.x_m - mo.x_m) * std::sin(mi.yaw_rad);
-      const double r = echo[i].range, half = sonar_.beam_width_rad / 2;
-      const double shift = std::copysign(r * std::tan(half) / 2, side);  // centre of the outer half
-      const double yaw = pose.theta_rad + mi.yaw_rad;
-      echo[i].z += Eigen::Vector2d(-std::sin(yaw), std::cos(yaw)) * shift;
-      echo[i].r = beamCovariance(yaw, std::max(p_.range_sigma_m, 0.01), std::max(0.05, r * std::tan(half) / 4));
+  if (explained) {
+    ++counters_.static_map;
+    return std::nullopt;
+  }
+  // The same for the walls the side sensors traced (no map needed): a
+  // corridor's walls reach the front cones' edges at a range that slides
+  // along with the robot, as a leading person's would.
+  const bool side_sensor = std::abs(std::remainder(sonar_.mounts[i].yaw_rad, M_PI)) > M_PI / 4;
+  for (int k = -3; k <= 3 && !explained && p_.wall_trace && !side_sensor; k += 6) {
+    const double a = yaw + k * sonar_.beam_width_rad / 6.0;
+    explained = nearLearned(bx + r * std::cos(a), by + r * std::sin(a), t_s);
+  }
+  if (explained) {
+    ++counters_.static_learned;
+    // A track started on this echo before the wall was learned (the first
+    // few tenths of a second of driving) goes: the echo that fed it is the wall's.
+    std::erase_if(tracks_, [&](const HumanTrack& t) {
+      const bool wall = std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m;
+      if (wall && !t.confirmed) ++counters_.tracks_unconfirmed_dropped;
+      return wall;
+    });
+    return std::nullopt;
+  }
+  // Persistence: a person passes through a 0.2 m cell in well under a
+  // second; structure keeps being hit in the same place for longer. Echoes
+  // at a tracked person are exempt: a person who stops is still a person.
+  bool at_person = false;
+  for (const auto& t : tracks_)
+    at_person = at_person || (t.isPerson() && std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m);
+  if (Cell* ce = cell(px, py); ce && !at_person) {
+    const auto now = static_cast<float>(t_s);
+    if (ce->last_s < 0 || now - ce->last_s > p_.grid_forget_s) ce->first_s = now;
+    ce->last_s = now;
+    if (now - ce->first_s > p_.grid_static_s) {
+      ++counters_.static_grid;
+      return std::nullopt;
     }
   }
-  // 2. The two front sensors see the same person: the two ranges fix its
-  // bearing (trilateration across the 0.24 m baseline), which the cone alone
-  // cannot; the fused point replaces both.
-  if (p_.triangulate_front && echo[0].use && echo[1].use) {
-    if (const auto fused = triangulate(pose, echo[0].range, echo[1].range)) {
-      echo[0].z = fused->first;
-      echo[0].r = fused->second;
-      echo[1].use = false;
-      ++counters_.triangulated;
+  if (p_.wall_trace && side_sensor && tracesWall(i, Eigen::Vector2d(px, py), pose, t_s)) {
+    ++counters_.static_wall_trace;
+    // A track started on this wall before the trace was long enough goes too.
+    std::erase_if(tracks_, [&](const HumanTrack& t) {
+      const bool wall = !t.isPerson() && std::hypot(t.x[0] - px, t.x[1] - py) < p_.gate_m;
+      if (wall && !t.confirmed) ++counters_.tracks_unconfirmed_dropped;
+      return wall;
+    });
+    return std::nullopt;
+  }
+  // Measurement covariance: range noise along the beam, the cone's width across it.
+  const double along = std::max(p_.range_sigma_m, 0.01);
+  const double across = std::max(0.05, r * std::tan(sonar_.beam_width_rad / 2) / 2);
+  return SonarEcho{true, Eigen::Vector2d(px, py), beamCovariance(yaw, along, across), r, yaw};
+}
+
+void HumanTracker::placeLoneFrontEcho(const control::Pose2& pose, const std::array<double, 4>& ranges_m,
+                                      SonarEchoes& echo) const {
+  if (!p_.triangulate_front || echo[0].use == echo[1].use || (ranges_m[0] > 0 && ranges_m[1] > 0)) return;
+  const std::size_t i = echo[0].use ? 0 : 1, o = 1 - i;
+  const auto& mi = sonar_.mounts[i];
+  const auto& mo = sonar_.mounts[o];
+  if (std::abs(mi.yaw_rad - mo.yaw_rad) >= 1e-6) return;
+  const double side = (mi.y_m - mo.y_m) * std::cos(mi.yaw_rad) - (mi.x_m - mo.x_m) * std::sin(mi.yaw_rad);
+  const double r = echo[i].range, half = sonar_.beam_width_rad / 2;
+  const double shift = std::copysign(r * std::tan(half) / 2, side);  // centre of the outer half
+  const double yaw = pose.theta_rad + mi.yaw_rad;
+  echo[i].z += Eigen::Vector2d(-std::sin(yaw), std::cos(yaw)) * shift;
+  echo[i].r = beamCovariance(yaw, std::max(p_.range_sigma_m, 0.01), std::max(0.05, r * std::tan(half) / 4));
+}
+
+void HumanTracker::triangulateFrontPair(const control::Pose2& pose, SonarEchoes& echo) {
+  if (!p_.triangulate_front || !echo[0].use || !echo[1].use) return;
+  if (const auto fused = triangulate(pose, echo[0].range, echo[1].range)) {
+    echo[0].z = fused->first;
+    echo[0].r = fused->second;
+    echo[1].use = false;
+    ++counters_.triangulated;
+  }
+}
+
+Eigen::Matrix2d HumanTracker::rangeOnly(const SonarEcho& e) const {
+  return beamCovariance(e.yaw, std::max(p_.range_sigma_m, 0.01),
+                        std::max(0.1, e.range * std::tan(sonar_.beam_width_rad / 2)));
+}
+
+HumanTrack* HumanTracker::cameraTrackNear(const control::Pose2& pose, const SonarEcho& e, double t_s) {
+  // A track the camera placed (its range from the foot row, +-25 %) may be
+  // metres off along its bearing, and a front echo's lateral place (one
+  // cone, or the two ranges' trilateration) a metre off across it: an echo
+  // within a detection's error of a track the camera saw in the last
+  // bearing_hold_s is that person, not a second one. The gate is one
+  // detection's error, not the track's covariance: a person's foot-row error
+  // is much the same picture after picture, so averaging does not shrink it.
+  const Eigen::Matrix2d echo_r = rangeOnly(e);
+  HumanTrack* best = nullptr;
+  double best_d2 = p_.camera.gate_chi2;
+  for (auto& t : tracks_) {
+    if (!cameraSeenAt(t, t_s)) continue;
+    const Eigen::Vector2d v = e.z - t.x.head<2>();
+    const double r = std::hypot(t.x[0] - pose.x_m, t.x[1] - pose.y_m);
+    const double yaw = std::atan2(t.x[1] - pose.y_m, t.x[0] - pose.x_m);
+    const Eigen::Matrix2d s = beamCovariance(yaw, std::max(0.05, p_.camera.range_sigma_frac * r),
+                                             std::max(0.05, r * p_.camera.bearing_sigma_deg * M_PI / 180.0)) +
+                              echo_r;
+    const double d2 = v.dot(s.ldlt().solve(v));
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = &t;
     }
   }
-  // 3. Association with tracks (nearest within the gate) or a new track.
-  for (std::size_t i = 0; i < 4; ++i) {
-    if (!echo[i].use) continue;
-    const Eigen::Vector2d& z = echo[i].z;
-    // The echo as a range only (across the beam, the whole cone): what it tells
-    // a track whose bearing the camera gives.
-    const auto range_only = [&] {
-      return beamCovariance(echo[i].yaw, std::max(p_.range_sigma_m, 0.01),
-                            std::max(0.1, echo[i].range * std::tan(sonar_.beam_width_rad / 2)));
-    };
-    HumanTrack* best = nullptr;
-    double best_d = p_.gate_m;
-    for (auto& t : tracks_) {
-      const double d = std::hypot(t.x[0] - z.x(), t.x[1] - z.y());
-      if (d < best_d) {
-        best_d = d;
-        best = &t;
-      }
-    }
-    // 3b. A track the camera placed (its range from the foot row, +-25 %) may
-    // be metres off along its bearing, and a front echo's lateral place (one
-    // cone, or the two ranges' trilateration) a metre off across it: an echo
-    // within a detection's error of a track the camera saw in the last
-    // bearing_hold_s is that person, not a second one. The gate is one
-    // detection's error, not the track's covariance: a person's foot-row error
-    // is much the same picture after picture, so averaging does not shrink it.
-    if (!best) {
-      const Eigen::Matrix2d echo_r = range_only();
-      double best_d2 = p_.camera.gate_chi2;
-      for (auto& t : tracks_) {
-        if (!cameraSeenAt(t, t_s)) continue;
-        const Eigen::Vector2d v = z - t.x.head<2>();
-        const double r = std::hypot(t.x[0] - pose.x_m, t.x[1] - pose.y_m);
-        const double yaw = std::atan2(t.x[1] - pose.y_m, t.x[0] - pose.x_m);
-        const Eigen::Matrix2d s =
-            beamCovariance(yaw, std::max(0.05, p_.camera.range_sigma_frac * r),
-                           std::max(0.05, r * p_.camera.bearing_sigma_deg * M_PI / 180.0)) +
-            echo_r;
-        const double d2 = v.dot(s.ldlt().solve(v));
-        if (d2 < best_d2) {
-          best_d2 = d2;
-          best = &t;
-        }
-      }
-      if (best) ++counters_.camera_echo_joins;
-    }
-    if (best) {
-      // A track the camera saw lately has its bearing from the camera: the
-      // echo gives it range only, or its 100 echoes a second, each placed on
-      // the beam's centre line, would outweigh the bearings and pull a
-      // crossing person back to the centre.
-      const Eigen::Matrix2d r = cameraSeenAt(*best, t_s) ? range_only() : echo[i].r;
-      update(*best, z, r, t_s);
-      ++counters_.associated;
-      const bool person = best->isPerson();
-      person_echo_[i] = person;
-      if (i == 0 && p_.triangulate_front && !echo[1].use && ranges_m[1] > 0) person_echo_[1] = person;
-    } else if (static_cast<int>(tracks_.size()) < p_.max_tracks &&
-               echo[i].range < sonar_.max_range_m - p_.new_track_margin_m) {
-      HumanTrack t;
-      t.id = next_id_++;
-      t.x << z.x(), z.y(), 0, 0;
-      t.p = Eigen::Matrix4d::Zero();
-      t.p.block<2, 2>(0, 0) = echo[i].r;
-      t.p(2, 2) = t.p(3, 3) = 1.0;  // unknown velocity: up to ~1-2 m/s
-      t.first_seen_s = t.last_seen_s = t_s;
-      t.hits = 1;
-      tracks_.push_back(t);
-      ++counters_.tracks_created;
+  return best;
+}
+
+void HumanTracker::associate(std::size_t i, const control::Pose2& pose, const std::array<double, 4>& ranges_m,
+                             const SonarEchoes& echo, double t_s) {
+  const SonarEcho& e = echo[i];
+  HumanTrack* best = nullptr;
+  double best_d = p_.gate_m;
+  for (auto& t : tracks_) {
+    const double d = std::hypot(t.x[0] - e.z.x(), t.x[1] - e.z.y());
+    if (d < best_d) {
+      best_d = d;
+      best = &t;
     }
   }
-  // 4. Negative information: a sensor whose cone covers a track's predicted
-  // position but hears nothing there (no echo, or one well beyond it) says
-  // the person is not there; a track contradicted on a few ticks in a row is
-  // dropped instead of coasting on a wrong velocity.
+  if (!best) {
+    best = cameraTrackNear(pose, e, t_s);
+    if (best) ++counters_.camera_echo_joins;
+  }
+  if (best) {
+    // A track the camera saw lately has its bearing from the camera: the
+    // echo gives it range only, or its 100 echoes a second, each placed on
+    // the beam's centre line, would outweigh the bearings and pull a
+    // crossing person back to the centre.
+    update(*best, e.z, cameraSeenAt(*best, t_s) ? rangeOnly(e) : e.r, t_s);
+    ++counters_.associated;
+    const bool person = best->isPerson();
+    person_echo_[i] = person;
+    if (i == 0 && p_.triangulate_front && !echo[1].use && ranges_m[1] > 0) person_echo_[1] = person;
+  } else if (static_cast<int>(tracks_.size()) < p_.max_tracks && e.range < sonar_.max_range_m - p_.new_track_margin_m) {
+    HumanTrack t;
+    t.id = next_id_++;
+    t.x << e.z.x(), e.z.y(), 0, 0;
+    t.p = Eigen::Matrix4d::Zero();
+    t.p.block<2, 2>(0, 0) = e.r;
+    t.p(2, 2) = t.p(3, 3) = 1.0;  // unknown velocity: up to ~1-2 m/s
+    t.first_seen_s = t.last_seen_s = t_s;
+    t.hits = 1;
+    tracks_.push_back(t);
+    ++counters_.tracks_created;
+  }
+}
+
+void HumanTracker::markContradicted(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s) {
   for (auto& t : tracks_) {
     if (t.last_seen_s >= t_s) {
       t.contradicted = 0;
@@ -300,7 +301,9 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     }
     t.contradicted = contradicted ? t.contradicted + 1 : 0;
   }
-  // Confirm, reclassify, drop.
+}
+
+void HumanTracker::classifyTracks(double t_s) {
   for (auto& t : tracks_) {
     const bool enough = t.hits >= p_.confirm_hits || t.camera_hits >= p_.camera.confirm_hits;
     if (!t.confirmed && enough && t.last_seen_s - t.first_seen_s <= p_.confirm_window_s + 1e-9) {
@@ -320,6 +323,9 @@ void HumanTracker::step(const control::Pose2& pose, const std::array<double, 4>&
     if (t.confirmed && t.camera_hits >= p_.camera.confirm_hits && t.person_logodds >= p_.camera.person_logodds)
       t.person = true;
   }
+}
+
+void HumanTracker::dropTracks(double t_s) {
   std::erase_if(tracks_, [&](const HumanTrack& t) {
     if (t.contradicted >= p_.contradiction_ticks) {
       ++counters_.tracks_contradicted;

@@ -92,6 +92,17 @@ struct HumanTrack {
   double positionSigma() const { return std::sqrt(std::max(p(0, 0), p(1, 1))); }
 };
 
+/// One sonar's echo as a point in the odometry frame with its covariance
+/// (HumanTracker::echoOf).
+struct SonarEcho {
+  bool use = false;
+  Eigen::Vector2d z = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d r = Eigen::Matrix2d::Identity();
+  double range = 0;
+  double yaw = 0;  // the beam's direction (odometry frame)
+};
+using SonarEchoes = std::array<SonarEcho, 4>;
+
 /// Detection bookkeeping (for telemetry and the scenario suite).
 struct TrackerCounters {
   uint64_t echoes = 0;            // valid ranges seen
@@ -135,6 +146,35 @@ class HumanTracker {
   /// Per sensor, last step: its echo went to a track that is a person (such
   /// echoes are people, not obstacles to steer round: they get the Eq 9 factor).
   const std::array<bool, 4>& personEchoes() const { return person_echo_; }
+  // The steps of step(), in its order; public so that each is tested on its
+  // own (tests/shared/behavior/test_tracker_steps.cpp). step() predicts the
+  // tracks to t_s first; the steps take the tracks as they are.
+
+  /// 1. Sensor i's range as a point, or nothing when structure explains it:
+  /// the map (any point of its arc within the cone), a wall the side sensors
+  /// traced, a cell that keeps echoing (grid_static_s), or a side sensor's
+  /// points lying along a wall (wall_trace; tracks started on such a wall go).
+  std::optional<SonarEcho> echoOf(std::size_t i, const control::Pose2& pose, double range_m, double t_s);
+  /// 2a. Only one of the two front sensors hears the object: it is more likely
+  /// on that sensor's outer side (the other cone covers the inner side).
+  void placeLoneFrontEcho(const control::Pose2& pose, const std::array<double, 4>& ranges_m, SonarEchoes& echo) const;
+  /// 2b. Both front sensors hear it: the two ranges fix its bearing
+  /// (trilateration across their baseline), the fused point replaces both.
+  void triangulateFrontPair(const control::Pose2& pose, SonarEchoes& echo);
+  /// 3. Echo i to the nearest track within gate_m, else to a track the camera
+  /// saw lately within one detection's error, else a new track.
+  void associate(std::size_t i, const control::Pose2& pose, const std::array<double, 4>& ranges_m,
+                 const SonarEchoes& echo, double t_s);
+  /// 4. Negative information: a sensor whose cone covers a track's place and
+  /// hears nothing there (or only well beyond it) contradicts the track.
+  void markContradicted(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s);
+  /// 5. Confirm (confirm_hits within confirm_window_s) and make people
+  /// (moving for moving_for_s, or confirmed by the camera).
+  void classifyTracks(double t_s);
+  /// 6. Drop tracks contradicted contradiction_ticks in a row, unseen for
+  /// coast_s, unconfirmed past the window, or static too long.
+  void dropTracks(double t_s);
+
   /// The camera detected this track within camera.bearing_hold_s of the last step.
   bool cameraSeen(const HumanTrack& t) const { return cameraSeenAt(t, last_t_s_); }
 
@@ -154,6 +194,11 @@ class HumanTracker {
   std::optional<std::pair<Eigen::Vector2d, Eigen::Matrix2d>> triangulate(const control::Pose2& pose, double r0,
                                                                           double r1) const;
   void update(HumanTrack& t, const Eigen::Vector2d& z, const Eigen::Matrix2d& r, double t_s);
+  /// An echo as a range only: across the beam, the whole cone (what it tells
+  /// a track whose bearing the camera gives).
+  Eigen::Matrix2d rangeOnly(const SonarEcho& e) const;
+  /// The track the camera saw lately that echo `e` lies within one detection's error of (chi2 gate).
+  HumanTrack* cameraTrackNear(const control::Pose2& pose, const SonarEcho& e, double t_s);
   /// Camera evidence on a track's log-odds (and its denial).
   void addPersonEvidence(HumanTrack& t, double logodds);
   /// Records sensor i's echo point and says whether its recent points trace a wall (wall_trace).
