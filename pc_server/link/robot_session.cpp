@@ -155,13 +155,14 @@ void RobotSession::sendCommand(v1::Command cmd) {
 }
 
 void RobotSession::setTeleop(double v_m_s, double w_rad_s, uint64_t first_id, double lease_s) {
-  const auto lapse_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(seconds(std::max(0.0, lease_s)));
-  asio::post(strand_, [self = shared_from_this(), v_m_s, w_rad_s, first_id, lease_s, lapse_at] {
+  const double lease = lease_s > 0 ? lease_s : 0.0;  // also NaN: no lease
+  const auto lapse_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(seconds(lease));
+  asio::post(strand_, [self = shared_from_this(), v_m_s, w_rad_s, first_id, lease, lapse_at] {
     if (self->closed_ || !self->peer_.accepted) return;
     self->teleop_.active = true;
     self->teleop_.v_m_s = v_m_s;
     self->teleop_.w_rad_s = w_rad_s;
-    self->teleop_.lease_s = lease_s > 0 ? lease_s : 0.0;
+    self->teleop_.lease_s = lease;
     self->teleop_.lapse_at = lapse_at;
     const uint64_t gen = ++self->teleop_.generation;
     self->teleop_timer_.cancel();

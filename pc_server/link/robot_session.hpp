@@ -148,7 +148,7 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
     double w_rad_s = 0;
     uint64_t generation = 0;  // bumps on every change, so stale timer chains end
     double lease_s = 0;       // > 0: lapses at lapse_at unless renewed
-    std::chrono::steady_clock::time_point lapse_at{};
+    Clock::time_point lapse_at{};
   } teleop_;
 };
 

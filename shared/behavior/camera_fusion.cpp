@@ -172,14 +172,7 @@ void HumanTracker::observeCamera(const control::Pose2& pose, const CameraLook& l
     }
     // 3. A camera-only track, at the detection with its covariance.
     if (!ranged || range > c.max_new_range_m || static_cast<int>(tracks_.size()) >= p_.max_tracks) continue;
-    HumanTrack t;
-    t.id = next_id_++;
-    t.x << m.z.x(), m.z.y(), 0, 0;
-    t.p = Eigen::Matrix4d::Zero();
-    t.p.block<2, 2>(0, 0) = m.r;
-    t.p(2, 2) = t.p(3, 3) = 1.0;  // unknown velocity: up to ~1-2 m/s
-    t.first_seen_s = t.last_seen_s = t_s;
-    t.hits = 1;
+    HumanTrack t = newTrack(m.z, m.r, t_s);
     t.camera_hits = 1;
     t.camera_seen_s = t_s;
     addPersonEvidence(t, c.hit_logodds);

@@ -270,17 +270,21 @@ void HumanTracker::associate(std::size_t i, const control::Pose2& pose, const st
     person_echo_[i] = person;
     if (i == 0 && p_.triangulate_front && !echo[1].use && ranges_m[1] > 0) person_echo_[1] = person;
   } else if (static_cast<int>(tracks_.size()) < p_.max_tracks && e.range < sonar_.max_range_m - p_.new_track_margin_m) {
-    HumanTrack t;
-    t.id = next_id_++;
-    t.x << e.z.x(), e.z.y(), 0, 0;
-    t.p = Eigen::Matrix4d::Zero();
-    t.p.block<2, 2>(0, 0) = e.r;
-    t.p(2, 2) = t.p(3, 3) = 1.0;  // unknown velocity: up to ~1-2 m/s
-    t.first_seen_s = t.last_seen_s = t_s;
-    t.hits = 1;
-    tracks_.push_back(t);
+    tracks_.push_back(newTrack(e.z, e.r, t_s));
     ++counters_.tracks_created;
   }
+}
+
+HumanTrack HumanTracker::newTrack(const Eigen::Vector2d& z, const Eigen::Matrix2d& r, double t_s) {
+  HumanTrack t;
+  t.id = next_id_++;
+  t.x << z.x(), z.y(), 0, 0;
+  t.p = Eigen::Matrix4d::Zero();
+  t.p.block<2, 2>(0, 0) = r;
+  t.p(2, 2) = t.p(3, 3) = 1.0;  // unknown velocity: up to ~1-2 m/s
+  t.first_seen_s = t.last_seen_s = t_s;
+  t.hits = 1;
+  return t;
 }
 
 void HumanTracker::markContradicted(const control::Pose2& pose, const std::array<double, 4>& ranges_m, double t_s) {

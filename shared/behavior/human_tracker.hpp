@@ -194,6 +194,8 @@ class HumanTracker {
   std::optional<std::pair<Eigen::Vector2d, Eigen::Matrix2d>> triangulate(const control::Pose2& pose, double r0,
                                                                           double r1) const;
   void update(HumanTrack& t, const Eigen::Vector2d& z, const Eigen::Matrix2d& r, double t_s);
+  /// A track at `z` with covariance `r`, unknown velocity, one hit at t_s (the next id).
+  HumanTrack newTrack(const Eigen::Vector2d& z, const Eigen::Matrix2d& r, double t_s);
   /// An echo as a range only: across the beam, the whole cone (what it tells
   /// a track whose bearing the camera gives).
   Eigen::Matrix2d rangeOnly(const SonarEcho& e) const;
