@@ -13,7 +13,11 @@
 #                 shared/robot/: the world does not know the robot's mind
 #   robot_client/ no sim/, pc_server/, experiments/, tests/ (the world file
 #                 of --map is shared/world)
-#   pc_server/    no robot_client/, experiments/, tests/
+#   pc_server/    no robot_client/, experiments/, tests/; inside it the parts
+#                 the front ends stand on (link/, video/, scene/, recording/,
+#                 tuning/) include no front end nor the app: not console/,
+#                 operator/, foxglove/, app/ (their config structs live beside
+#                 them; text helpers are shared/util)
 #   experiments/  no robot_client/; of tests/ only tests/support/paths.hpp and
 #                 udp_relay.hpp (the seeded lossy link of bench_video --loss)
 if(NOT ROOT)
@@ -49,6 +53,9 @@ check_folder(shared/robot "${programs}" "the decision core includes no program")
 check_folder(sim "^(robot_client|pc_server|experiments|tests)/|^shared/robot/" "the simulator includes no other program and not the robot's decision core")
 check_folder(robot_client "^(sim|pc_server|experiments|tests)/" "robot_client includes no other program (nor the simulator)")
 check_folder(pc_server "^(robot_client|experiments|tests)/" "pc_server includes no other program")
+foreach(part link video scene recording tuning)
+  check_folder(pc_server/${part} "^pc_server/(console|operator|foxglove|app)/" "pc_server/${part} is below the front ends: it includes no console/, operator/, foxglove/ or app/")
+endforeach()
 check_folder(experiments "^robot_client/|^tests/(.*/)?[a-z_]+\\.hpp$" "an experiment includes no program's code (of tests/ only tests/support/paths.hpp, udp_relay.hpp)")
 
 # The allowed exception of the rule above.

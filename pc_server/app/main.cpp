@@ -7,7 +7,7 @@
 #include "pc_server/app/cli_options.hpp"
 #include "pc_server/operator/operator_socket.hpp"
 #include "pc_server/app/server_app.hpp"
-#include "pc_server/app/startup_error.hpp"
+#include "shared/util/startup_error.hpp"
 
 int main(int argc, char** argv) {
   using namespace inspect::server;
@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   } catch (const inspect::config::ConfigError& e) {
     std::fprintf(stderr, "pc_server: %s\n", e.what());
     return 2;
-  } catch (const StartupError& e) {
+  } catch (const inspect::util::StartupError& e) {
     std::fprintf(stderr, "pc_server: %s\n", e.what());
     return 3;
   } catch (const std::exception& e) {

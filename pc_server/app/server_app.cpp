@@ -28,7 +28,7 @@
 #include "pc_server/link/link_server.hpp"
 #include "pc_server/operator/operator_socket.hpp"
 #include "pc_server/link/robot_registry.hpp"
-#include "pc_server/app/startup_error.hpp"
+#include "shared/util/startup_error.hpp"
 #include "pc_server/app/stop_flag.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/video/video_hub.hpp"
@@ -100,7 +100,7 @@ ServerConfig resolveConfig(const CliOptions& options) {
 
 void writePortFile(const std::string& path, uint16_t port, const std::string& flag) {
   if (const auto why = writeFileAtomically(path, std::to_string(port) + "\n"); !why.empty())
-    throw StartupError(flag + ": " + why);
+    throw util::StartupError(flag + ": " + why);
 }
 
 int runServer(const CliOptions& options) {
@@ -159,7 +159,7 @@ int runServer(const CliOptions& options) {
     try {
       recorder = std::make_unique<Recorder>(config.recording, INSPECT_VERSION);
     } catch (const std::exception& e) {
-      throw StartupError(std::string("recording: ") + e.what());
+      throw util::StartupError(std::string("recording: ") + e.what());
     }
     link.addEnvelopeObserver([rec = recorder.get()](const std::string& id, const std::string& address,
                                                     const v1::Envelope& env, bool inbound, uint64_t time_us) {
@@ -237,7 +237,7 @@ int runServer(const CliOptions& options) {
       try {
         fo.server.tls = net::makeTlsContext({"", config.tls.cert, config.tls.key}, net::TlsRole::kWebServer);
       } catch (const net::TlsError& e) {
-        throw StartupError(std::string("foxglove.tls: ") + e.what());
+        throw util::StartupError(std::string("foxglove.tls: ") + e.what());
       }
     }
     fo.scene_hz = fc.scene_hz;

@@ -10,11 +10,11 @@ namespace inspect::server {
 /// Throws config::ConfigError.
 ServerConfig resolveConfig(const CliOptions& options);
 
-/// Writes `port` to `path` through a temporary file and a rename. Throws StartupError.
+/// Writes `port` to `path` through a temporary file and a rename. Throws util::StartupError.
 void writePortFile(const std::string& path, uint16_t port, const std::string& flag = "--port-file");
 
 /// Runs the server until the console ends or SIGINT/SIGTERM; returns the exit status.
-/// Throws config::ConfigError / StartupError for startup failures.
+/// Throws config::ConfigError / util::StartupError for startup failures.
 int runServer(const CliOptions& options);
 
 }  // namespace inspect::server

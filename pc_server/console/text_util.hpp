@@ -1,26 +1,14 @@
 #pragma once
-// Small text helpers of the console: strict number parsing, word splitting
-// (number formatting: shared/util/number_text.hpp).
-#include <optional>
+// The console's text: gains as text, how an unknown value reads; the typed-word
+// parsing (shared/util/text_parse.hpp) and number formatting it uses.
 #include <string>
-#include <string_view>
-#include <vector>
 
 #include "shared/control/gain_set.hpp"
 #include "shared/util/number_text.hpp"
+#include "shared/util/text_parse.hpp"
 
 namespace inspect::server {
 
-/// Whole-string finite decimal number ("1.5", "-2", "1e-3"); nullopt otherwise.
-std::optional<double> parseNumber(std::string_view text);
-/// Whole-string integer (decimal, or hex with 0x); nullopt otherwise.
-std::optional<long long> parseInteger(std::string_view text);
-/// Splits on blanks (spaces and tabs).
-std::vector<std::string> splitWords(std::string_view text);
-/// Removes leading and trailing blanks (and a trailing '\r').
-std::string trim(std::string_view text);
-/// "key=value" into its two halves (neither empty); false otherwise.
-bool splitKeyValue(const std::string& a, std::string& k, std::string& v);
 /// Every tracking gain as "kp=11.94 ki=11.5 ...".
 std::string gainsText(const control::GainSet& g);
 
@@ -31,5 +19,10 @@ inline constexpr const char* kUnknown = "unknown";
 using util::fmtFixed;
 using util::fmtShort;
 using util::fmtSigned;
+using util::parseInteger;
+using util::parseNumber;
+using util::splitKeyValue;
+using util::splitWords;
+using util::trim;
 
 }  // namespace inspect::server

@@ -48,7 +48,7 @@ class FoxgloveBridge : public WsServer::Handler {
                  Console::Options console_options, ClientOperator::Configure configure);
   ~FoxgloveBridge() override;
 
-  /// Listens and starts the timers. Throws StartupError.
+  /// Listens and starts the timers. Throws util::StartupError.
   boost::asio::ip::tcp::endpoint start();
   /// Closes the clients (their sessions end, robots they drove are stopped); idempotent.
   void stop();

@@ -8,7 +8,7 @@ namespace inspect::server::foxglove {
 
 /// Reads the token in `path` (its first line, 16 to 256 printable characters),
 /// or, when there is no such file, creates it (mode 0600) with a new random
-/// token (32 hex digits from OpenSSL's RAND_bytes). Throws StartupError naming
+/// token (32 hex digits from OpenSSL's RAND_bytes). Throws util::StartupError naming
 /// the file and what was wrong.
 std::string loadOrCreateToken(const std::string& path);
 

@@ -12,7 +12,7 @@
 #include <boost/beast/websocket.hpp>
 #include <boost/beast/websocket/ssl.hpp>
 
-#include "pc_server/app/startup_error.hpp"
+#include "shared/util/startup_error.hpp"
 #include "pc_server/foxglove/ws_upgrade.hpp"
 #include "shared/util/token_bucket.hpp"
 #include "shared/util/log.hpp"
@@ -502,7 +502,7 @@ WsServer::~WsServer() { stop(); }
 tcp::endpoint WsServer::listen() {
   beast::error_code ec;
   const auto addr = asio::ip::make_address(options_.bind, ec);
-  if (ec) throw StartupError("foxglove: bind address '" + options_.bind + "' is not a numeric IP address");
+  if (ec) throw util::StartupError("foxglove: bind address '" + options_.bind + "' is not a numeric IP address");
   const tcp::endpoint ep(addr, options_.port);
   const std::string where = options_.bind + ":" + std::to_string(options_.port);
   acceptor_.open(ep.protocol(), ec);
@@ -510,7 +510,7 @@ tcp::endpoint WsServer::listen() {
   if (!ec) acceptor_.bind(ep, ec);
   if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
   if (ec)
-    throw StartupError("foxglove: cannot listen on " + where + ": " + ec.message() +
+    throw util::StartupError("foxglove: cannot listen on " + where + ": " + ec.message() +
                        (ec == asio::error::address_in_use ? " (another program uses the port; --foxglove-port or --no-foxglove)"
                                                           : ""));
   doAccept();

@@ -66,7 +66,7 @@ class WsServer {
   WsServer(const WsServer&) = delete;
   WsServer& operator=(const WsServer&) = delete;
 
-  /// Binds and starts accepting. Throws StartupError naming the address.
+  /// Binds and starts accepting. Throws util::StartupError naming the address.
   boost::asio::ip::tcp::endpoint listen();
   /// Closes every client (going away) and stops accepting; idempotent.
   void stop();

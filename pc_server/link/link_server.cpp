@@ -4,7 +4,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "pc_server/link/robot_session.hpp"
-#include "pc_server/app/startup_error.hpp"
+#include "shared/util/startup_error.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
 
@@ -17,7 +17,7 @@ using boost::system::error_code;
 namespace {
 }
 
-LinkServer::LinkServer(asio::io_context& ioc, const ServerConfig& config, RobotRegistry& registry)
+LinkServer::LinkServer(asio::io_context& ioc, const LinkConfig& config, RobotRegistry& registry)
     : ioc_(ioc),
       config_(config),
       registry_(registry),
@@ -32,21 +32,21 @@ tcp::endpoint LinkServer::listen() {
       tls_ = net::makeTlsContext({config_.tls.ca, config_.tls.cert, config_.tls.key}, net::TlsRole::kServer);
       cert_info_ = net::describeCertificate(config_.tls.cert);
     } catch (const net::TlsError& e) {
-      throw StartupError(std::string("TLS: ") + e.what() + " (or --plaintext for an isolated test bench)");
+      throw util::StartupError(std::string("TLS: ") + e.what() + " (or --plaintext for an isolated test bench)");
     }
   }
   error_code ec;
   const auto address = asio::ip::make_address(config_.bind_address, ec);
-  if (ec) throw StartupError("bind address '" + config_.bind_address + "' is not an IP address");
+  if (ec) throw util::StartupError("bind address '" + config_.bind_address + "' is not an IP address");
   const tcp::endpoint want(address, config_.port);
   const std::string where = config_.bind_address + ":" + std::to_string(config_.port);
   acceptor_.open(want.protocol(), ec);
   if (!ec) acceptor_.set_option(tcp::acceptor::reuse_address(true), ec);
   if (!ec) acceptor_.bind(want, ec);
   if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) throw StartupError("cannot listen on " + where + ": " + ec.message());
+  if (ec) throw util::StartupError("cannot listen on " + where + ": " + ec.message());
   const auto got = acceptor_.local_endpoint(ec);
-  if (ec) throw StartupError("cannot read the listening address: " + ec.message());
+  if (ec) throw util::StartupError("cannot read the listening address: " + ec.message());
   asio::post(acceptor_.get_executor(), [this] { doAccept(); });
   return got;
 }

@@ -20,7 +20,7 @@
 #include "pc_server/link/stored_events.hpp"
 #include "pc_server/link/command_sink.hpp"
 #include "shared/net/tls.hpp"
-#include "pc_server/app/server_config.hpp"
+#include "pc_server/link/link_config.hpp"
 
 namespace inspect::server {
 
@@ -29,13 +29,13 @@ class RobotSession;
 
 class LinkServer : public CommandSink {
  public:
-  LinkServer(boost::asio::io_context& ioc, const ServerConfig& config, RobotRegistry& registry);
+  LinkServer(boost::asio::io_context& ioc, const LinkConfig& config, RobotRegistry& registry);
   ~LinkServer() override;
   LinkServer(const LinkServer&) = delete;
   LinkServer& operator=(const LinkServer&) = delete;
 
   /// Loads the TLS files (unless config.tls.plaintext), binds to
-  /// config.bind_address:config.port and starts accepting. Throws StartupError.
+  /// config.bind_address:config.port and starts accepting. Throws util::StartupError.
   boost::asio::ip::tcp::endpoint listen();
   /// Stops accepting and closes every session; thread-safe, idempotent.
   void stop();
@@ -87,7 +87,7 @@ class LinkServer : public CommandSink {
   std::shared_ptr<RobotSession> find(const std::string& robot_id) const;
 
   boost::asio::io_context& ioc_;
-  const ServerConfig config_;
+  const LinkConfig config_;
   std::shared_ptr<boost::asio::ssl::context> tls_;  // null: plaintext
   std::string cert_info_;
   RobotRegistry& registry_;

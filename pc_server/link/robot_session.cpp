@@ -6,11 +6,13 @@
 #include "pc_server/link/hello_check.hpp"
 #include "pc_server/link/link_server.hpp"
 #include "pc_server/link/robot_registry.hpp"
-#include "pc_server/console/text_util.hpp"
 #include "shared/net/link_version.hpp"
 #include "shared/util/clock.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::server {
+
+using util::fmtShort;
 
 namespace asio = boost::asio;
 using boost::system::error_code;
@@ -39,7 +41,7 @@ std::chrono::nanoseconds seconds(double s) {
 
 RobotSession::RobotSession(Strand strand, asio::ip::tcp::socket socket,
                            const std::shared_ptr<asio::ssl::context>& tls, LinkServer& server, RobotRegistry& registry,
-                           const ServerConfig& config, uint64_t serial)
+                           const LinkConfig& config, uint64_t serial)
     : strand_(strand),
       stream_(std::move(socket), tls),
       server_(server),

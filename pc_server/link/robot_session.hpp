@@ -16,7 +16,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "inspect_robot/v1/link.pb.h"
-#include "pc_server/app/server_config.hpp"
+#include "pc_server/link/link_config.hpp"
 #include "shared/util/token_bucket.hpp"
 #include "shared/net/delimited_codec.hpp"
 #include "shared/net/tls.hpp"
@@ -40,7 +40,7 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   /// null = plaintext (--plaintext), else the TLS handshake comes first.
   RobotSession(Strand strand, boost::asio::ip::tcp::socket socket,
                const std::shared_ptr<boost::asio::ssl::context>& tls, LinkServer& server, RobotRegistry& registry,
-               const ServerConfig& config, uint64_t serial);
+               const LinkConfig& config, uint64_t serial);
 
   /// Starts the TLS handshake, then reading; arms the handshake timeout (TLS + Hello).
   void start();
@@ -92,7 +92,7 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   net::LinkStream stream_;
   LinkServer& server_;
   RobotRegistry& registry_;
-  const ServerConfig config_;
+  const LinkConfig config_;
   const uint64_t serial_;
   std::string address_;
 

@@ -13,7 +13,7 @@
 #include <streambuf>
 
 #include "pc_server/operator/line_reader.hpp"
-#include "pc_server/app/startup_error.hpp"
+#include "shared/util/startup_error.hpp"
 #include "shared/util/log.hpp"
 
 namespace inspect::server {
@@ -57,7 +57,7 @@ sockaddr_un unixAddress(const std::string& path) {
   sockaddr_un a{};
   a.sun_family = AF_UNIX;
   if (path.size() >= sizeof a.sun_path)
-    throw StartupError("--operator-socket '" + path + "': path longer than " +
+    throw util::StartupError("--operator-socket '" + path + "': path longer than " +
                        std::to_string(sizeof a.sun_path - 1) + " characters");
   std::memcpy(a.sun_path, path.c_str(), path.size() + 1);
   return a;
@@ -92,16 +92,16 @@ void OperatorSocket::start() {
   if (const int probe = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0); probe >= 0) {
     const bool live = ::connect(probe, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0;
     ::close(probe);
-    if (live) throw StartupError("--operator-socket '" + path_ + "': another pc_server is listening there");
+    if (live) throw util::StartupError("--operator-socket '" + path_ + "': another pc_server is listening there");
     struct stat st {};
     if (::lstat(path_.c_str(), &st) == 0) {
       if (!S_ISSOCK(st.st_mode))
-        throw StartupError("--operator-socket '" + path_ + "': exists and is not a socket (not replaced)");
+        throw util::StartupError("--operator-socket '" + path_ + "': exists and is not a socket (not replaced)");
       ::unlink(path_.c_str());
     }
   }
   listen_fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (listen_fd_ < 0) throw StartupError("--operator-socket: socket(): " + std::string(std::strerror(errno)));
+  if (listen_fd_ < 0) throw util::StartupError("--operator-socket: socket(): " + std::string(std::strerror(errno)));
   const mode_t old = ::umask(0117);  // rw for the owner and group: file permissions decide who may attach
   const int rc = ::bind(listen_fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof addr);
   ::umask(old);
@@ -109,7 +109,7 @@ void OperatorSocket::start() {
     const std::string why = std::strerror(errno);
     ::close(listen_fd_);
     listen_fd_ = -1;
-    throw StartupError("--operator-socket '" + path_ + "': " + why);
+    throw util::StartupError("--operator-socket '" + path_ + "': " + why);
   }
   acceptor_ = std::thread([this] { acceptLoop(); });
 }

@@ -30,7 +30,7 @@ class OperatorSocket {
   OperatorSocket& operator=(const OperatorSocket&) = delete;
 
   /// Creates the socket (a stale one from a dead server is replaced; a live
-  /// server's is not) and starts accepting. Throws StartupError.
+  /// server's is not) and starts accepting. Throws util::StartupError.
   void start();
   /// Ends every session (their waits are interrupted) and removes the socket.
   void stop();

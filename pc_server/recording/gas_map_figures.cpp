@@ -7,12 +7,15 @@
 #include <iterator>
 #include <sstream>
 
-#include "pc_server/console/text_util.hpp"
+#include "shared/util/number_text.hpp"
 #include "pc_server/recording/run_stats.hpp"
 #include "shared/util/gnuplot.hpp"
 #include "shared/util/number_text.hpp"
 
 namespace inspect::server::report {
+
+using util::fmtFixed;
+using util::fmtShort;
 namespace fs = std::filesystem;
 namespace {
 

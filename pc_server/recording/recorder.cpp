@@ -11,10 +11,13 @@
 #include "shared/record/mcap_writer.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
+#include "shared/util/number_text.hpp"
 #include "shared/video/frame_source.hpp"
 #include "shared/video/mp4_writer.hpp"
 
 namespace inspect::server {
+
+using util::fmtShort;
 
 namespace fs = std::filesystem;
 

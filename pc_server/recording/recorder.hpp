@@ -21,7 +21,7 @@
 #include "pc_server/recording/run_stats.hpp"
 #include "pc_server/scene/robot_scene.hpp"
 #include "pc_server/scene/site_maps.hpp"
-#include "pc_server/app/server_config.hpp"
+#include "pc_server/recording/recording_config.hpp"
 #include "shared/catalog/catalog.hpp"
 #include "shared/video/rtp_h264.hpp"
 

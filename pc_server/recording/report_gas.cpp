@@ -4,10 +4,13 @@
 #include <cstdio>
 #include <tuple>
 
-#include "pc_server/console/text_util.hpp"
+#include "shared/util/number_text.hpp"
 #include "shared/util/number_text.hpp"
 
 namespace inspect::server::report {
+
+using util::fmtFixed;
+using util::fmtShort;
 
 std::string gasValue(double v) { return util::significant(v, 4); }
 

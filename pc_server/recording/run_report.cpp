@@ -14,10 +14,13 @@
 
 #include "pc_server/recording/report_gas.hpp"
 #include "pc_server/recording/run_stats.hpp"
-#include "pc_server/console/text_util.hpp"
+#include "shared/util/number_text.hpp"
 #include "shared/util/gnuplot.hpp"
 
 namespace inspect::server {
+
+using util::fmtFixed;
+using util::fmtShort;
 namespace fs = std::filesystem;
 
 namespace {

@@ -9,7 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "pc_server/app/startup_error.hpp"
+#include "shared/util/startup_error.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/file_util.hpp"
 #include "shared/util/log.hpp"
@@ -47,15 +47,15 @@ VideoHub::VideoHub(const VideoServerConfig& config, const std::string& link_bind
   try {
     receiver_ = std::make_unique<video::VideoReceiver>(rs);
   } catch (const video::VideoError& e) {
-    throw StartupError(e.what());
+    throw util::StartupError(e.what());
   }
   std::error_code fec;
   std::filesystem::create_directories(config.dir, fec);
-  if (fec) throw StartupError("video.dir: cannot create '" + config.dir + "': " + fec.message());
+  if (fec) throw util::StartupError("video.dir: cannot create '" + config.dir + "': " + fec.message());
   if (config.forward_base_port) {
     boost::system::error_code ec;
     fwd_socket_.open(asio::ip::udp::v4(), ec);
-    if (ec) throw StartupError("video: cannot open the forwarding socket: " + ec.message());
+    if (ec) throw util::StartupError("video: cannot open the forwarding socket: " + ec.message());
   }
   receiver_->setKeyframeRequest([this](const std::string& robot) {
     v1::Command c;

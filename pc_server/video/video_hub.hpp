@@ -16,14 +16,14 @@
 
 #include "inspect_robot/v1/link.pb.h"
 #include "pc_server/link/command_sink.hpp"
-#include "pc_server/app/server_config.hpp"
+#include "pc_server/video/video_config.hpp"
 #include "shared/video/video_receiver.hpp"
 
 namespace inspect::server {
 
 class VideoHub {
  public:
-  /// Binds the UDP port and creates the directory; throws StartupError naming
+  /// Binds the UDP port and creates the directory; throws util::StartupError naming
   /// what failed. `link_bind` is used when config.bind is empty.
   VideoHub(const VideoServerConfig& config, const std::string& link_bind, CommandSink& sink);
   ~VideoHub();

@@ -1,8 +1,8 @@
 #pragma once
-// Startup failures that are not configuration mistakes (cannot listen, cannot write the port file).
+// Start-up failures that are not configuration mistakes (cannot listen, cannot write the port file).
 #include <stdexcept>
 
-namespace inspect::server {
+namespace inspect::util {
 
 /// main() prints what() on one line and exits with status 3.
 class StartupError : public std::runtime_error {
@@ -10,4 +10,4 @@ class StartupError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-}  // namespace inspect::server
+}  // namespace inspect::util

@@ -1,0 +1,25 @@
+# The build's include check (cmake/CheckIncludes.cmake) on scratch trees:
+# a tree that keeps the arrows passes; one deliberate inner-layer include
+# (pc_server/link including pc_server/console) fails, naming the file.
+#   cmake -DSCRIPT=<CheckIncludes.cmake> -DWORK=<scratch dir> -P check_includes_test.cmake
+set(tree ${WORK}/include_check_tree)
+file(REMOVE_RECURSE ${tree})
+file(WRITE ${tree}/pc_server/console/console.hpp "#pragma once\n#include \"pc_server/link/link_config.hpp\"\n")
+file(WRITE ${tree}/pc_server/link/link_config.hpp "#pragma once\n#include \"shared/util/text_parse.hpp\"\n")
+file(WRITE ${tree}/shared/util/text_parse.hpp "#pragma once\n")
+execute_process(COMMAND ${CMAKE_COMMAND} -DROOT=${tree} -P ${SCRIPT} RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "a tree that keeps the arrows was refused:\n${err}")
+endif()
+foreach(part link video scene recording tuning)
+  foreach(front console operator foxglove app)
+    file(WRITE ${tree}/pc_server/${part}/bad.cpp "#include \"pc_server/${front}/x.hpp\"\n")
+    execute_process(COMMAND ${CMAKE_COMMAND} -DROOT=${tree} -P ${SCRIPT} RESULT_VARIABLE rc ERROR_VARIABLE err)
+    if(rc EQUAL 0 OR NOT err MATCHES "pc_server/${part}/bad.cpp: #include \"pc_server/${front}/x.hpp\"")
+      message(FATAL_ERROR "pc_server/${part} including pc_server/${front} was not refused (rc ${rc}):\n${err}")
+    endif()
+    file(REMOVE ${tree}/pc_server/${part}/bad.cpp)
+  endforeach()
+endforeach()
+file(REMOVE_RECURSE ${tree})
+message(STATUS "include check: the clean tree passes, 24 inner-layer includes refused")
