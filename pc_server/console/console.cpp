@@ -41,7 +41,16 @@ Console::Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, 
     : Console(registry, sink, out, stop, Options{}) {}
 
 Console::Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop, Options options)
-    : registry_(registry), sink_(sink), out_(out), stop_(stop), options_(options) {}
+    : registry_(registry), sink_(sink), out_(out), stop_(stop), options_(options) {
+  setSession(nullptr, 0);
+}
+
+void Console::setSession(ControlArbiter* arbiter, uint64_t session) {
+  control_ = arbiter;
+  session_ = session;
+  service_.emplace(registry_, sink_, arbiter,
+                   OperatorService::Options{options_.ack_timeout_s, options_.max_v_m_s, options_.max_w_rad_s});
+}
 
 bool Console::fail(const std::string& cmd, const std::string& message) {
   out_ << cmd << ": " << message << "\n";
@@ -136,11 +145,11 @@ bool Console::sleepPumping(double s) {
 }
 
 bool Console::mayMove(const std::string& robot, const std::string& cmd) {
-  if (!control_) return true;
-  const auto d = control_->authorizeMotion(robot, session_, clock_->nowNs());
-  if (d.taken_now) out_ << robot << ": control taken by " << control_->sessionName(session_) << "\n";
-  if (d.allowed) return true;
-  out_ << robot << ": " << cmd << " refused: " << d.reason << "\n";
+  std::string note;
+  const auto refused = service_->authorize(session_, robot, cmd, clock_->nowNs(), &note);
+  if (!note.empty()) out_ << note << "\n";
+  if (!refused) return true;
+  out_ << refused->text() << "\n";
   ++tally_.errors;
   return false;
 }
@@ -163,27 +172,10 @@ bool Console::cmdControl(const Args& args, const std::string&, int) {
   const bool force = take && args.size() == 2 && args[1] == "force";
   if ((!take && !release) || (release && args.size() != 1) || (take && args.size() > 1 && !force))
     return fail("control", "syntax: control | control take [force] | control release");
-  if (selected_.empty()) return fail("control", "no robot selected");
-  const std::string robot = selected_;
-  if (release) {
-    std::string why;
-    if (!control_->release(robot, session_, &why)) return fail("control", why);
-    sink_.clearTeleop(robot);
-    out_ << robot << ": control released; the robot is free\n";
-    return true;
-  }
-  const auto r = control_->take(robot, session_, force, clock_->nowNs());
-  if (!r.ok) return fail("control", r.reason);
-  if (r.previous) {
-    // The new operator starts from standstill: nothing of the old one's commands goes on.
-    sink_.clearTeleop(robot);
-    v1::Command stop;
-    stop.mutable_stop();
-    sink_.sendCommand(robot, std::move(stop));
-    out_ << robot << ": control taken over from " << r.previous->name << " (robot stopped)\n";
-  } else {
-    out_ << robot << ": controlled by " << control_->sessionName(session_) << "\n";
-  }
+  const auto r = release ? service_->releaseControl(session_, selected_)
+                         : service_->takeControl(session_, selected_, force, clock_->nowNs());
+  if (!r.ok()) return fail("control", r.reason);
+  out_ << r.robot << ": " << r.reason << "\n";
   return true;
 }
 
@@ -200,21 +192,38 @@ std::optional<std::string> Console::connectedRobot(const std::string& cmd) {
   return selected_;
 }
 
-std::optional<v1::Ack> Console::waitAck(const std::string& robot_id, uint64_t command_id) {
-  const int64_t deadline = deadlineAfter(options_.ack_timeout_s);
-  WakeSignal& arrived = registry_.ackSignal();
+CallResult Console::await(const PendingCall& pending) {
+  WakeSignal& arrived = service_->ackSignal();
   for (;;) {
     const uint64_t seen = arrived.generation();  // before looking: an Ack after the look moves it
-    if (auto a = registry_.ack(robot_id, command_id)) return a;
     const int64_t now = clock_->nowNs();
-    if (now >= deadline) return std::nullopt;
+    if (auto r = service_->settle(pending, now)) return *r;
     pump();
     // Woken by the Ack itself (a millisecond or two on a working link, so
     // 'drive' + 'wait T' stays close to T of motion); the console's status
     // line and events are pumped at least every ack_pump_period_s meanwhile.
-    const double left_s = static_cast<double>(deadline - now) * 1e-9;
-    if (!clock_->waitSignal(std::min(left_s, options_.ack_pump_period_s), arrived, seen)) return std::nullopt;
+    const double left_s = static_cast<double>(pending.deadline_ns - now) * 1e-9;
+    if (!clock_->waitSignal(std::min(left_s, options_.ack_pump_period_s), arrived, seen))
+      return *service_->settle(pending, std::max(now, pending.deadline_ns));  // the server stops
   }
+}
+
+bool Console::report(const Issued& issued, bool runs) {
+  if (const auto* p = std::get_if<PendingCall>(&issued); p && !p->control_note.empty()) out_ << p->control_note << "\n";
+  const CallResult r = std::holds_alternative<CallResult>(issued) ? std::get<CallResult>(issued)
+                                                                  : await(std::get<PendingCall>(issued));
+  if (r.outcome == CallOutcome::kInvalid) return fail(r.action, r.reason);
+  out_ << r.text() << "\n";
+  if (!r.ok()) {
+    ++tally_.errors;
+    return false;
+  }
+  if (runs && r.outcome == CallOutcome::kAccepted) {
+    // One run per robot: a new one ends the previous (the robot does the same).
+    std::erase_if(runs_, [&](const Run& run) { return run.robot_id == r.robot; });
+    runs_.push_back({r.robot, r.command_id, r.action});
+  }
+  return true;
 }
 
 bool Console::cmdHelp(const Args& args, const std::string&, int) {

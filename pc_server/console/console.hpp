@@ -15,6 +15,7 @@
 #include "pc_server/link/command_sink.hpp"
 #include "pc_server/console/console_clock.hpp"
 #include "pc_server/operator/control_arbiter.hpp"
+#include "pc_server/operator/operator_service.hpp"
 #include "pc_server/operator/keyboard_teleop.hpp"
 #include "pc_server/link/robot_registry.hpp"
 #include "pc_server/app/stop_flag.hpp"
@@ -82,10 +83,7 @@ class Console {
   /// Makes this console a session of `arbiter`: its motion commands need the
   /// robot's control (taken on first use when free), `control` shows and
   /// changes it, and notes from other sessions print in background().
-  void setSession(ControlArbiter* arbiter, uint64_t session) {
-    control_ = arbiter;
-    session_ = session;
-  }
+  void setSession(ControlArbiter* arbiter, uint64_t session);
   uint64_t session() const { return session_; }
   /// Starts this console's event feed at the newest event: a session that
   /// attaches mid-run does not replay the registry's buffer (up to
@@ -110,6 +108,8 @@ class Console {
   /// The robot's status line with the video figures and the recording mark ("| REC <run-id>").
   std::string statusText(const std::string& robot) const;
   CommandSink& sink() { return sink_; }
+  /// The operator service this console's commands call (docs/console.md).
+  OperatorService& service() { return *service_; }
   /// Where the tuning host reads the robot and control configs and writes
   /// its sessions (defaults: config/robot.yaml, config/control.yaml, runs/tuning).
   void setTuningPaths(std::string robot_config, std::string control_config, std::string dir);
@@ -180,11 +180,13 @@ class Console {
   bool cmdControl(const Args& args, const std::string& rest, int line_no);
   /// Sends a Stop/EStop/Resume and reports its Ack.
   bool simpleCommand(const std::string& name, const Args& args, v1::Command cmd);
-  /// Sends `cmd` to the selected robot, waits for its Ack and prints the answer. With `runs`
-  /// (track, goto, route) the command's COMPLETED Ack is printed when it comes (background()).
+  /// Sends `cmd` to the selected robot through the service, waits for its Ack and prints the answer.
   bool sendAndReport(const std::string& name, v1::Command cmd, bool runs = false);
-  /// Waits up to ack_timeout_s for the Ack of `command_id`; nullopt when none came.
-  std::optional<v1::Ack> waitAck(const std::string& robot_id, uint64_t command_id);
+  /// A service call's result, waited for when pending, printed. With `runs` (track, goto,
+  /// route) the command's COMPLETED Ack is printed when it comes (background()).
+  bool report(const Issued& issued, bool runs = false);
+  /// The result of a pending call, pumping while it waits (timed out when the server stops).
+  CallResult await(const PendingCall& pending);
   /// Sleeps up to `seconds` while pumping; false if the server is stopping.
   bool sleepPumping(double seconds);
   /// Now on this console's clock, in seconds (for elapsed times).
@@ -209,6 +211,7 @@ class Console {
   std::string selected_;
   uint64_t event_cursor_ = 0;
   ControlArbiter* control_ = nullptr;
+  std::optional<OperatorService> service_;
   uint64_t session_ = 0;  // this session's place in the registry's event feed (from the start for the first)
   bool quit_ = false;
   Tally tally_;

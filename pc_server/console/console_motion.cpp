@@ -18,37 +18,29 @@ namespace inspect::server {
 bool Console::cmdDrive(const Args& args, const std::string&, int) {
   if (!options_.allow_drive)
     return fail("drive", "not from a Foxglove session: publish geometry_msgs/Twist on /<robot>/cmd_vel (the Teleop "
-                         "panel; a set-point lapses 0.5 s after the last, docs/foxglove.md)");
+                         "panel; a set-point lapses foxglove.teleop_timeout_s after the last, docs/foxglove.md)");
   if (args.size() != 2) return fail("drive", "needs two numbers: drive <v_m_s> <w_rad_s>");
   const auto v = parseNumber(args[0]);
   if (!v) return fail("drive", "'" + args[0] + "' is not a number");
   const auto w = parseNumber(args[1]);
   if (!w) return fail("drive", "'" + args[1] + "' is not a number");
-  if (std::fabs(*v) > options_.max_v_m_s)
-    return fail("drive", "v " + args[0] + " m/s is outside [-" + fmtShort(options_.max_v_m_s) + ", " +
-                             fmtShort(options_.max_v_m_s) + "]");
-  if (std::fabs(*w) > options_.max_w_rad_s)
-    return fail("drive", "w " + args[1] + " rad/s is outside [-" + fmtShort(options_.max_w_rad_s) + ", " +
-                             fmtShort(options_.max_w_rad_s) + "]");
-  const auto robot = connectedRobot("drive");
-  if (!robot || !mayMove(*robot, "drive")) return false;
-  const uint64_t id = sink_.setTeleop(*robot, *v, *w, 0.0);  // held until stop (docs/failsafes.md)
-  if (id == 0) return fail("drive", *robot + " is not connected");
   const std::string what = "drive " + fmtSigned(*v) + " m/s " + fmtSigned(*w) + " rad/s";
-  const auto ack = waitAck(*robot, id);
-  if (!ack) {
-    sink_.clearTeleop(*robot);
-    out_ << *robot << ": " << what << ": no ack within " << fmtShort(options_.ack_timeout_s) << " s (set-point cleared)\n";
+  // Held until stop (lease 0, docs/failsafes.md): a typed `drive` is meant to last.
+  const Issued issued = service_->teleop(session_, selected_, *v, *w, 0.0, clock_->nowNs());
+  if (const auto* done = std::get_if<CallResult>(&issued)) return report(*done);
+  const auto& pending = std::get<PendingCall>(issued);
+  if (!pending.control_note.empty()) out_ << pending.control_note << "\n";
+  const CallResult r = await(pending);
+  if (!r.ok()) {
+    service_->clearTeleop(r.robot);
     ++tally_.errors;
+    if (r.outcome == CallOutcome::kTimedOut)
+      out_ << r.robot << ": " << what << ": no ack within " << fmtShort(r.ack_timeout_s) << " s (set-point cleared)\n";
+    else
+      out_ << r.robot << ": " << what << " rejected: " << r.reason << "\n";
     return false;
   }
-  if (ack->status() == v1::Ack::REJECTED) {
-    sink_.clearTeleop(*robot);
-    out_ << *robot << ": " << what << " rejected: " << ack->reason() << "\n";
-    ++tally_.errors;
-    return false;
-  }
-  out_ << *robot << ": " << what << " accepted (re-sent until stop)\n";
+  out_ << r.robot << ": " << what << " accepted (re-sent until stop)\n";
   return true;
 }
 
@@ -72,6 +64,10 @@ bool Console::simpleCommand(const std::string& name, const Args& args, v1::Comma
   return sendAndReport(name, std::move(cmd));
 }
 
+bool Console::sendAndReport(const std::string& name, v1::Command cmd, bool runs) {
+  return report(service_->send(session_, selected_, name, std::move(cmd), clock_->nowNs()), runs);
+}
+
 bool Console::cmdTrack(const Args& args, const std::string&, int) {
   static const char* kSyntax =
       "syntax: track circle <radius_m> [speed_m_s] [laps] [controller] | track line <length_m> [speed_m_s] [controller]";
@@ -87,28 +83,21 @@ bool Console::cmdTrack(const Args& args, const std::string&, int) {
       return fail("track", "'" + args[i] + "' is neither a number nor a controller (fuzzy_pid, pid, direct)");
     }
   }
-  v1::Command c;
-  auto* t = c.mutable_track();
-  t->set_controller(controller);
-  const double speed = nums.size() > 1 ? nums[1] : 0.5;
-  if (!(speed > 0) || speed > 1.0) return fail("track", "speed " + fmtShort(speed) + " m/s is outside (0, 1]");
+  TrackRequest t;
+  t.controller = controller;
+  t.speed_m_s = nums.size() > 1 ? nums[1] : 0.5;
   if (args[0] == "circle") {
     if (nums.empty() || nums.size() > 3) return fail("track", kSyntax);
-    if (std::abs(nums[0]) < 0.1 || std::abs(nums[0]) > 100) return fail("track", "radius must be 0.1 to 100 m (negative turns right)");
-    const double laps = nums.size() > 2 ? nums[2] : 1.0;
-    if (!(laps > 0) || laps > 100) return fail("track", "laps must be in (0, 100]");
-    t->mutable_circle()->set_radius_m(nums[0]);
-    t->mutable_circle()->set_speed_m_s(speed);
-    t->mutable_circle()->set_laps(laps);
+    t.shape = TrackRequest::Shape::kCircle;
+    t.laps = nums.size() > 2 ? nums[2] : 1.0;
   } else if (args[0] == "line") {
     if (nums.empty() || nums.size() > 2) return fail("track", kSyntax);
-    if (!(nums[0] > 0) || nums[0] > 1000) return fail("track", "length must be in (0, 1000] m");
-    t->mutable_line()->set_length_m(nums[0]);
-    t->mutable_line()->set_speed_m_s(speed);
+    t.shape = TrackRequest::Shape::kLine;
   } else {
     return fail("track", "unknown path '" + args[0] + "' (circle or line)");
   }
-  return sendAndReport("track", std::move(c), true);
+  t.size_m = nums[0];
+  return report(service_->track(session_, selected_, t, clock_->nowNs()), true);
 }
 
 bool Console::cmdGoto(const Args& args, const std::string&, int) {
@@ -119,16 +108,8 @@ bool Console::cmdGoto(const Args& args, const std::string&, int) {
     if (!v) return fail("goto", "'" + a + "' is not a number");
     nums.push_back(*v);
   }
-  if (std::fabs(nums[0]) > 1000 || std::fabs(nums[1]) > 1000) return fail("goto", "x and y must be in [-1000, 1000] m");
-  if (nums.size() > 2 && (!(nums[2] > 0) || nums[2] > kMaxRouteSpeed_m_s))
-    return fail("goto", "speed " + args[2] + " m/s is outside (0, " + fmtShort(kMaxRouteSpeed_m_s) + "]");
-  v1::Command c;
-  auto* g = c.mutable_go_to();
-  auto* p = g->add_points();
-  p->set_x_m(nums[0]);
-  p->set_y_m(nums[1]);
-  if (nums.size() > 2) g->set_speed_m_s(nums[2]);
-  return sendAndReport("goto", std::move(c), true);
+  const std::optional<double> speed = nums.size() > 2 ? std::optional<double>(nums[2]) : std::nullopt;
+  return report(service_->goTo(session_, selected_, nums[0], nums[1], speed, clock_->nowNs()), true);
 }
 
 bool Console::cmdRoute(const Args& args, const std::string&, int) {
@@ -155,45 +136,6 @@ bool Console::cmdRoute(const Args& args, const std::string&, int) {
   out_ << "route '" << r.name << "': " << r.points.size() << " points"
        << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string()) << "\n";
   return sendAndReport("route", std::move(c), true);
-}
-
-bool Console::sendAndReport(const std::string& name, v1::Command cmd, bool runs) {
-  const auto robot = connectedRobot(name);
-  if (!robot) return false;
-  // Everything but stop, e-stop and the camera stream's settings moves the robot or its mount.
-  const bool motion = !cmd.has_stop() && !cmd.has_estop() && !cmd.has_video();
-  if (motion && !mayMove(*robot, name)) return false;
-  const uint64_t id = sink_.sendCommand(*robot, std::move(cmd));
-  if (id == 0) return fail(name, *robot + " is not connected");
-  const auto ack = waitAck(*robot, id);
-  if (!ack) {
-    out_ << *robot << ": " << name << ": no ack within " << fmtShort(options_.ack_timeout_s) << " s\n";
-    ++tally_.errors;
-    return false;
-  }
-  switch (ack->status()) {
-    case v1::Ack::ACCEPTED:
-      out_ << *robot << ": " << name << " accepted\n";
-      if (runs) {
-        // One run per robot: a new one ends the previous (the robot does the same).
-        std::erase_if(runs_, [&](const Run& r) { return r.robot_id == *robot; });
-        runs_.push_back({*robot, id, name});
-      }
-      return true;
-    case v1::Ack::COMPLETED: out_ << *robot << ": " << name << " completed\n"; return true;
-    case v1::Ack::FAILED:
-      out_ << *robot << ": " << name << " failed: " << ack->reason() << "\n";
-      ++tally_.errors;
-      return false;
-    case v1::Ack::REJECTED:
-      out_ << *robot << ": " << name << " rejected: " << ack->reason() << "\n";
-      ++tally_.errors;
-      return false;
-    default:
-      out_ << *robot << ": " << name << ": ack with an unknown status " << ack->status() << "\n";
-      ++tally_.errors;
-      return false;
-  }
 }
 
 bool Console::cmdStop(const Args& args, const std::string&, int) {
@@ -226,12 +168,11 @@ bool Console::cmdVideo(const Args& args, const std::string&, int) {
     out_ << videoReport(*robot, registry_.snapshot(*robot, clock_->nowNs()), video_);
     return true;
   }
-  v1::Command c;
-  auto* v = c.mutable_video();
+  using W = VideoRequest::What;
+  VideoRequest v;
   if ((what == "on" || what == "off" || what == "keyframe") && args.size() == 1) {
-    if (what == "keyframe") v->set_keyframe(true);
-    else v->set_enabled(what == "on");
-    return sendAndReport("video " + what, std::move(c));
+    v.what = what == "on" ? W::kOn : what == "off" ? W::kOff : W::kKeyframe;
+    return report(service_->video(session_, selected_, v, clock_->nowNs()));
   }
   if (what != "res" && what != "fps" && what != "bitrate" && what != "on" && what != "off" && what != "keyframe")
     return fail("video", "unknown '" + what + "'; " + kSyntax);
@@ -240,39 +181,38 @@ bool Console::cmdVideo(const Args& args, const std::string&, int) {
     const auto x = args[1].find('x');
     const auto w = x == std::string::npos ? std::nullopt : parseInteger(args[1].substr(0, x));
     const auto h = x == std::string::npos ? std::nullopt : parseInteger(args[1].substr(x + 1));
-    if (!w || !h || *w < 64 || *h < 64 || *w > 4096 || *h > 4096 || *w % 2 || *h % 2)
-      return fail("video", "res '" + args[1] + "': want <W>x<H>, even, 64 to 4096 (e.g. 1280x720)");
-    v->set_width(static_cast<uint32_t>(*w));
-    v->set_height(static_cast<uint32_t>(*h));
+    if (!w || !h) return fail("video", "res '" + args[1] + "': want <W>x<H>, even, 64 to 4096 (e.g. 1280x720)");
+    v.what = W::kRes;
+    v.width = *w;
+    v.height = *h;
   } else if (what == "fps") {
     const auto f = parseNumber(args[1]);
-    if (!f || !(*f >= 1 && *f <= 120)) return fail("video", "fps '" + args[1] + "': want 1 to 120");
-    v->set_fps(*f);
+    if (!f) return fail("video", "fps '" + args[1] + "': want 1 to 120");
+    v.what = W::kFps;
+    v.fps = *f;
   } else if (what == "bitrate") {
     const auto b = parseInteger(args[1]);
-    if (!b || *b < 50 || *b > 50000) return fail("video", "bitrate '" + args[1] + "': want 50 to 50000 kbit/s");
-    v->set_bitrate_kbps(static_cast<uint32_t>(*b));
+    if (!b) return fail("video", "bitrate '" + args[1] + "': want 50 to 50000 kbit/s");
+    v.what = W::kBitrate;
+    v.bitrate_kbps = *b;
   } else {
     return fail("video", "unknown '" + what + "'; " + kSyntax);
   }
-  return sendAndReport("video " + what, std::move(c));
+  return report(service_->video(session_, selected_, v, clock_->nowNs()));
 }
 
 bool Console::cmdPtz(const Args& args, const std::string&, int) {
-  v1::Command c;
-  auto* p = c.mutable_ptz();
+  PtzRequest p;
   if (args.size() == 1 && args[0] == "home") {
-    p->set_home(true);
-    return sendAndReport("ptz", std::move(c));
+    p.home = true;
+    return report(service_->ptz(session_, selected_, p, clock_->nowNs()));
   }
   const auto pan = args.size() == 2 ? parseNumber(args[0]) : std::nullopt;
   const auto tilt = args.size() == 2 ? parseNumber(args[1]) : std::nullopt;
   if (!pan || !tilt) return fail("ptz", "syntax: ptz <pan_deg> <tilt_deg> | ptz home");
-  if (std::abs(*pan) > 180 || std::abs(*tilt) > 90)
-    return fail("ptz", "pan must be within [-180, 180] and tilt within [-90, 90] degrees");
-  p->set_pan_rad(*pan * M_PI / 180.0);
-  p->set_tilt_rad(*tilt * M_PI / 180.0);
-  return sendAndReport("ptz", std::move(c));
+  p.pan_deg = *pan;
+  p.tilt_deg = *tilt;
+  return report(service_->ptz(session_, selected_, p, clock_->nowNs()));
 }
 
 bool Console::cmdFoxglove(const Args& args, const std::string&, int) {

@@ -401,20 +401,22 @@ bool Console::pushGains(const std::string& robot, const control::GainSet& g, con
   TuningState* ts = tuning("gains");
   if (!ts) return false;
   if (const std::string why = control::validateGains(g); !why.empty()) return fail("gains", "not pushed: " + why);
-  if (!mayMove(robot, "gains push")) return false;
   v1::Command c;
   auto* u = c.mutable_gains();
   net::toProto(g, *u->mutable_gains());
   u->set_source(source);
   if (ts->fis_imported) u->set_fis(fuzzy::formatFis(ts->fis));
-  const uint64_t id = sink_.sendCommand(robot, std::move(c));
-  if (id == 0) return fail("gains", robot + " is not connected");
-  const auto ack = waitAck(robot, id);
-  if (!ack) {
+  const Issued issued = service_->send(session_, robot, "gains push", std::move(c), clock_->nowNs());
+  if (const auto* done = std::get_if<CallResult>(&issued)) return report(*done);
+  const auto& pending = std::get<PendingCall>(issued);
+  if (!pending.control_note.empty()) out_ << pending.control_note << "\n";
+  const CallResult r = await(pending);
+  if (r.outcome == CallOutcome::kTimedOut) {
     ++tally_.errors;
-    out_ << robot << ": gains push: no ack within " << fmtShort(options_.ack_timeout_s) << " s\n";
+    out_ << r.text() << "\n";
     return false;
   }
+  const v1::Ack* ack = &r.ack;
   const bool ok = ack->status() == v1::Ack::ACCEPTED;
   if (ok) {
     out_ << robot << ": gains v" << ack->gains_version() << " accepted (" << ack->reason() << ")\n";

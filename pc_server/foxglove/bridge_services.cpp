@@ -74,8 +74,8 @@ bool flag(const Json& j, const char* key) {
 
 const std::vector<ServiceDef>& serviceDefs() {
   static const std::vector<ServiceDef> defs{
-      {"/stop", "inspect/Stop", schema(""), "zero the robot's set-point (always allowed)"},
-      {"/estop", "inspect/EStop", schema(""), "emergency stop, latched until /resume (always allowed)"},
+      {"/stop", "inspect/Stop", schema(""), "zero the robot's set-point (always allowed)", true},
+      {"/estop", "inspect/EStop", schema(""), "emergency stop, latched until /resume (always allowed)", true},
       {"/resume", "inspect/Resume", schema(""), "clear a latched e-stop or failsafe (needs control)"},
       {"/goto", "inspect/GoTo",
        schema(R"("x": {"type": "number"}, "y": {"type": "number"}, "speed": {"type": "number", "description": "m/s, optional"})",
@@ -112,6 +112,7 @@ Service toService(const ServiceDef& d) {
   s.type = d.type;
   s.request_schema = d.request_schema;
   s.response_schema = responseSchema();
+  s.urgent = d.urgent;
   return s;
 }
 
@@ -129,33 +130,40 @@ ServiceRequest parseServiceRequest(const std::string& service, std::string_view 
   }
   try {
     r.robot = word(j, "robot", false);
-    const auto speed = [&] {
+    using Call = ServiceRequest::Call;
+    const auto speed = [&]() -> std::optional<double> {
       const double v = number(j, "speed", false);
-      return std::isnan(v) ? std::string() : " " + util::shortest(v);
+      return std::isnan(v) ? std::nullopt : std::optional<double>(v);
+    };
+    const auto speedWord = [&] {
+      const auto v = speed();
+      return v ? " " + util::shortest(*v) : std::string();
     };
     if (service == "/stop") {
-      r.line = "stop";
-      r.immediate = true;
+      r.call = Call::kStop;
     } else if (service == "/estop") {
-      r.line = "estop";
-      r.immediate = true;
+      r.call = Call::kEstop;
     } else if (service == "/resume") {
-      r.line = "resume";
+      r.call = Call::kResume;
     } else if (service == "/goto") {
-      r.line = "goto " + util::shortest(number(j, "x", true)) + " " + util::shortest(number(j, "y", true)) + speed();
+      r.call = Call::kGoto;
+      r.x_m = number(j, "x", true);
+      r.y_m = number(j, "y", true);
+      r.speed_m_s = speed();
     } else if (service == "/route") {
       r.line = "route " + word(j, "route", true);
     } else if (service == "/inspect") {
-      r.line = "inspect " + word(j, "route", true) + speed();
+      r.line = "inspect " + word(j, "route", true) + speedWord();
     } else if (service == "/record_start") {
       const std::string name = text(j, "name");
       r.line = "record start" + (name.empty() ? std::string() : " " + name);
     } else if (service == "/record_stop") {
       r.line = "record stop";
     } else if (service == "/control_take") {
-      r.line = flag(j, "force") ? "control take force" : "control take";
+      r.call = Call::kControlTake;
+      r.force = flag(j, "force");
     } else if (service == "/control_release") {
-      r.line = "control release";
+      r.call = Call::kControlRelease;
     } else if (service == "/console") {
       const auto it = j.find("command");
       if (it == j.end() || !it->is_string()) throw Bad{"missing \"command\" (a string)"};

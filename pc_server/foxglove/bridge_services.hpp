@@ -1,8 +1,11 @@
 #pragma once
 // The services a Foxglove client may call (docs/foxglove.md, "Services"):
-// each is a console command with JSON arguments, run in the client's own
-// operator session with the console's rules (control, limits, acks). Pure:
-// JSON in, the console line out.
+// JSON arguments decoded into a typed call of the operator service (stop,
+// e-stop, resume, go to, control), run in the client's own operator session
+// with the same rules as the console (control, limits, acks); the rest
+// (route, inspect, record, console) as a console line of that session. Pure:
+// JSON in, the call out.
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,6 +19,7 @@ struct ServiceDef {
   std::string type;            // e.g. "inspect/GoTo"
   std::string request_schema;  // JSON Schema
   std::string summary;
+  bool urgent = false;         // stop, e-stop: never refused for the rate, never queued
 };
 /// Every service, in the order advertised; all answer {"ok": bool, "message": string}.
 const std::vector<ServiceDef>& serviceDefs();
@@ -24,14 +28,21 @@ const std::string& responseSchema();
 /// The advertised form of a definition (id left 0).
 Service toService(const ServiceDef& d);
 
-/// A request turned into what the session runs: an optional robot to select
-/// first, then one console line; or what was wrong with the request.
+/// A request turned into what the session runs: a typed call of the operator
+/// service, or (kConsoleLine) one console line after selecting `robot`; or
+/// what was wrong with the request.
 struct ServiceRequest {
+  enum class Call { kConsoleLine, kStop, kEstop, kResume, kGoto, kControlTake, kControlRelease };
+  Call call = Call::kConsoleLine;
   std::string robot;  // "" = the session's selected robot
-  std::string line;   // e.g. "goto 1.5 2 0.3"
-  bool immediate = false;  // stop and e-stop: sent at once, never queued behind another call
+  double x_m = 0.0, y_m = 0.0;         // kGoto
+  std::optional<double> speed_m_s;     // kGoto
+  bool force = false;                  // kControlTake
+  std::string line;   // kConsoleLine: e.g. "route lab_loop"
   std::string error;
   bool ok() const { return error.empty(); }
+  /// Stop and e-stop: sent at once, never queued behind another call.
+  bool urgent() const { return call == Call::kStop || call == Call::kEstop; }
 };
 ServiceRequest parseServiceRequest(const std::string& service, std::string_view json);
 

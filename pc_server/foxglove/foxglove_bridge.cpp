@@ -22,6 +22,8 @@ using SteadyClock = std::chrono::steady_clock;
 namespace {
 constexpr const char* kTag = "foxglove";
 constexpr auto kDeadmanPeriod = std::chrono::milliseconds(50);
+// A service call waiting for its robot's Ack looks again this often (an Ack takes 1-2 ms on a working link).
+constexpr auto kCallPollPeriod = std::chrono::milliseconds(5);
 constexpr auto kRefusalDebounce = std::chrono::seconds(1);
 }  // namespace
 
@@ -37,7 +39,9 @@ FoxgloveBridge::FoxgloveBridge(asio::io_context& ioc, Options options, RobotRegi
                                Console::Options console_options, ClientOperator::Configure configure)
     : ioc_(ioc), options_(std::move(options)), registry_(registry), sink_(sink), control_(control), maps_(maps),
       geometry_(geometry), console_options_(console_options), configure_(std::move(configure)),
-      server_(ioc, options_.server, *this), tick_timer_(ioc), deadman_timer_(ioc) {
+      server_(ioc, options_.server, *this), tick_timer_(ioc), deadman_timer_(ioc),
+      service_(registry, sink, &control,
+               OperatorService::Options{console_options.ack_timeout_s, options_.max_v_m_s, options_.max_w_rad_s}) {
   for (const auto& d : serviceDefs()) service_ids_[d.name] = server_.addService(toService(d));
 }
 
@@ -57,6 +61,9 @@ void FoxgloveBridge::stop() {
     if (stopped_) return;
     stopped_ = true;
     clients.swap(clients_);
+    for (auto& weak : call_timers_)
+      if (const auto t = weak.lock()) t->cancel();  // their handlers then return without answering
+    call_timers_.clear();
   }
   // The timers see stopped_ at their next expiry and end their chains.
   server_.stop();
@@ -370,12 +377,6 @@ void FoxgloveBridge::teleop(uint64_t client, const std::string& topic_robot, std
     refuse(client, "teleop: not a geometry_msgs/Twist JSON ({\"linear\": {\"x\": v}, \"angular\": {\"z\": w}})");
     return;
   }
-  if (std::fabs(*v) > options_.max_v_m_s || std::fabs(*w) > options_.max_w_rad_s) {
-    refuse(client, "teleop: v " + util::fmtShort(*v) + " m/s, w " + util::fmtShort(*w) + " rad/s is outside +-" +
-                       util::fmtShort(options_.max_v_m_s) + " m/s, +-" + util::fmtShort(options_.max_w_rad_s) +
-                       " rad/s; set-point ignored");
-    return;
-  }
   const auto op = operatorOf(client);
   if (!op) return;
   std::string robot = topic_robot;
@@ -385,23 +386,21 @@ void FoxgloveBridge::teleop(uint64_t client, const std::string& topic_robot, std
     refuse(client, "teleop: no robot connected");
     return;
   }
-  const auto d = control_.authorizeMotion(robot, op->session(), monoNowNs());
-  if (!d.allowed) {
-    {
+  // The set-point lapses to zero in the robot's session teleop_timeout_s after
+  // this message unless the next one renews it (the deadman below only tells the client).
+  const Issued issued = service_.teleop(op->session(), robot, *v, *w, options_.teleop_timeout_s, monoNowNs());
+  if (const auto* r = std::get_if<CallResult>(&issued)) {
+    if (r->outcome == CallOutcome::kRefused) {
       // Another session holds the robot: this client drives nothing, its deadman has nothing to stop.
       std::lock_guard lk(mu_);
       if (const auto it = clients_.find(client); it != clients_.end() && it->second.teleop_robot == robot)
         it->second.teleop_robot.clear();
     }
-    refuse(client, "teleop refused: " + d.reason);
+    refuse(client, r->outcome == CallOutcome::kRefused ? "teleop refused: " + r->reason
+                                                       : "teleop: " + r->reason + "; set-point ignored");
     return;
   }
-  // The set-point lapses to zero in the robot's session teleop_timeout_s after
-  // this message unless the next one renews it (the deadman below only tells the client).
-  if (sink_.setTeleop(robot, *v, *w, options_.teleop_timeout_s) == 0) {
-    refuse(client, "teleop: " + robot + " is not connected");
-    return;
-  }
+  const bool taken_now = !std::get<PendingCall>(issued).control_note.empty();  // the Ack is not waited for
   std::string previous;
   {
     std::lock_guard lk(mu_);
@@ -412,7 +411,7 @@ void FoxgloveBridge::teleop(uint64_t client, const std::string& topic_robot, std
     it->second.last_teleop = SteadyClock::now();
   }
   if (!previous.empty() && previous != robot) stopRobot(previous);
-  if (d.taken_now) server_.status(client, StatusLevel::kInfo, robot + ": controlled by " + op->name());
+  if (taken_now) server_.status(client, StatusLevel::kInfo, robot + ": controlled by " + op->name());
 }
 
 void FoxgloveBridge::onServiceCall(uint64_t client, const Service& service, uint32_t call_id, std::string_view payload) {
@@ -423,27 +422,8 @@ void FoxgloveBridge::onServiceCall(uint64_t client, const Service& service, uint
   }
   const auto op = operatorOf(client);
   if (!op) return;
-  if (req.immediate) {
-    // Stop and e-stop never wait behind another call of the session, and need
-    // no control. Without a robot named: the one this client drives, else its selected one.
-    std::string robot = req.robot;
-    if (robot.empty()) {
-      std::lock_guard lk(mu_);
-      if (const auto it = clients_.find(client); it != clients_.end()) robot = it->second.teleop_robot;
-    }
-    if (robot.empty()) robot = op->selected();
-    if (robot.empty()) robot = registry_.firstConnected();
-    v1::Command c;
-    if (req.line == "estop") c.mutable_estop();
-    else c.mutable_stop();
-    const uint64_t id = robot.empty() ? 0 : sink_.sendCommand(robot, std::move(c));
-    if (id == 0) {
-      server_.respond(client, service.id, call_id,
-                      serviceResponse(false, robot.empty() ? "no robot connected" : robot + " is not connected"));
-      return;
-    }
-    server_.respond(client, service.id, call_id,
-                    serviceResponse(true, robot + ": " + req.line + " sent (command " + std::to_string(id) + ")"));
+  if (req.call != ServiceRequest::Call::kConsoleLine) {
+    callService(client, *op, service.id, call_id, req);
     return;
   }
   const uint32_t sid = service.id;
@@ -453,6 +433,68 @@ void FoxgloveBridge::onServiceCall(uint64_t client, const Service& service, uint
   if (!queued)
     server_.failCall(client, service.id, call_id,
                      "busy: " + std::to_string(ClientOperator::kMaxQueued) + " calls of this client are waiting");
+}
+
+void FoxgloveBridge::callService(uint64_t client, const ClientOperator& op, uint32_t service_id, uint32_t call_id,
+                                 const ServiceRequest& req) {
+  using Call = ServiceRequest::Call;
+  // The robot: the one named (remembered as the client's selection), else
+  // for a stop the one this client drives, else the last one it named, else
+  // its console session's selected one, else the first connected.
+  std::string robot = req.robot;
+  {
+    std::lock_guard lk(mu_);
+    const auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    if (!robot.empty()) it->second.selected = robot;
+    if (robot.empty() && req.urgent()) robot = it->second.teleop_robot;
+    if (robot.empty()) robot = it->second.selected;
+  }
+  if (robot.empty()) robot = op.selected();
+  if (robot.empty()) robot = registry_.firstConnected();
+  const uint64_t session = op.session();
+  const int64_t now = monoNowNs();
+  CallResult done;
+  switch (req.call) {
+    case Call::kControlTake: done = service_.takeControl(session, robot, req.force, now); break;
+    case Call::kControlRelease: done = service_.releaseControl(session, robot); break;
+    default: {
+      const Issued issued = req.call == Call::kStop    ? service_.stop(session, robot, now)
+                            : req.call == Call::kEstop ? service_.estop(session, robot, now)
+                            : req.call == Call::kResume
+                                ? service_.resume(session, robot, now)
+                                : service_.goTo(session, robot, req.x_m, req.y_m, req.speed_m_s, now);
+      if (const auto* p = std::get_if<PendingCall>(&issued)) {
+        awaitCall(client, service_id, call_id, *p);
+        return;
+      }
+      done = std::get<CallResult>(issued);
+    }
+  }
+  // Control take/release answer with the console's line ("robot1: controlled by ...").
+  const bool control = req.call == Call::kControlTake || req.call == Call::kControlRelease;
+  server_.respond(client, service_id, call_id,
+                  serviceResponse(done.ok(), control && done.ok() ? done.robot + ": " + done.reason : done.text()));
+}
+
+void FoxgloveBridge::awaitCall(uint64_t client, uint32_t service_id, uint32_t call_id, PendingCall pending) {
+  if (const auto r = service_.settle(pending, monoNowNs())) {
+    const std::string note = r->control_note.empty() ? "" : r->control_note + "\n";
+    server_.respond(client, service_id, call_id, serviceResponse(r->ok(), note + r->text()));
+    return;
+  }
+  auto timer = std::make_shared<asio::steady_timer>(ioc_, kCallPollPeriod);
+  {
+    std::lock_guard lk(mu_);
+    if (stopped_) return;
+    std::erase_if(call_timers_, [](const auto& w) { return w.expired(); });
+    call_timers_.push_back(timer);
+  }
+  timer->async_wait([this, timer, client, service_id, call_id, pending = std::move(pending)](
+                        const boost::system::error_code& ec) mutable {
+    if (ec) return;  // stop(): the bridge is going
+    awaitCall(client, service_id, call_id, std::move(pending));
+  });
 }
 
 std::string FoxgloveBridge::report() const {

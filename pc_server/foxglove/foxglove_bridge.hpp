@@ -20,6 +20,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "pc_server/console/console.hpp"
+#include "pc_server/foxglove/bridge_services.hpp"
 #include "pc_server/foxglove/client_operator.hpp"
 #include "pc_server/foxglove/ws_server.hpp"
 #include "pc_server/scene/camera_people.hpp"
@@ -92,6 +93,7 @@ class FoxgloveBridge : public WsServer::Handler {
     std::shared_ptr<ClientOperator> op;
     std::string peer;
     std::string teleop_robot;  // "" = not driving
+    std::string selected;      // the robot its last call named ("" = none yet: the console session's)
     std::chrono::steady_clock::time_point last_teleop{};
     std::chrono::steady_clock::time_point last_refusal{};
   };
@@ -109,6 +111,11 @@ class FoxgloveBridge : public WsServer::Handler {
   /// The client's operator session (null once it has gone).
   std::shared_ptr<ClientOperator> operatorOf(uint64_t client) const;
   void stopRobot(const std::string& robot);
+  /// A typed service call through the operator service; the answer is sent when it settles.
+  void callService(uint64_t client, const ClientOperator& op, uint32_t service_id, uint32_t call_id,
+                   const ServiceRequest& req);
+  /// Polls a pending call every kCallPollPeriod until the robot's Ack or the deadline; then answers.
+  void awaitCall(uint64_t client, uint32_t service_id, uint32_t call_id, PendingCall pending);
   /// Stops `robot` if `session` still holds its control; false (nothing sent) otherwise.
   bool stopIfHeld(const std::string& robot, uint64_t session);
 
@@ -123,6 +130,9 @@ class FoxgloveBridge : public WsServer::Handler {
   ClientOperator::Configure configure_;
   WsServer server_;
   boost::asio::steady_timer tick_timer_, deadman_timer_;
+  OperatorService service_;
+  /// Timers of calls waiting for an Ack (cancelled by stop()).
+  std::vector<std::weak_ptr<boost::asio::steady_timer>> call_timers_;
   std::map<std::string, uint32_t> service_ids_;  // name -> id
 
   mutable std::mutex mu_;

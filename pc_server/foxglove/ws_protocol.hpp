@@ -39,6 +39,7 @@ struct Service {
   std::string type;             // e.g. "inspect/Stop"
   std::string request_schema;   // JSON Schema text
   std::string response_schema;
+  bool urgent = false;          // never refused for the rate (stop, e-stop); not sent to clients
 };
 
 enum class StatusLevel { kInfo = 0, kWarning = 1, kError = 2 };

@@ -183,11 +183,11 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
   /// One message from the client (on the strand).
   void onMessage(bool text, std::string_view bytes) {
     const Parsed p = text ? parseClientText(bytes) : parseClientBinary(bytes);
-    // Stop and e-stop are never refused for the rate: a flood must not keep a robot moving.
+    // Urgent services (stop, e-stop) are never refused for the rate: a flood must not keep a robot moving.
     bool urgent = false;
     if (const auto* call = std::get_if<ServiceCallRequest>(&p.message); call && p.ok()) {
       Service sv;
-      urgent = server_.findService(call->service_id, sv) && (sv.name == "/stop" || sv.name == "/estop");
+      urgent = server_.findService(call->service_id, sv) && sv.urgent;
     }
     if (!urgent && !withinRate()) {
       if (const auto* call = std::get_if<ServiceCallRequest>(&p.message); call && p.ok())

@@ -359,11 +359,12 @@ async function main() {
   const bgoto = await b.call("/goto", { x: 1, y: 0 });
   check(!bgoto.ok && /control/.test(bgoto.message), `B's /goto without control: ${JSON.stringify(bgoto)}`);
   const bstop = await b.call("/stop", {});
-  check(bstop.ok, `B's /stop: ${JSON.stringify(bstop)}`);
+  // The operator service answers once the robot's Ack is in.
+  check(bstop.ok && /stop accepted/.test(bstop.message), `B's /stop: ${JSON.stringify(bstop)}`);
 
   // 5. E-stop and resume from the controlling client; then release.
   const estop = await a.call("/estop", {});
-  check(estop.ok, `/estop: ${JSON.stringify(estop)}`);
+  check(estop.ok && /estop accepted/.test(estop.message), `/estop: ${JSON.stringify(estop)}`);
   check(await until(() => a.mode() === MODE.ESTOP, 2000), "telemetry did not show ESTOP after /estop");
   const resume = await a.call("/resume", {});
   check(resume.ok, `/resume: ${JSON.stringify(resume)}`);

@@ -1,5 +1,6 @@
 // The bridge's services (pc_server/foxglove/bridge_services): JSON requests
-// become console lines; every bad argument is named.
+// become typed calls of the operator service or console lines; every bad
+// argument is named.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -21,21 +22,33 @@ TEST(BridgeServices, EveryServiceHasValidSchemas) {
   EXPECT_FALSE(nlohmann::json::parse(responseSchema(), nullptr, false).is_discarded());
 }
 
-TEST(BridgeServices, RequestsBecomeConsoleLines) {
+TEST(BridgeServices, RequestsBecomeTypedCallsOrConsoleLines) {
+  using Call = ServiceRequest::Call;
   auto r = parseServiceRequest("/goto", R"({"x": 1.5, "y": -2, "speed": 0.3, "robot": "robot2"})");
   ASSERT_TRUE(r.ok()) << r.error;
-  EXPECT_EQ(r.line, "goto 1.5 -2 0.3");
+  EXPECT_EQ(r.call, Call::kGoto);
+  EXPECT_DOUBLE_EQ(r.x_m, 1.5);
+  EXPECT_DOUBLE_EQ(r.y_m, -2);
+  EXPECT_EQ(r.speed_m_s, 0.3);
   EXPECT_EQ(r.robot, "robot2");
-  EXPECT_FALSE(r.immediate);
+  EXPECT_FALSE(r.urgent());
+  EXPECT_FALSE(parseServiceRequest("/goto", R"({"x": 1, "y": 2})").speed_m_s);
   r = parseServiceRequest("/stop", "");
   ASSERT_TRUE(r.ok());
-  EXPECT_EQ(r.line, "stop");
-  EXPECT_TRUE(r.immediate);
-  EXPECT_TRUE(parseServiceRequest("/estop", "{}").immediate);
+  EXPECT_EQ(r.call, Call::kStop);
+  EXPECT_TRUE(r.urgent());
+  EXPECT_TRUE(parseServiceRequest("/estop", "{}").urgent());
+  EXPECT_EQ(parseServiceRequest("/resume", "{}").call, Call::kResume);
   EXPECT_EQ(parseServiceRequest("/inspect", R"({"route": "gas_lab_inspection"})").line, "inspect gas_lab_inspection");
-  EXPECT_EQ(parseServiceRequest("/control_take", R"({"force": true})").line, "control take force");
+  const auto take = parseServiceRequest("/control_take", R"({"force": true})");
+  EXPECT_EQ(take.call, Call::kControlTake);
+  EXPECT_TRUE(take.force);
+  EXPECT_EQ(parseServiceRequest("/control_release", "{}").call, Call::kControlRelease);
   EXPECT_EQ(parseServiceRequest("/record_start", R"({"name": "night round B"})").line, "record start night round B");
+  EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status"})").call, Call::kConsoleLine);
   EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status"})").line, "status");
+  // The urgent flag travels with the advertised service (the server's rate limit skips them).
+  for (const auto& d : serviceDefs()) EXPECT_EQ(toService(d).urgent, d.name == "/stop" || d.name == "/estop") << d.name;
 }
 
 TEST(BridgeServices, NamesWhatIsWrong) {
