@@ -6,6 +6,7 @@
 #include "pc_server/console/console.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/recording/run_report.hpp"
+#include "pc_server/scene/topics.hpp"
 #include "pc_server/console/status_line.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "shared/record/csv_export.hpp"
@@ -33,25 +34,31 @@ RunLog readRunLog(const std::string& mcap_path) {
   RunLog log;
   auto reader = record::McapReader::open(mcap_path);
   uint64_t t0_us = 0;
+  // Topics by the topic table: a run's own names ("/robot1/telemetry") or an
+  // older run's ("/telemetry"); docs/recording.md "Topics".
+  using scene::TopicKind;
   reader.forEach([&](const record::McapMessageView& m) {
-    if (m.topic == "/telemetry") {
+    const auto topic = scene::parseTopic(m.topic);
+    if (!topic) return true;
+    if (topic->kind == TopicKind::kTelemetry) {
       v1::Telemetry t;
       if (t.ParseFromArray(m.data.data(), static_cast<int>(m.data.size()))) {
         if (log.telemetry.empty()) t0_us = t.robot_time_us();
         log.telemetry.push_back(std::move(t));
         log.telemetry_log_ns.push_back(m.log_time_ns);
       }
-    } else if (m.topic == "/event" || m.topic == "/server_event") {
+    } else if (topic->kind == TopicKind::kEvents || topic->kind == TopicKind::kServerEvents) {
+      const bool robots = topic->kind == TopicKind::kEvents;
       v1::Event e;
       if (e.ParseFromArray(m.data.data(), static_cast<int>(m.data.size()))) {
-        const double t = m.topic == "/event" && t0_us ? (static_cast<double>(e.robot_time_us()) - t0_us) * 1e-6
+        const double t = robots && t0_us ? (static_cast<double>(e.robot_time_us()) - t0_us) * 1e-6
                          : log.telemetry_log_ns.empty()
                              ? 0.0
                              : (static_cast<double>(m.log_time_ns) - static_cast<double>(log.telemetry_log_ns[0])) * 1e-9;
-        log.events.emplace_back(t, (m.topic == "/event" ? "" : "server: ") + e.text());
+        log.events.emplace_back(t, (robots ? "" : "server: ") + e.text());
         if (e.has_gas_alarm()) log.gas_alarms.emplace_back(t, e.gas_alarm());
       }
-    } else if (m.topic == "/robot_info" && !log.hello) {
+    } else if (topic->kind == TopicKind::kRobotInfo && !log.hello) {
       v1::Hello h;
       if (h.ParseFromArray(m.data.data(), static_cast<int>(m.data.size()))) log.hello = std::move(h);
     }
@@ -144,7 +151,7 @@ bool Console::cmdExport(const Args& args, const std::string&, int) {
   const auto& [d, dir] = *run;
   const std::string out_dir = args.size() == 3 ? args[2] : dir + "/csv";
   try {
-    const auto r = record::exportCsv(dir + "/run.mcap", out_dir);
+    const auto r = record::exportCsv(dir + "/run.mcap", out_dir, false, "/" + d.info.robot + "/");
     out_ << d.info.id << ": exported " << r.files.size() << " CSV files to " << out_dir << "\n";
     for (const auto& [topic, path] : r.files)
       out_ << "  " << path << " (" << (r.rows.count(topic) ? r.rows.at(topic) : 0) << " rows)\n";

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pc_server/foxglove/bridge_services.hpp"
+#include "pc_server/scene/topics.hpp"
 #include "shared/record/mcap_writer.hpp"
 #include "shared/util/base64.hpp"
 #include "shared/util/clock.hpp"
@@ -99,18 +100,23 @@ void FoxgloveBridge::publishMessage(uint32_t channel, uint64_t ns, const google:
 }
 
 void FoxgloveBridge::advertiseRobot(const std::string& robot, RobotState& r) {
-  const std::string p = "/" + robot + "/";
+  // The topic table's live topics (pc_server/scene/topics: the names the recorder writes too).
+  using scene::TopicKind;
   auto& c = r.ch;
-  c.telemetry = addChannel(p + "telemetry", v1::Telemetry::descriptor(), WsServer::Kind::kData);
-  c.events = addChannel(p + "events", v1::Event::descriptor(), WsServer::Kind::kData);
-  c.acks = addChannel(p + "acks", v1::Ack::descriptor(), WsServer::Kind::kData);
-  c.alarms = addChannel(p + "alarms", v1::GasAlarm::descriptor(), WsServer::Kind::kData);
-  c.camera = addChannel(p + "camera", ::foxglove::CompressedVideo::descriptor(), WsServer::Kind::kVideo);
-  c.camera_people = addChannel(p + "camera_people", ::foxglove::ImageAnnotations::descriptor(), WsServer::Kind::kData);
-  c.tf = addChannel(p + "tf", ::foxglove::FrameTransforms::descriptor(), WsServer::Kind::kData);
-  c.scene = addChannel(p + "scene", ::foxglove::SceneUpdate::descriptor(), WsServer::Kind::kData);
-  c.log = addChannel(p + "log", ::foxglove::Log::descriptor(), WsServer::Kind::kData);
-  c.video_stats = addChannel(p + "video_stats", v1::VideoStats::descriptor(), WsServer::Kind::kData);
+  const auto add = [&](TopicKind kind) {
+    const auto& d = scene::topicDef(kind);
+    return addChannel(scene::topicName(robot, kind), d.type(), d.video ? WsServer::Kind::kVideo : WsServer::Kind::kData);
+  };
+  c.telemetry = add(TopicKind::kTelemetry);
+  c.events = add(TopicKind::kEvents);
+  c.acks = add(TopicKind::kAcks);
+  c.alarms = add(TopicKind::kAlarms);
+  c.camera = add(TopicKind::kCamera);
+  c.camera_people = add(TopicKind::kCameraPeople);
+  c.tf = add(TopicKind::kTf);
+  c.scene = add(TopicKind::kScene);
+  c.log = add(TopicKind::kLog);
+  c.video_stats = add(TopicKind::kVideoStats);
   r.connected = true;
   log::info(kTag, robot, ": channels advertised");
 }
@@ -210,7 +216,9 @@ void FoxgloveBridge::tick() {
         r.last_grid = now;
         for (const auto& name : r.scene->gridChannels()) {
           auto& id = r.ch.grids[name];
-          if (id == 0) id = addChannel("/" + robot + "/gas/" + name, ::foxglove::Grid::descriptor(), WsServer::Kind::kData);
+          if (id == 0)
+            id = addChannel(scene::topicName(robot, scene::TopicKind::kGasGrid, name), ::foxglove::Grid::descriptor(),
+                            WsServer::Kind::kData);
           if (server_.subscribed(id))
             if (const auto g = r.scene->grid(name, ns)) publishMessage(id, ns, *g);
         }

@@ -8,6 +8,7 @@
 
 #include "foxglove/CompressedVideo.pb.h"
 #include "pc_server/scene/camera_people.hpp"
+#include "pc_server/scene/topics.hpp"
 #include "shared/record/mcap_writer.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
@@ -203,17 +204,22 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
   try {
     fs::create_directories(run->info.dir);
     run->mcap.open(run->info.dir + "/run.mcap");
-    run->ch_telemetry = run->mcap.addProtobufChannel(v1::Telemetry::descriptor(), "/telemetry");
-    run->ch_command = run->mcap.addProtobufChannel(v1::Command::descriptor(), "/command");
-    run->ch_ack = run->mcap.addProtobufChannel(v1::Ack::descriptor(), "/ack");
-    run->ch_event = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/event");
-    run->ch_server = run->mcap.addProtobufChannel(v1::Event::descriptor(), "/server_event");
-    run->ch_camera = run->mcap.addProtobufChannel(::foxglove::CompressedVideo::descriptor(), "/camera");
-    run->ch_camera_people = run->mcap.addProtobufChannel(::foxglove::ImageAnnotations::descriptor(), "/camera_people");
-    run->ch_info = run->mcap.addProtobufChannel(v1::Hello::descriptor(), "/robot_info");
-    run->ch_tf = run->mcap.addProtobufChannel(::foxglove::FrameTransforms::descriptor(), "/tf");
-    run->ch_scene = run->mcap.addProtobufChannel(::foxglove::SceneUpdate::descriptor(), "/scene");
-    run->ch_log = run->mcap.addProtobufChannel(::foxglove::Log::descriptor(), "/log");
+    // The topic table's recorded topics: the live view's names (pc_server/scene/topics).
+    using scene::TopicKind;
+    const auto add = [&](TopicKind kind) {
+      return run->mcap.addProtobufChannel(scene::topicDef(kind).type(), scene::topicName(robot, kind));
+    };
+    run->ch_telemetry = add(TopicKind::kTelemetry);
+    run->ch_command = add(TopicKind::kCommands);
+    run->ch_ack = add(TopicKind::kAcks);
+    run->ch_event = add(TopicKind::kEvents);
+    run->ch_server = add(TopicKind::kServerEvents);
+    run->ch_camera = add(TopicKind::kCamera);
+    run->ch_camera_people = add(TopicKind::kCameraPeople);
+    run->ch_info = add(TopicKind::kRobotInfo);
+    run->ch_tf = add(TopicKind::kTf);
+    run->ch_scene = add(TopicKind::kScene);
+    run->ch_log = add(TopicKind::kLog);
     run->scene = std::make_unique<scene::RobotScene>(robot, geometry_);
     video::Mp4Settings ms;
     ms.max_fragment_s = config_.max_fragment_s;
@@ -501,7 +507,9 @@ void Recorder::writeScene(Run& r, const std::string& robot, uint64_t ns, bool te
     r.last_grid_ns = ns;
     for (const auto& name : r.scene->gridChannels()) {
       auto& ch = r.ch_grid[name];
-      if (ch == 0) ch = r.mcap.addProtobufChannel(::foxglove::Grid::descriptor(), "/gas/" + name);
+      if (ch == 0)
+        ch = r.mcap.addProtobufChannel(::foxglove::Grid::descriptor(),
+                                       scene::topicName(r.info.robot, scene::TopicKind::kGasGrid, name));
       if (const auto g = r.scene->grid(name, ns)) r.mcap.write(ch, ns, ns, *g);
     }
   }

@@ -428,7 +428,9 @@ RunWheelData readRunWheelSeries(const std::string& mcap_path) {
   const std::string type = v1::Telemetry::descriptor()->full_name();
   for (const auto& [id, ch] : reader.channels()) {
     topics += (topics.empty() ? "" : ", ") + ch.topic;
-    if (ch.topic != "/telemetry") continue;
+    // "/<robot>/telemetry" (pc_server/scene/topics) or an older run's "/telemetry".
+    if (ch.topic != "/telemetry" && !(ch.topic.ends_with("/telemetry") && ch.topic.find('/', 1) == ch.topic.size() - 10))
+      continue;
     if (ch.message_encoding != "protobuf" || ch.schema_name != type)
       throw std::runtime_error(mcap_path + ": /telemetry is not " + type + " in protobuf (encoding '" +
                                ch.message_encoding + "', schema '" + ch.schema_name + "')");

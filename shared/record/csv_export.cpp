@@ -172,7 +172,9 @@ struct CsvFile {
   }
 };
 
-std::string fileBase(std::string_view topic) {
+std::string fileBase(std::string_view topic, std::string_view drop_prefix) {
+  if (!drop_prefix.empty() && topic.starts_with(drop_prefix) && topic.size() > drop_prefix.size())
+    topic.remove_prefix(drop_prefix.size());
   if (topic.starts_with('/')) topic.remove_prefix(1);
   std::string name(topic);
   std::ranges::replace(name, '/', '_');
@@ -191,7 +193,8 @@ bool drawing(const pb::Descriptor* d) {
 
 }  // namespace
 
-CsvExportResult exportCsv(const std::string& mcap_path, const std::string& out_dir, bool include_bytes) {
+CsvExportResult exportCsv(const std::string& mcap_path, const std::string& out_dir, bool include_bytes,
+                          std::string_view drop_prefix) {
   const McapReader reader = McapReader::open(mcap_path);
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
@@ -210,7 +213,7 @@ CsvExportResult exportCsv(const std::string& mcap_path, const std::string& out_d
   std::set<std::string> names;
   for (const auto& [id, ch] : reader.channels()) {
     if (drawing(reader.descriptor(id))) continue;
-    std::string base = fileBase(ch.topic);
+    std::string base = fileBase(ch.topic, drop_prefix);
     if (base.empty() || !names.insert(base).second) base += "_" + std::to_string(id);
     names.insert(base);
     CsvFile& out = files[id];

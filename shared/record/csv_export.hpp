@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 
 namespace inspect::record {
 
@@ -33,7 +34,9 @@ struct CsvExportResult {
 /// two channels would share a name, and then the key is "<topic>#<id>" for a
 /// topic seen twice). Creates `out_dir`. A file cut off (no footer) exports
 /// what McapReader reads of it. Throws std::runtime_error naming the file on
-/// read, decode or write errors.
-CsvExportResult exportCsv(const std::string& mcap_path, const std::string& out_dir, bool include_bytes = false);
+/// read, decode or write errors. A topic that starts with `drop_prefix` loses
+/// it first (a run of robot1: "/robot1/telemetry" -> telemetry.csv).
+CsvExportResult exportCsv(const std::string& mcap_path, const std::string& out_dir, bool include_bytes = false,
+                          std::string_view drop_prefix = "");
 
 }  // namespace inspect::record

@@ -73,7 +73,7 @@ std::vector<RecordedAlarm> mcapAlarms(const std::string& path) {
   std::vector<RecordedAlarm> out;
   auto r = record::McapReader::open(path);
   r.forEach([&](const record::McapMessageView& m) {
-    if (m.topic != "/event") return true;
+    if (!m.topic.ends_with("/events")) return true;  // "/<robot>/events", the robot's own
     v1::Event e;
     if (!e.ParseFromArray(m.data.data(), static_cast<int>(m.data.size()))) return true;
     if (e.kind() == v1::Event::ALARM_RAISED || e.kind() == v1::Event::ALARM_CLEARED)

@@ -20,9 +20,12 @@
 #include <filesystem>
 #include <map>
 #include <regex>
+#include <set>
 
 #include "shared/config/gas_config.hpp"
+#include "shared/record/mcap_reader.hpp"
 #include "shared/util/clock.hpp"
+#include "tests/support/paths.hpp"
 #include "tests/support/stack.hpp"
 
 using namespace inspect::test;
@@ -194,8 +197,27 @@ TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
     const std::regex re("\"" + topic + "\":([0-9]+)");
     return std::regex_search(counts, mm, re) ? std::stol(mm[1]) : 0L;
   };
-  for (const std::string topic : {"/tf", "/scene", "/log", "/gas/CH4", "/gas/H2S", "/telemetry", "/camera"})
+  for (const std::string topic : {"/robot1/tf", "/robot1/scene", "/robot1/log", "/robot1/gas/CH4", "/robot1/gas/H2S",
+                                  "/robot1/telemetry", "/robot1/camera"})
     EXPECT_GT(count(topic), 0) << topic << " missing from the run's MCAP: " << counts;
+  // The live layout opens the recording unchanged: every topic it names (but
+  // the Teleop panel's cmd_vel, which a client publishes) is a channel of the
+  // run, under the same name (pc_server/scene/topics; docs/recording.md).
+  {
+    const std::string layout = readFile(srcPath("config/foxglove/inspect_live.json"));
+    std::set<std::string> channels;
+    for (const auto& [id, ch] : inspect::record::McapReader::open(mcap).channels()) channels.insert(ch.topic);
+    const std::regex re_topic(R"re("(/robot1/[A-Za-z0-9_/]+))re");
+    int named = 0;
+    for (auto it = std::sregex_iterator(layout.begin(), layout.end(), re_topic); it != std::sregex_iterator(); ++it) {
+      const std::string topic = (*it)[1];
+      if (topic == "/robot1/cmd_vel") continue;
+      ++named;
+      EXPECT_TRUE(channels.count(topic)) << "config/foxglove/inspect_live.json names " << topic
+                                          << ", which the recording does not have";
+    }
+    EXPECT_GE(named, 8) << "the layout's topics were not found in it";
+  }
   long total = 0;
   const std::regex re_topic(R"("/[^"]+":([0-9]+))");
   for (auto it = std::sregex_iterator(counts.begin(), counts.end(), re_topic);

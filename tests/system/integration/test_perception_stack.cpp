@@ -102,7 +102,7 @@ TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAwa
   for (const auto& e : std::filesystem::directory_iterator(s.dir() / "runs", ec))
     if (e.is_directory() && std::filesystem::exists(e.path() / "run.mcap")) mcap = (e.path() / "run.mcap").string();
   ASSERT_FALSE(mcap.empty()) << out;
-  const std::string json = captureOutput(std::string("node ") + reader + " --decode --annotations /camera_people /camera " + mcap);
+  const std::string json = captureOutput(std::string("node ") + reader + " --decode --annotations /robot1/camera_people /robot1/camera " + mcap);
   ASSERT_TRUE(std::regex_search(json, m, std::regex(R"("messages":([0-9]+),"boxes":([0-9]+),"on_a_picture":([0-9]+))")))
       << json;
   const int messages = std::stoi(m[1]), boxes = std::stoi(m[2]), on_a_picture = std::stoi(m[3]);

@@ -179,7 +179,7 @@ std::vector<RecordedTelemetry> readTelemetry(const std::string& mcap_path) {
   const auto reader = record::McapReader::open(mcap_path);
   uint16_t channel = 0;
   for (const auto& [id, c] : reader.channels())
-    if (c.topic == "/telemetry") channel = id;
+    if (c.topic.ends_with("/telemetry")) channel = id;  // "/<robot>/telemetry" (older runs: "/telemetry")
   std::vector<RecordedTelemetry> out;
   if (channel == 0) return out;
   v1::Telemetry t;
