@@ -103,14 +103,196 @@ void writePortFile(const std::string& path, uint16_t port, const std::string& fl
     throw util::StartupError(flag + ": " + why);
 }
 
+namespace {
+
+ConsoleMode consoleModeOf(const CliOptions& options) {
+  if (options.no_console) return ConsoleMode::kNone;
+  if (options.script_path) return ConsoleMode::kScript;
+  if (options.interactive || ::isatty(0)) return ConsoleMode::kInteractive;
+  return ConsoleMode::kStream;
+}
+
+/// The robot's body and sensors for the 3-D scene, from robot.yaml beside the server's config (default: the paper's robot).
+scene::Geometry robotGeometry(const std::filesystem::path& robot_yaml) {
+  scene::Geometry geometry;
+  if (!std::filesystem::exists(robot_yaml)) return geometry;
+  try {
+    geometry = scene::geometryOf(config::loadRobotConfigFile(robot_yaml.string()));
+  } catch (const std::exception& e) {
+    log::warn(log::tag::kServer, "the 3-D scene draws the default robot: ", e.what());
+  }
+  return geometry;
+}
+
+/// The recorder, fed by every envelope of the link, with its sources of gains, Hello and scene.
+std::unique_ptr<Recorder> startRecorder(const ServerConfig& config, LinkServer& link, RobotRegistry& registry,
+                                        scene::SiteMaps& site_maps, const scene::Geometry& geometry) {
+  std::unique_ptr<Recorder> recorder;
+  try {
+    recorder = std::make_unique<Recorder>(config.recording, INSPECT_VERSION);
+  } catch (const std::exception& e) {
+    throw util::StartupError(std::string("recording: ") + e.what());
+  }
+  link.addEnvelopeObserver([rec = recorder.get()](const std::string& id, const std::string& address,
+                                                  const v1::Envelope& env, bool inbound, uint64_t time_us) {
+    rec->onEnvelope(id, address, env, inbound, time_us);
+  });
+  // The gain set the robot announced (Hello, GAINS_APPLIED events) with its
+  // version; else what its latest telemetry shows while tracking (the
+  // recorder adds the controller at the run's first tracking telemetry).
+  recorder->setGainsSource([&registry](const std::string& robot) {
+    const auto snap = registry.snapshot(robot, monoNowNs());
+    if (snap && snap->gains_known) return runGainsJson(snap->gains, snap->gains_version);
+    return snap && snap->has_telemetry ? gainsJson(snap->telemetry) : std::string("{}");
+  });
+  recorder->setHelloSource([&registry](const std::string& robot) -> std::optional<v1::Hello> {
+    const auto snap = registry.snapshot(robot, monoNowNs());
+    if (!snap) return std::nullopt;
+    return snap->hello;
+  });
+  recorder->setScene(&site_maps, geometry);
+  std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog.sqlite)";
+  if (!recorder->startupReport().empty()) std::cout << "; " << recorder->startupReport();
+  std::cout << std::endl;
+  return recorder;
+}
+
+/// The video hub: telemetry from the link (clock offsets), access units to the recorder and the bridge.
+std::unique_ptr<VideoHub> startVideo(const ServerConfig& config, const CliOptions& options, LinkServer& link,
+                                     Recorder* recorder, std::atomic<foxglove::FoxgloveBridge*>& bridge_ptr) {
+  auto video = std::make_unique<VideoHub>(config.video, config.bind_address, link);
+  link.addEnvelopeObserver([hub = video.get()](const std::string& id, const std::string& address,
+                                               const v1::Envelope& env, bool inbound, uint64_t time_us) {
+    if (inbound && env.has_telemetry()) hub->onTelemetry(id, address, env, time_us);
+  });
+  if (recorder) {
+    recorder->setVideoFigures([hub = video.get()](const std::string& robot) -> std::optional<VideoFigures> {
+      const auto st = hub->stats(robot);
+      if (!st) return std::nullopt;
+      return VideoFigures{static_cast<int64_t>(st->frames), static_cast<int64_t>(st->decoded),
+                          static_cast<int64_t>(st->lost_packets)};
+    });
+  }
+  // Every intact access unit goes to the run's recording and to the Foxglove clients, as received.
+  video->setAccessUnitHook([recorder, &bridge_ptr](const std::string& robot, const video::Frame& f, uint64_t capture_us) {
+    if (recorder) recorder->onAccessUnit(robot, f, capture_us);
+    if (auto* b = bridge_ptr.load()) b->onAccessUnit(robot, f, capture_us);
+  });
+  video->start();
+  std::cout << "pc_server: video on UDP port " << video->port() << ", SDP files in " << config.video.dir << "/"
+            << std::endl;
+  if (options.video_port_file) writePortFile(*options.video_port_file, video->port(), "--video-port-file");
+  return video;
+}
+
+/// The Foxglove bridge's options from foxglove: in server.yaml (the token read or made, wss's context).
+foxglove::FoxgloveBridge::Options bridgeOptions(const ServerConfig& config, const Console::Options& copt,
+                                                VideoHub* video) {
+  const auto& fc = config.foxglove;
+  foxglove::FoxgloveBridge::Options fo;
+  fo.server.bind = fc.bind;
+  fo.server.port = fc.port;
+  fo.server.name = config.server_id;
+  if (fc.auth == "token") fo.server.token = foxglove::loadOrCreateToken(fc.token_file);
+  fo.server.allowed_origins = fc.allowed_origins;
+  fo.server.max_clients = fc.max_clients;
+  if (fc.tls) {
+    try {
+      fo.server.tls = net::makeTlsContext({"", config.tls.cert, config.tls.key}, net::TlsRole::kWebServer);
+    } catch (const net::TlsError& e) {
+      throw util::StartupError(std::string("foxglove.tls: ") + e.what());
+    }
+  }
+  fo.scene_hz = fc.scene_hz;
+  fo.grid_hz = fc.grid_hz;
+  fo.teleop_timeout_s = fc.teleop_timeout_s;
+  fo.max_v_m_s = copt.max_v_m_s;
+  fo.max_w_rad_s = copt.max_w_rad_s;
+  if (video)
+    fo.video_stats = [video](const std::string& robot) -> std::optional<v1::VideoReceiveStats> {
+      const auto st = video->stats(robot);
+      return st ? std::optional(toProto(*st)) : std::nullopt;
+    };
+  return fo;
+}
+
+/// Prints where the bridge listens (and how to get in); writes its port file.
+void announceBridge(const ServerConfig& config, const CliOptions& options, uint16_t port) {
+  const auto& fc = config.foxglove;
+  const std::string url = std::string(fc.tls ? "wss" : "ws") + "://" + (fc.bind == "0.0.0.0" ? "<this-host>" : fc.bind) +
+                          ":" + std::to_string(port) + "/";
+  std::cout << "pc_server: Foxglove WebSocket on " << url
+            << (fc.auth == "token" ? "?token=<the token in " + fc.token_file + ">" : std::string(" (no token: loopback only)"))
+            << std::endl;
+  if (options.foxglove_port_file) writePortFile(*options.foxglove_port_file, port, "--foxglove-port-file");
+}
+
+/// SIGINT and SIGTERM: stop the server; a first SIGINT during a console job (tune) cancels only the job.
+void watchSignals(asio::signal_set& signals, StopFlag& stop) {
+  signals.async_wait([&signals, &stop](const boost::system::error_code& ec, int sig) {
+    if (ec) return;
+    if (sig == SIGINT && stop.interrupt()) {
+      // A console job (tune) takes Ctrl-C as "cancel, keep the best so far".
+      log::info(log::tag::kServer, "SIGINT: cancelling the running console job (Ctrl-C again to shut down)");
+      stop.setInterruptTarget(nullptr);
+      watchSignals(signals, stop);
+      return;
+    }
+    log::info(log::tag::kServer, "signal ", sig == SIGINT ? "SIGINT" : "SIGTERM", ": shutting down");
+    stop.request();
+  });
+}
+
+/// MCAP chunks of quiet recordings reach the disk within a second.
+void tickRecorder(asio::steady_timer& timer, Recorder& recorder) {
+  recorder.tick();
+  timer.expires_after(std::chrono::milliseconds(200));
+  timer.async_wait([&timer, &recorder](const boost::system::error_code& ec) {
+    if (!ec) tickRecorder(timer, recorder);
+  });
+}
+
+/// The server's own console (by its mode) and the attached ones, until the
+/// operator quits or the server is stopped; the exit status (1: the script or stream failed).
+int runConsoles(ConsoleMode mode, const std::vector<std::string>& script, const CliOptions& options,
+              const ServerConfig& config, RobotRegistry& registry, LinkServer& link, ControlArbiter& control,
+              const Console::Options& copt, const std::function<void(Console&)>& configure, StopFlag& stop) {
+  int status = 0;
+  Console console(registry, link, std::cout, stop, copt);
+  configure(console);
+  console.setSession(&control, control.openSession(localUserName() + "@console"));
+  std::unique_ptr<OperatorSocket> operators;
+  if (!config.operator_socket.empty()) {
+    operators = std::make_unique<OperatorSocket>(config.operator_socket, registry, link, control, copt, configure);
+    operators->start();
+    std::cout << "pc_server: operator consoles: pc_server --attach " << config.operator_socket << std::endl;
+  }
+  console.setAlarmStyle(::isatty(STDOUT_FILENO) == 1);  // red + bell on a terminal, plain text into pipes
+  ConsoleRunner runner(console, stop, config.status_refresh_hz);
+  switch (mode) {
+    case ConsoleMode::kNone:
+      stop.wait();
+      break;
+    case ConsoleMode::kScript:
+      status = runner.runScript(script, *options.script_path) ? 0 : 1;
+      if (options.interactive && !stop.requested() && !console.quitRequested()) runner.runInteractive();
+      break;
+    case ConsoleMode::kInteractive:
+      runner.runInteractive();
+      break;
+    case ConsoleMode::kStream:
+      status = runner.runStream(0) ? 0 : 1;
+      break;
+  }
+  if (operators) operators->stop();
+  return status;
+}
+
+}  // namespace
+
 int runServer(const CliOptions& options) {
   const ServerConfig config = resolveConfig(options);
-
-  ConsoleMode mode = ConsoleMode::kNone;
-  if (options.no_console) mode = ConsoleMode::kNone;
-  else if (options.script_path) mode = ConsoleMode::kScript;
-  else if (options.interactive || ::isatty(0)) mode = ConsoleMode::kInteractive;
-  else mode = ConsoleMode::kStream;
+  const ConsoleMode mode = consoleModeOf(options);
   std::vector<std::string> script;
   if (options.script_path) script = readScriptFile(*options.script_path);
 
@@ -122,14 +304,7 @@ int runServer(const CliOptions& options) {
   const std::filesystem::path cfg_dir =
       options.config_path ? std::filesystem::path(*options.config_path).parent_path() : std::filesystem::path("config");
   const auto beside = [&](const char* name) { return (cfg_dir.empty() ? std::filesystem::path(".") : cfg_dir) / name; };
-  scene::Geometry geometry;
-  if (std::filesystem::exists(beside("robot.yaml"))) {
-    try {
-      geometry = scene::geometryOf(config::loadRobotConfigFile(beside("robot.yaml").string()));
-    } catch (const std::exception& e) {
-      log::warn(log::tag::kServer, "the 3-D scene draws the default robot: ", e.what());
-    }
-  }
+  const scene::Geometry geometry = robotGeometry(beside("robot.yaml"));
   scene::SiteMaps site_maps;
   site_maps.setDefault(config.site_map);
 
@@ -155,61 +330,9 @@ int runServer(const CliOptions& options) {
   if (options.port_file) writePortFile(*options.port_file, endpoint.port(), "--port-file");
 
   std::unique_ptr<Recorder> recorder;
-  if (config.recording.enabled) {
-    try {
-      recorder = std::make_unique<Recorder>(config.recording, INSPECT_VERSION);
-    } catch (const std::exception& e) {
-      throw util::StartupError(std::string("recording: ") + e.what());
-    }
-    link.addEnvelopeObserver([rec = recorder.get()](const std::string& id, const std::string& address,
-                                                    const v1::Envelope& env, bool inbound, uint64_t time_us) {
-      rec->onEnvelope(id, address, env, inbound, time_us);
-    });
-    // The gain set the robot announced (Hello, GAINS_APPLIED events) with its
-    // version; else what its latest telemetry shows while tracking (the
-    // recorder adds the controller at the run's first tracking telemetry).
-    recorder->setGainsSource([&registry](const std::string& robot) {
-      const auto snap = registry.snapshot(robot, monoNowNs());
-      if (snap && snap->gains_known) return runGainsJson(snap->gains, snap->gains_version);
-      return snap && snap->has_telemetry ? gainsJson(snap->telemetry) : std::string("{}");
-    });
-    recorder->setHelloSource([&registry](const std::string& robot) -> std::optional<v1::Hello> {
-      const auto snap = registry.snapshot(robot, monoNowNs());
-      if (!snap) return std::nullopt;
-      return snap->hello;
-    });
-    recorder->setScene(&site_maps, geometry);
-    std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog.sqlite)";
-    if (!recorder->startupReport().empty()) std::cout << "; " << recorder->startupReport();
-    std::cout << std::endl;
-  }
-
+  if (config.recording.enabled) recorder = startRecorder(config, link, registry, site_maps, geometry);
   std::unique_ptr<VideoHub> video;
-  if (config.video.enabled) {
-    video = std::make_unique<VideoHub>(config.video, config.bind_address, link);
-    link.addEnvelopeObserver([hub = video.get()](const std::string& id, const std::string& address,
-                                                 const v1::Envelope& env, bool inbound, uint64_t time_us) {
-      if (inbound && env.has_telemetry()) hub->onTelemetry(id, address, env, time_us);
-    });
-    if (recorder) {
-      recorder->setVideoFigures([hub = video.get()](const std::string& robot) -> std::optional<VideoFigures> {
-        const auto st = hub->stats(robot);
-        if (!st) return std::nullopt;
-        return VideoFigures{static_cast<int64_t>(st->frames), static_cast<int64_t>(st->decoded),
-                            static_cast<int64_t>(st->lost_packets)};
-      });
-    }
-    // Every intact access unit goes to the run's recording and to the Foxglove clients, as received.
-    video->setAccessUnitHook([rec = recorder.get(), &bridge_ptr](const std::string& robot, const video::Frame& f,
-                                                                 uint64_t capture_us) {
-      if (rec) rec->onAccessUnit(robot, f, capture_us);
-      if (auto* b = bridge_ptr.load()) b->onAccessUnit(robot, f, capture_us);
-    });
-    video->start();
-    std::cout << "pc_server: video on UDP port " << video->port() << ", SDP files in " << config.video.dir << "/"
-              << std::endl;
-    if (options.video_port_file) writePortFile(*options.video_port_file, video->port(), "--video-port-file");
-  }
+  if (config.video.enabled) video = startVideo(config, options, link, recorder.get(), bridge_ptr);
 
   Console::Options copt;
   // Every console (this one, those attached to the operator socket and each
@@ -225,106 +348,24 @@ int runServer(const CliOptions& options) {
   };
   std::unique_ptr<foxglove::FoxgloveBridge> bridge;
   if (config.foxglove.enabled) {
-    const auto& fc = config.foxglove;
-    foxglove::FoxgloveBridge::Options fo;
-    fo.server.bind = fc.bind;
-    fo.server.port = fc.port;
-    fo.server.name = config.server_id;
-    if (fc.auth == "token") fo.server.token = foxglove::loadOrCreateToken(fc.token_file);
-    fo.server.allowed_origins = fc.allowed_origins;
-    fo.server.max_clients = fc.max_clients;
-    if (fc.tls) {
-      try {
-        fo.server.tls = net::makeTlsContext({"", config.tls.cert, config.tls.key}, net::TlsRole::kWebServer);
-      } catch (const net::TlsError& e) {
-        throw util::StartupError(std::string("foxglove.tls: ") + e.what());
-      }
-    }
-    fo.scene_hz = fc.scene_hz;
-    fo.grid_hz = fc.grid_hz;
-    fo.teleop_timeout_s = fc.teleop_timeout_s;
-    fo.max_v_m_s = copt.max_v_m_s;
-    fo.max_w_rad_s = copt.max_w_rad_s;
-    if (video)
-      fo.video_stats = [hub = video.get()](const std::string& robot) -> std::optional<v1::VideoReceiveStats> {
-        const auto st = hub->stats(robot);
-        return st ? std::optional(toProto(*st)) : std::nullopt;
-      };
-    bridge = std::make_unique<foxglove::FoxgloveBridge>(ioc, fo, registry, link, control, site_maps, geometry, copt,
-                                                        configure);
+    bridge = std::make_unique<foxglove::FoxgloveBridge>(ioc, bridgeOptions(config, copt, video.get()), registry, link,
+                                                        control, site_maps, geometry, copt, configure);
     const auto ep = bridge->start();  // a failure here leaves no pointer to a destroyed bridge
     bridge_ptr = bridge.get();
-    const std::string url = std::string(fc.tls ? "wss" : "ws") + "://" + (fc.bind == "0.0.0.0" ? "<this-host>" : fc.bind) +
-                            ":" + std::to_string(ep.port()) + "/";
-    std::cout << "pc_server: Foxglove WebSocket on " << url
-              << (fc.auth == "token" ? "?token=<the token in " + fc.token_file + ">" : std::string(" (no token: loopback only)"))
-              << std::endl;
-    if (options.foxglove_port_file) writePortFile(*options.foxglove_port_file, ep.port(), "--foxglove-port-file");
+    announceBridge(config, options, ep.port());
   }
 
   StopFlag stop;
   asio::signal_set signals(ioc, SIGINT, SIGTERM);
-  std::function<void()> wait_signal = [&] {
-    signals.async_wait([&](const boost::system::error_code& ec, int sig) {
-      if (ec) return;
-      if (sig == SIGINT && stop.interrupt()) {
-        // A console job (tune) takes Ctrl-C as "cancel, keep the best so far".
-        log::info(log::tag::kServer, "SIGINT: cancelling the running console job (Ctrl-C again to shut down)");
-        stop.setInterruptTarget(nullptr);
-        wait_signal();
-        return;
-      }
-      log::info(log::tag::kServer, "signal ", sig == SIGINT ? "SIGINT" : "SIGTERM", ": shutting down");
-      stop.request();
-    });
-  };
-  wait_signal();
-
-  // MCAP chunks of quiet recordings reach the disk within a second.
+  watchSignals(signals, stop);
   asio::steady_timer record_timer(ioc);
-  std::function<void()> record_tick = [&] {
-    if (recorder) recorder->tick();
-    record_timer.expires_after(std::chrono::milliseconds(200));
-    record_timer.async_wait([&](const boost::system::error_code& ec) {
-      if (!ec) record_tick();
-    });
-  };
-  if (recorder) record_tick();
+  if (recorder) tickRecorder(record_timer, *recorder);
 
   auto work = asio::make_work_guard(ioc);
   IoThreads io{ioc, {}};
   for (int i = 0; i < kIoThreads; ++i) io.threads.emplace_back([&ioc] { ioc.run(); });
 
-  int status = 0;
-  {
-    Console console(registry, link, std::cout, stop, copt);
-    configure(console);
-    console.setSession(&control, control.openSession(localUserName() + "@console"));
-    std::unique_ptr<OperatorSocket> operators;
-    if (!config.operator_socket.empty()) {
-      operators = std::make_unique<OperatorSocket>(config.operator_socket, registry, link, control, copt, configure);
-      operators->start();
-      std::cout << "pc_server: operator consoles: pc_server --attach " << config.operator_socket << std::endl;
-    }
-    console.setAlarmStyle(::isatty(STDOUT_FILENO) == 1);  // red + bell on a terminal, plain text into pipes
-    ConsoleRunner runner(console, stop, config.status_refresh_hz);
-    switch (mode) {
-      case ConsoleMode::kNone:
-        stop.wait();
-        break;
-      case ConsoleMode::kScript:
-        status = runner.runScript(script, *options.script_path) ? 0 : 1;
-        if (options.interactive && !stop.requested() && !console.quitRequested()) runner.runInteractive();
-        break;
-      case ConsoleMode::kInteractive:
-        runner.runInteractive();
-        break;
-      case ConsoleMode::kStream:
-        status = runner.runStream(0) ? 0 : 1;
-        break;
-    }
-    if (operators) operators->stop();
-  }
+  const int status = runConsoles(mode, script, options, config, registry, link, control, copt, configure, stop);
   std::cout.flush();
   if (bridge) bridge->stop();
 
@@ -341,7 +382,6 @@ int runServer(const CliOptions& options) {
   // IoThreads' destructor joins the io threads before the recorder (declared
   // earlier) ends the runs still open.
   return status;  // io stops and joins the threads
-
 }
 
 }  // namespace inspect::server
