@@ -22,6 +22,13 @@
 #include "shared/catalog/catalog.hpp"
 #include "shared/control/gain_set.hpp"
 
+namespace inspect::tuning {
+struct TuneSetup;
+struct TuneResult;
+struct Comparison;
+class Tuner;
+}  // namespace inspect::tuning
+
 namespace inspect::server {
 
 class VideoHub;
@@ -29,6 +36,7 @@ class Recorder;
 namespace scene {
 class SiteMaps;
 }
+struct KeyValueOption;
 
 class Console {
  public:
@@ -159,6 +167,19 @@ class Console {
   bool cmdTune(const Args& args, const std::string& rest, int line_no);
   bool cmdGains(const Args& args, const std::string& rest, int line_no);
   struct TuningState;
+  /// `tune list`: the tuning sessions in the catalog, newest first.
+  bool cmdTuneList();
+  /// tune's key=value options, each setting its part of `s`, the plant's
+  /// description or the start gains (parsed by applyKeyValues).
+  std::vector<KeyValueOption> tuneOptions(TuningState& ts, tuning::TuneSetup& s, std::string& plant_source,
+                                          std::string& start);
+  /// Runs the optimiser from `start` with its progress line (Ctrl-C cancels); nullopt (printed why) on failure.
+  std::optional<tuning::TuneResult> runTuner(tuning::Tuner& tuner, const control::GainSet& start);
+  /// Writes the session's files under the tuning directory and books it in the
+  /// catalog; the session's id, or nullopt (printed why).
+  std::optional<std::string> saveTuneSession(const tuning::TuneSetup& setup, const tuning::TuneResult& result,
+                                             const tuning::Comparison& cmp, const std::string& params,
+                                             const std::string& robot);
   /// The tuning host's state, loaded on first use; prints why (as `cmd`) and returns null on failure.
   TuningState* tuning(const std::string& cmd);
   /// Sends gains to a robot, reports its Ack and books the push in the catalog.

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "pc_server/console/console.hpp"
+#include "pc_server/console/key_value_options.hpp"
 #include "pc_server/console/tuning_state.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/console/text_util.hpp"
@@ -147,24 +148,191 @@ bool Console::cmdIdentify(const Args& args, const std::string&, int) {
 
 // ---------------------------------------------------------------------- tune
 
-bool Console::cmdTune(const Args& args, const std::string&, int) {
-  if (args.size() == 1 && args[0] == "list") {
-    // The tuning sessions in the catalog, newest first.
-    if (!recorder_) return fail("tune", "the server records nothing (--no-record): no catalog of sessions");
-    const auto list = recorder_->catalog().listTuningSessions(20);
-    if (list.empty()) {
-      out_ << "no tuning sessions in the catalog\n";
-      return true;
-    }
-    for (const auto& t : list) {
-      char line[512];
-      std::snprintf(line, sizeof line, "%-34s %-8s %-36s %5lld evals %7.1f s  cost %.4g -> %.4g%s  %s\n", t.id.c_str(),
-                    t.robot.empty() ? "-" : t.robot.c_str(), t.reference.c_str(), static_cast<long long>(t.evals),
-                    t.wall_s, t.initial_cost, t.best_cost, t.cancelled ? " (cancelled)" : "", t.dir.c_str());
-      out_ << line;
-    }
+bool Console::cmdTuneList() {
+  // The tuning sessions in the catalog, newest first.
+  // The tuning sessions in the catalog, newest first.
+  if (!recorder_) return fail("tune", "the server records nothing (--no-record): no catalog of sessions");
+  const auto list = recorder_->catalog().listTuningSessions(20);
+  if (list.empty()) {
+    out_ << "no tuning sessions in the catalog\n";
     return true;
   }
+  for (const auto& t : list) {
+    char line[512];
+    std::snprintf(line, sizeof line, "%-34s %-8s %-36s %5lld evals %7.1f s  cost %.4g -> %.4g%s  %s\n", t.id.c_str(),
+                  t.robot.empty() ? "-" : t.robot.c_str(), t.reference.c_str(), static_cast<long long>(t.evals),
+                  t.wall_s, t.initial_cost, t.best_cost, t.cancelled ? " (cancelled)" : "", t.dir.c_str());
+    out_ << line;
+  }
+  return true;
+}
+
+std::vector<KeyValueOption> Console::tuneOptions(TuningState& ts, tuning::TuneSetup& s, std::string& plant_source,
+                                                 std::string& start) {
+  using Kind = KeyValueOption::Kind;
+  const auto number = [](std::string key, double lo, double hi, std::function<void(double)> set) {
+    return KeyValueOption{std::move(key), Kind::kNumber, lo, hi, {}, [set](double x, const std::string&) {
+                            set(x);
+                            return std::string();
+                          }};
+  };
+  const auto count = [&](std::string key, double lo, double hi, int& field) {
+    return number(std::move(key), lo, hi, [&field](double x) { field = static_cast<int>(x); });
+  };
+  return {
+      {"ref", Kind::kWord, 0, 0, {"circle", "line", "waypoints"},
+       [&s](double, const std::string& v) {
+         using K = tuning::TuneReference::Kind;
+         s.reference.kind = v == "circle" ? K::kCircle : v == "line" ? K::kLine : K::kWaypoints;
+         return std::string();
+       }},
+      number("radius", 0.5, 50.0, [&s](double x) { s.reference.radius_m = x; }),
+      number("speed", 0.05, ts.robot.limits.max_v_m_s, [&s](double x) { s.reference.speed_m_s = x; }),
+      number("laps", 0.1, 10.0, [&s](double x) { s.reference.laps = x; }),
+      number("length", 1.0, 100.0, [&s](double x) { s.reference.length_m = x; }),
+      count("evals", 10, 100000, s.max_evals),
+      count("variations", 1, 64, s.plant_variations),
+      count("seeds", 1, 64, s.seeds),
+      count("threads", 0, 64, s.threads),
+      number("seed", 0, 4294967295.0, [&s](double x) { s.seed = static_cast<uint32_t>(x); }),
+      {"params", Kind::kWord, 0, 0, {},
+       [&s](double, const std::string& v) {
+         s.params.clear();
+         if (v == "all") {
+           s.params.assign(control::kGainNames.begin(), control::kGainNames.end());
+           return std::string();
+         }
+         std::stringstream ss(v);
+         std::string p;
+         while (std::getline(ss, p, ',')) {
+           control::GainSet probe;
+           if (!control::gainByName(probe, p))
+             return "params: unknown gain '" + p + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3, or all)";
+           s.params.push_back(p);
+         }
+         return std::string();
+       }},
+      {"plant", Kind::kWord, 0, 0, {},
+       [this, &ts, &s, &plant_source](double, const std::string& v) -> std::string {
+         if (v == "current") return "";
+         if (v == "nominal") {
+           s.plant = sim::nominalPlant(ts.robot);
+           plant_source = "nominal (config/robot.yaml)";
+           return "";
+         }
+         try {
+           std::string path = v;
+           if (!fs::exists(path) && recorder_) {  // a run id: its identified plant
+             path = recorder_->config().dir + "/" + v + "/plant.yaml";
+             if (!fs::exists(path))
+               return "plant=" + v + ": no such file, and no run '" + v + "' with plant.yaml (identify it first)";
+           }
+           s.plant = tuning::loadPlantFile(path);
+           plant_source = "from " + path;
+           return "";
+         } catch (const std::exception& e) {
+           return std::string("plant=") + v + ": " + e.what();
+         }
+       }},
+      {"start", Kind::kWord, 0, 0, {"working", "paper", "tuned"},
+       [&ts, &start](double, const std::string& v) -> std::string {
+         if (v == "tuned" && !ts.tuned) return "start=tuned: nothing tuned yet";
+         start = v;
+         return "";
+       }},
+  };
+}
+
+std::optional<tuning::TuneResult> Console::runTuner(tuning::Tuner& tuner, const control::GainSet& start_gains) {
+  std::atomic<bool>& cancel = tune_.cancel;  // outlives the command: the signal handler may still hold it
+  cancel.store(false);
+  stop_.setInterruptTarget(&cancel);
+  const bool tty = alarm_style_;  // an interactive terminal: one redrawn progress line
+  int last_decile = -1;
+  const double t0 = nowS();
+  double last_draw_s = -1.0;
+  tuning::TuneResult result;
+  try {
+    result = tuner.run(
+        start_gains,
+        [&](const tuning::TuneProgress& p) {
+          if (stop_.requested()) cancel.store(true);
+          const double el = nowS() - t0;
+          const double frac = p.max_evals > 0 ? static_cast<double>(p.evals) / p.max_evals : 1.0;
+          const int decile = static_cast<int>(frac * 10.0);
+          char line[200];
+          std::string bar(20, '.');
+          for (int i = 0; i < static_cast<int>(frac * 20.0) && i < 20; ++i) bar[static_cast<std::size_t>(i)] = '#';
+          std::snprintf(line, sizeof line, "[%s] %4d/%d evals  best cost %.4g (start %.4g, %+.1f %%)  %s  %.1f s",
+                        bar.c_str(), p.evals, p.max_evals, p.best_cost, p.initial_cost,
+                        p.initial_cost > 0 ? 100.0 * (p.best_cost - p.initial_cost) / p.initial_cost : 0.0,
+                        p.phase.c_str(), el);
+          if (tty) {
+            if (el - last_draw_s >= 0.1 || p.evals == p.max_evals) {
+              out_ << "\r\x1b[K" << line << std::flush;
+              last_draw_s = el;
+            }
+          } else if (decile != last_decile) {
+            out_ << "  " << line << "\n" << std::flush;
+            last_decile = decile;
+          }
+        },
+        &cancel);
+  } catch (const std::exception& e) {
+    stop_.setInterruptTarget(nullptr);
+    if (tty) out_ << "\n";
+    fail("tune", e.what());
+    return std::nullopt;
+  }
+  stop_.setInterruptTarget(nullptr);
+  if (tty) out_ << "\n";
+  return result;
+}
+
+std::optional<std::string> Console::saveTuneSession(const tuning::TuneSetup& setup, const tuning::TuneResult& result,
+                                                    const tuning::Comparison& cmp, const std::string& params,
+                                                    const std::string& robot) {
+  TuningState* ts = tune_.state.get();
+  std::string session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot);
+  for (int n = 2; fs::exists(tune_.dir + "/" + session) && n < 1000; ++n)  // two sessions in one second
+    session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot) + "-" + std::to_string(n);
+  const std::string dir = tune_.dir + "/" + session;
+  try {
+    const auto files = tuning::writeTuningSession(dir, setup, result, cmp, ts->fis);
+    for (const auto& n : files.notes) out_ << "  note: " << n << "\n";
+    out_ << "tune: session " << session << ": " << files.files.size() << " files in " << dir << "/\n";
+  } catch (const std::exception& e) {
+    fail("tune", "cannot write the session: " + std::string(e.what()));
+    return std::nullopt;
+  }
+  if (recorder_) {
+    catalog::TuningSession cs;
+    cs.id = session;
+    cs.created = std::chrono::system_clock::now();
+    cs.robot = robot;
+    cs.reference = setup.reference.describe();
+    cs.plant_json = tuning::plantJson(setup.plant);
+    cs.params = params;
+    cs.algorithm = result.algorithm;
+    cs.evals = result.evals;
+    cs.wall_s = result.wall_s;
+    cs.cancelled = result.cancelled;
+    cs.initial_cost = result.initial_eval.cost;
+    cs.best_cost = result.best_eval.cost;
+    cs.initial_gains_json = config::gainsJson(result.initial);
+    cs.best_gains_json = config::gainsJson(result.best);
+    cs.dir = dir;
+    try {
+      recorder_->catalog().addTuningSession(cs);
+    } catch (const std::exception& e) {
+      out_ << "tune: warning: session not in the catalog: " << e.what() << "\n";
+    }
+  }
+  return session;
+}
+
+bool Console::cmdTune(const Args& args, const std::string&, int) {
+  if (args.size() == 1 && args[0] == "list") return cmdTuneList();
   TuningState* ts = tuning("tune");
   if (!ts) return false;
   tuning::TuneSetup s;
@@ -174,97 +342,8 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
   s.plant = ts->plant;
   std::string plant_source = ts->plant_source;
   std::string start = "working";
-  for (const auto& a : args) {
-    std::string k, v;
-    if (!splitKeyValue(a, k, v)) return fail("tune", "'" + a + "' is not key=value (help tune)");
-    const auto num = parseNumber(v);
-    auto number = [&](double lo, double hi) -> std::optional<double> {
-      if (!num || !(*num >= lo && *num <= hi)) {
-        fail("tune", k + "=" + v + ": expected a number in [" + fmtShort(lo) + ", " + fmtShort(hi) + "]");
-        return std::nullopt;
-      }
-      return num;
-    };
-    if (k == "ref") {
-      if (v == "circle") s.reference.kind = tuning::TuneReference::Kind::kCircle;
-      else if (v == "line") s.reference.kind = tuning::TuneReference::Kind::kLine;
-      else if (v == "waypoints") s.reference.kind = tuning::TuneReference::Kind::kWaypoints;
-      else return fail("tune", "ref=" + v + ": expected circle, line or waypoints");
-    } else if (k == "radius") {
-      const auto x = number(0.5, 50.0);
-      if (!x) return false;
-      s.reference.radius_m = *x;
-    } else if (k == "speed") {
-      const auto x = number(0.05, ts->robot.limits.max_v_m_s);
-      if (!x) return false;
-      s.reference.speed_m_s = *x;
-    } else if (k == "laps") {
-      const auto x = number(0.1, 10.0);
-      if (!x) return false;
-      s.reference.laps = *x;
-    } else if (k == "length") {
-      const auto x = number(1.0, 100.0);
-      if (!x) return false;
-      s.reference.length_m = *x;
-    } else if (k == "evals") {
-      const auto x = number(10, 100000);
-      if (!x) return false;
-      s.max_evals = static_cast<int>(*x);
-    } else if (k == "variations") {
-      const auto x = number(1, 64);
-      if (!x) return false;
-      s.plant_variations = static_cast<int>(*x);
-    } else if (k == "seeds") {
-      const auto x = number(1, 64);
-      if (!x) return false;
-      s.seeds = static_cast<int>(*x);
-    } else if (k == "threads") {
-      const auto x = number(0, 64);
-      if (!x) return false;
-      s.threads = static_cast<int>(*x);
-    } else if (k == "seed") {
-      const auto x = number(0, 4294967295.0);
-      if (!x) return false;
-      s.seed = static_cast<uint32_t>(*x);
-    } else if (k == "params") {
-      s.params.clear();
-      if (v == "all") {
-        s.params.assign(control::kGainNames.begin(), control::kGainNames.end());
-      } else {
-        std::stringstream ss(v);
-        std::string p;
-        while (std::getline(ss, p, ',')) {
-          control::GainSet probe;
-          if (!control::gainByName(probe, p))
-            return fail("tune", "params: unknown gain '" + p + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3, or all)");
-          s.params.push_back(p);
-        }
-      }
-    } else if (k == "plant") {
-      if (v == "nominal") {
-        s.plant = sim::nominalPlant(ts->robot);
-        plant_source = "nominal (config/robot.yaml)";
-      } else if (v != "current") {
-        try {
-          std::string path = v;
-          if (!fs::exists(path) && recorder_) {  // a run id: its identified plant
-            path = recorder_->config().dir + "/" + v + "/plant.yaml";
-            if (!fs::exists(path)) return fail("tune", "plant=" + v + ": no such file, and no run '" + v + "' with plant.yaml (identify it first)");
-          }
-          s.plant = tuning::loadPlantFile(path);
-          plant_source = "from " + path;
-        } catch (const std::exception& e) {
-          return fail("tune", std::string("plant=") + v + ": " + e.what());
-        }
-      }
-    } else if (k == "start") {
-      if (v != "working" && v != "paper" && v != "tuned") return fail("tune", "start=" + v + ": expected working, paper or tuned");
-      if (v == "tuned" && !ts->tuned) return fail("tune", "start=tuned: nothing tuned yet");
-      start = v;
-    } else {
-      return fail("tune", "unknown option '" + k + "' (help tune)");
-    }
-  }
+  if (const std::string why = applyKeyValues(args, tuneOptions(*ts, s, plant_source, start), "tune"); !why.empty())
+    return fail("tune", why);
   const control::GainSet start_gains = start == "paper" ? ts->paper : start == "tuned" ? *ts->tuned : ts->working;
   // Each run's samples are held in memory: a reference longer than 5 minutes
   // (a slow, many-lap circle) would cost gigabytes and minutes per evaluation.
@@ -294,101 +373,30 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
        << setup.seeds << " noise seeds); Ctrl-C stops and keeps the best so far\n";
   out_.flush();
 
-  std::atomic<bool>& cancel = tune_.cancel;  // outlives the command: the signal handler may still hold it
-  cancel.store(false);
-  stop_.setInterruptTarget(&cancel);
-  const bool tty = alarm_style_;  // an interactive terminal: one redrawn progress line
-  int last_decile = -1;
-  const double t0 = nowS();
-  double last_draw_s = -1.0;
-  tuning::TuneResult result;
-  try {
-    result = tuner->run(
-        start_gains,
-        [&](const tuning::TuneProgress& p) {
-          if (stop_.requested()) cancel.store(true);
-          const double el = nowS() - t0;
-          const double frac = p.max_evals > 0 ? static_cast<double>(p.evals) / p.max_evals : 1.0;
-          const int decile = static_cast<int>(frac * 10.0);
-          char line[200];
-          std::string bar(20, '.');
-          for (int i = 0; i < static_cast<int>(frac * 20.0) && i < 20; ++i) bar[static_cast<std::size_t>(i)] = '#';
-          std::snprintf(line, sizeof line, "[%s] %4d/%d evals  best cost %.4g (start %.4g, %+.1f %%)  %s  %.1f s",
-                        bar.c_str(), p.evals, p.max_evals, p.best_cost, p.initial_cost,
-                        p.initial_cost > 0 ? 100.0 * (p.best_cost - p.initial_cost) / p.initial_cost : 0.0,
-                        p.phase.c_str(), el);
-          if (tty) {
-            if (el - last_draw_s >= 0.1 || p.evals == p.max_evals) {
-              out_ << "\r\x1b[K" << line << std::flush;
-              last_draw_s = el;
-            }
-          } else if (decile != last_decile) {
-            out_ << "  " << line << "\n" << std::flush;
-            last_decile = decile;
-          }
-        },
-        &cancel);
-  } catch (const std::exception& e) {
-    stop_.setInterruptTarget(nullptr);
-    if (tty) out_ << "\n";
-    return fail("tune", e.what());
-  }
-  stop_.setInterruptTarget(nullptr);
-  if (tty) out_ << "\n";
-  out_ << "tune: " << (result.cancelled ? "cancelled after " : "done: ") << result.evals << " evaluations in "
-       << fmtShort(result.wall_s, 3) << " s (" << result.algorithm << "); cost " << fmtShort(result.initial_eval.cost, 4)
-       << " -> " << fmtShort(result.best_eval.cost, 4) << "\n";
-  out_ << "  best: " << gainsText(result.best) << "\n";
+  const auto result = runTuner(*tuner, start_gains);
+  if (!result) return false;
+  out_ << "tune: " << (result->cancelled ? "cancelled after " : "done: ") << result->evals << " evaluations in "
+       << fmtShort(result->wall_s, 3) << " s (" << result->algorithm << "); cost " << fmtShort(result->initial_eval.cost, 4)
+       << " -> " << fmtShort(result->best_eval.cost, 4) << "\n";
+  out_ << "  best: " << gainsText(result->best) << "\n";
 
   // PID and fuzzy-PID with the paper's gains against the tuned set.
   tuning::Comparison cmp;
   try {
     cmp = tuning::compareControllers(*tuner, {{"PID (paper)", control::WheelControl::kPid, ts->paper},
                                               {"fuzzy-PID (paper)", control::WheelControl::kFuzzyPid, ts->paper},
-                                              {"fuzzy-PID (tuned)", control::WheelControl::kFuzzyPid, result.best}});
+                                              {"fuzzy-PID (tuned)", control::WheelControl::kFuzzyPid, result->best}});
   } catch (const std::exception& e) {
     return fail("tune", std::string("comparison: ") + e.what());
   }
   out_ << tuning::comparisonTable(cmp);
   const std::string robot = selected_;
-  std::string session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot);
-  for (int n = 2; fs::exists(tune_.dir + "/" + session) && n < 1000; ++n)  // two sessions in one second
-    session = sessionStamp() + "-tune" + (robot.empty() ? "" : "-" + robot) + "-" + std::to_string(n);
-  const std::string dir = tune_.dir + "/" + session;
-  try {
-    const auto files = tuning::writeTuningSession(dir, setup, result, cmp, ts->fis);
-    for (const auto& n : files.notes) out_ << "  note: " << n << "\n";
-    out_ << "tune: session " << session << ": " << files.files.size() << " files in " << dir << "/\n";
-  } catch (const std::exception& e) {
-    return fail("tune", "cannot write the session: " + std::string(e.what()));
-  }
-  if (recorder_) {
-    catalog::TuningSession cs;
-    cs.id = session;
-    cs.created = std::chrono::system_clock::now();
-    cs.robot = robot;
-    cs.reference = setup.reference.describe();
-    cs.plant_json = tuning::plantJson(setup.plant);
-    cs.params = params;
-    cs.algorithm = result.algorithm;
-    cs.evals = result.evals;
-    cs.wall_s = result.wall_s;
-    cs.cancelled = result.cancelled;
-    cs.initial_cost = result.initial_eval.cost;
-    cs.best_cost = result.best_eval.cost;
-    cs.initial_gains_json = config::gainsJson(result.initial);
-    cs.best_gains_json = config::gainsJson(result.best);
-    cs.dir = dir;
-    try {
-      recorder_->catalog().addTuningSession(cs);
-    } catch (const std::exception& e) {
-      out_ << "tune: warning: session not in the catalog: " << e.what() << "\n";
-    }
-  }
-  ts->tuned = result.best;
-  ts->tuned_session = session;
-  ts->working = result.best;
-  ts->last_session_dir = dir;
+  const auto session = saveTuneSession(setup, *result, cmp, params, robot);
+  if (!session) return false;
+  ts->tuned = result->best;
+  ts->tuned_session = *session;
+  ts->working = result->best;
+  ts->last_session_dir = tune_.dir + "/" + *session;
   out_ << "tune: the working gains are now the tuned set; `gains push` sends them to " << (robot.empty() ? "the selected robot" : robot)
        << "\n";
   return true;

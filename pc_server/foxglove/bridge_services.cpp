@@ -27,30 +27,30 @@ bool plainWord(const std::string& s) {
   return true;
 }
 
-struct Bad {
+struct BadRequest {
   std::string what;
 };
 
 double number(const Json& j, const char* key, bool required, double fallback = NAN) {
   const auto it = j.find(key);
   if (it == j.end() || it->is_null()) {
-    if (required) throw Bad{"missing \"" + std::string(key) + "\" (a number)"};
+    if (required) throw BadRequest{"missing \"" + std::string(key) + "\" (a number)"};
     return fallback;
   }
-  if (!it->is_number()) throw Bad{"\"" + std::string(key) + "\" must be a number"};
+  if (!it->is_number()) throw BadRequest{"\"" + std::string(key) + "\" must be a number"};
   const double v = it->get<double>();
-  if (!std::isfinite(v)) throw Bad{"\"" + std::string(key) + "\" must be finite"};
+  if (!std::isfinite(v)) throw BadRequest{"\"" + std::string(key) + "\" must be finite"};
   return v;
 }
 std::string word(const Json& j, const char* key, bool required) {
   const auto it = j.find(key);
   if (it == j.end() || it->is_null()) {
-    if (required) throw Bad{"missing \"" + std::string(key) + "\" (a string)"};
+    if (required) throw BadRequest{"missing \"" + std::string(key) + "\" (a string)"};
     return "";
   }
-  if (!it->is_string()) throw Bad{"\"" + std::string(key) + "\" must be a string"};
+  if (!it->is_string()) throw BadRequest{"\"" + std::string(key) + "\" must be a string"};
   const std::string s = it->get<std::string>();
-  if (!plainWord(s)) throw Bad{"\"" + std::string(key) + "\" must be one word (1-200 printable characters, no spaces or #)"};
+  if (!plainWord(s)) throw BadRequest{"\"" + std::string(key) + "\" must be one word (1-200 printable characters, no spaces or #)"};
   return s;
 }
 /// Words separated by single spaces (a run name): printable, no #.
@@ -60,13 +60,13 @@ std::string text(const Json& j, const char* key) {
   const std::string s = it->is_string() ? it->get<std::string>() : std::string("\x01");
   bool ok = !s.empty() && s.size() <= 200 && s.front() != ' ' && s.back() != ' ';
   for (const unsigned char c : s) ok = ok && c >= ' ' && c != 0x7f && c != '#';
-  if (!ok) throw Bad{"\"" + std::string(key) + "\" must be text of 1-200 printable characters without #"};
+  if (!ok) throw BadRequest{"\"" + std::string(key) + "\" must be text of 1-200 printable characters without #"};
   return s;
 }
 bool flag(const Json& j, const char* key) {
   const auto it = j.find(key);
   if (it == j.end() || it->is_null()) return false;
-  if (!it->is_boolean()) throw Bad{"\"" + std::string(key) + "\" must be true or false"};
+  if (!it->is_boolean()) throw BadRequest{"\"" + std::string(key) + "\" must be true or false"};
   return it->get<bool>();
 }
 
@@ -166,16 +166,16 @@ ServiceRequest parseServiceRequest(const std::string& service, std::string_view 
       r.call = Call::kControlRelease;
     } else if (service == "/console") {
       const auto it = j.find("command");
-      if (it == j.end() || !it->is_string()) throw Bad{"missing \"command\" (a string)"};
+      if (it == j.end() || !it->is_string()) throw BadRequest{"missing \"command\" (a string)"};
       std::string line = it->get<std::string>();
-      if (line.size() > 4096) throw Bad{"\"command\" is longer than 4096 characters"};
+      if (line.size() > 4096) throw BadRequest{"\"command\" is longer than 4096 characters"};
       for (const unsigned char c : line)
-        if (c < ' ' && c != '\t') throw Bad{"\"command\" must be one line without control characters"};
+        if (c < ' ' && c != '\t') throw BadRequest{"\"command\" must be one line without control characters"};
       r.line = std::move(line);
     } else {
-      throw Bad{"unknown service"};
+      throw BadRequest{"unknown service"};
     }
-  } catch (const Bad& b) {
+  } catch (const BadRequest& b) {
     r.error = service + ": " + b.what;
   }
   return r;
