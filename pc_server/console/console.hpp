@@ -167,6 +167,10 @@ class Console {
   bool cmdTune(const Args& args, const std::string& rest, int line_no);
   bool cmdGains(const Args& args, const std::string& rest, int line_no);
   struct TuningState;
+  /// `gains show [robot]`: working, the robot's, the paper's and the tuned set side by side.
+  bool gainsShow(const Args& args, TuningState& ts);
+  /// `gains set name=value ... | paper | tuned | robot`: the working set, checked.
+  bool gainsSet(const Args& args, TuningState& ts);
   /// `tune list`: the tuning sessions in the catalog, newest first.
   bool cmdTuneList();
   /// tune's key=value options, each setting its part of `s`, the plant's

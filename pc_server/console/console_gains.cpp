@@ -33,77 +33,81 @@
 
 namespace inspect::server {
 
+bool Console::gainsShow(const Args& args, TuningState& ts) {
+  if (args.size() > 2) return fail("gains", "syntax: gains show [robot]");
+  const std::string robot = args.size() == 2 ? args[1] : selected_;
+  std::optional<RobotSnapshot> snap;
+  if (!robot.empty()) snap = registry_.snapshot(robot, clock_->nowNs());
+  const bool have_robot = snap && snap->gains_known;
+  const control::GainSet rg = have_robot ? net::fromProto(snap->gains) : control::GainSet{};
+  char head[200];
+  std::snprintf(head, sizeof head, "%-6s %12s %12s %12s %12s\n", "gain", "working",
+                have_robot ? (robot + " v" + std::to_string(snap->gains_version)).c_str() : "robot", "paper",
+                ts.tuned ? "tuned" : "");
+  out_ << head;
+  for (const char* n : control::kGainNames) {
+    char row[200];
+    const std::string rv = have_robot ? fmtShort(control::gainValue(rg, n), 5) : std::string("--");
+    const std::string tv = ts.tuned ? fmtShort(control::gainValue(*ts.tuned, n), 5) : std::string();
+    std::snprintf(row, sizeof row, "%-6s %12s %12s %12s %12s\n", n, fmtShort(control::gainValue(ts.working, n), 5).c_str(),
+                  rv.c_str(), fmtShort(control::gainValue(ts.paper, n), 5).c_str(), tv.c_str());
+    out_ << row;
+  }
+  out_ << "fuzzy system: " << ts.fis.name << (ts.fis_imported ? " (imported; pushed with the gains)" : "")
+       << (have_robot && !snap->hello.fis_name().empty() ? "; robot's: " + snap->hello.fis_name() : std::string())
+       << "\n";
+  if (!have_robot && !robot.empty()) out_ << "(" << robot << " has not announced its gains)\n";
+  return true;
+}
+
+bool Console::gainsSet(const Args& args, TuningState& ts) {
+  if (args.size() < 2) return fail("gains", "syntax: gains set <name>=<value> ... | gains set paper|tuned|robot");
+  if (args.size() == 2 && (args[1] == "paper" || args[1] == "tuned" || args[1] == "robot")) {
+    if (args[1] == "paper") ts.working = ts.paper;
+    if (args[1] == "tuned") {
+      if (!ts.tuned) return fail("gains", "nothing tuned yet (tune)");
+      ts.working = *ts.tuned;
+    }
+    if (args[1] == "robot") {
+      const auto snap = selected_.empty() ? std::optional<RobotSnapshot>() : registry_.snapshot(selected_, clock_->nowNs());
+      if (!snap || !snap->gains_known) return fail("gains", "the selected robot has not announced its gains");
+      ts.working = net::fromProto(snap->gains);
+    }
+    out_ << "gains: working set = " << args[1] << ": " << gainsText(ts.working) << "\n";
+    return true;
+  }
+  control::GainSet next = ts.working;
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    std::string k, v;
+    if (!splitKeyValue(args[i], k, v)) {
+      // "gains set kp 12" form
+      if (args.size() == 3 && i == 1) {
+        k = args[1];
+        v = args[2];
+        i = 2;
+      } else {
+        return fail("gains", "'" + args[i] + "' is not name=value");
+      }
+    }
+    double* slot = control::gainByName(next, k);
+    if (!slot) return fail("gains", "unknown gain '" + k + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3)");
+    const auto x = parseNumber(v);
+    if (!x) return fail("gains", k + ": '" + v + "' is not a number");
+    *slot = *x;
+  }
+  if (const std::string why = control::validateGains(next); !why.empty()) return fail("gains", why + " (nothing changed)");
+  ts.working = next;
+  out_ << "gains: working set: " << gainsText(ts.working) << "\n";
+  return true;
+}
+
 bool Console::cmdGains(const Args& args, const std::string&, int) {
   if (args.empty()) return fail("gains", "syntax: gains show|set|push|revert|export|import ... (help gains)");
   TuningState* ts = tuning("gains");
   if (!ts) return false;
   const std::string& sub = args[0];
-  if (sub == "show") {
-    if (args.size() > 2) return fail("gains", "syntax: gains show [robot]");
-    const std::string robot = args.size() == 2 ? args[1] : selected_;
-    std::optional<RobotSnapshot> snap;
-    if (!robot.empty()) snap = registry_.snapshot(robot, clock_->nowNs());
-    const bool have_robot = snap && snap->gains_known;
-    const control::GainSet rg = have_robot ? net::fromProto(snap->gains) : control::GainSet{};
-    char head[200];
-    std::snprintf(head, sizeof head, "%-6s %12s %12s %12s %12s\n", "gain", "working",
-                  have_robot ? (robot + " v" + std::to_string(snap->gains_version)).c_str() : "robot", "paper",
-                  ts->tuned ? "tuned" : "");
-    out_ << head;
-    for (const char* n : control::kGainNames) {
-      char row[200];
-      const std::string rv = have_robot ? fmtShort(control::gainValue(rg, n), 5) : std::string("--");
-      const std::string tv = ts->tuned ? fmtShort(control::gainValue(*ts->tuned, n), 5) : std::string();
-      std::snprintf(row, sizeof row, "%-6s %12s %12s %12s %12s\n", n, fmtShort(control::gainValue(ts->working, n), 5).c_str(),
-                    rv.c_str(), fmtShort(control::gainValue(ts->paper, n), 5).c_str(), tv.c_str());
-      out_ << row;
-    }
-    out_ << "fuzzy system: " << ts->fis.name << (ts->fis_imported ? " (imported; pushed with the gains)" : "")
-         << (have_robot && !snap->hello.fis_name().empty() ? "; robot's: " + snap->hello.fis_name() : std::string())
-         << "\n";
-    if (!have_robot && !robot.empty()) out_ << "(" << robot << " has not announced its gains)\n";
-    return true;
-  }
-  if (sub == "set") {
-    if (args.size() < 2) return fail("gains", "syntax: gains set <name>=<value> ... | gains set paper|tuned|robot");
-    if (args.size() == 2 && (args[1] == "paper" || args[1] == "tuned" || args[1] == "robot")) {
-      if (args[1] == "paper") ts->working = ts->paper;
-      if (args[1] == "tuned") {
-        if (!ts->tuned) return fail("gains", "nothing tuned yet (tune)");
-        ts->working = *ts->tuned;
-      }
-      if (args[1] == "robot") {
-        const auto snap = selected_.empty() ? std::optional<RobotSnapshot>() : registry_.snapshot(selected_, clock_->nowNs());
-        if (!snap || !snap->gains_known) return fail("gains", "the selected robot has not announced its gains");
-        ts->working = net::fromProto(snap->gains);
-      }
-      out_ << "gains: working set = " << args[1] << ": " << gainsText(ts->working) << "\n";
-      return true;
-    }
-    control::GainSet next = ts->working;
-    for (std::size_t i = 1; i < args.size(); ++i) {
-      std::string k, v;
-      if (!splitKeyValue(args[i], k, v)) {
-        // "gains set kp 12" form
-        if (args.size() == 3 && i == 1) {
-          k = args[1];
-          v = args[2];
-          i = 2;
-        } else {
-          return fail("gains", "'" + args[i] + "' is not name=value");
-        }
-      }
-      double* slot = control::gainByName(next, k);
-      if (!slot) return fail("gains", "unknown gain '" + k + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3)");
-      const auto x = parseNumber(v);
-      if (!x) return fail("gains", k + ": '" + v + "' is not a number");
-      *slot = *x;
-    }
-    if (const std::string why = control::validateGains(next); !why.empty()) return fail("gains", why + " (nothing changed)");
-    ts->working = next;
-    out_ << "gains: working set: " << gainsText(ts->working) << "\n";
-    return true;
-  }
+  if (sub == "show") return gainsShow(args, *ts);
+  if (sub == "set") return gainsSet(args, *ts);
   if (sub == "push") {
     if (args.size() > 2) return fail("gains", "syntax: gains push [robot]");
     std::string robot;

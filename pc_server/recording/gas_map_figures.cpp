@@ -78,21 +78,16 @@ std::vector<char> behindWalls(const gas::ConcentrationMap& m, const std::vector<
   return hidden;
 }
 
-std::string gasMapScript(const std::string& png_path, const GasMapFigure& f) {
-  const Channel& ch = *f.channel;
-  const gas::ConcentrationMap& m = *f.map;
-  const gas::Bounds& b = m.bounds();
-  // Colour range: the map's values, stretched to the warning threshold so that
-  // readings below A1 never look alarming; falling channels run the other way.
-  auto [lo, hi] = m.valueRange();
-  if (ch.falling && std::isfinite(ch.alarm_low)) lo = std::min(lo, ch.alarm_low);
-  if (!ch.falling && std::isfinite(ch.alarm_low)) hi = std::max(hi, ch.alarm_low);
-  if (!std::isfinite(lo) || !std::isfinite(hi)) lo = 0.0, hi = 1.0;
-  if (!(hi - lo > 1e-9)) hi = lo + 1.0;
+// Alarm levels 1-3 (A1, A2, sensor fault): points, and darker for text on the map.
+constexpr const char* kLevelColor[] = {"#999999", "#ff9f1c", "#e00000", "#8e44ad"};
+constexpr const char* kLabelColor[] = {"#555555", "#8a4b00", "#a00000", "#5b2370"};
 
+/// The figure's data blocks: the map's cells as coloured pixels (hidden behind walls, faded
+/// where samples are few), the path, the walls and each alarm level's points.
+void writeMapData(std::ostringstream& g, const GasMapFigure& f, double lo, double hi) {
+  const gas::ConcentrationMap& m = *f.map;
+  const Channel& ch = *f.channel;
   const std::vector<char> hidden = behindWalls(m, f.path, f.walls);
-  std::ostringstream g;
-  g.precision(7);
   g << "$img << EOD\n";
   for (std::size_t r = 0; r < m.rows(); ++r) {
     for (std::size_t c = 0; c < m.cols(); ++c) {
@@ -116,8 +111,6 @@ std::string gasMapScript(const std::string& png_path, const GasMapFigure& f) {
   g << "EOD\n$walls << EOD\n";
   for (const auto& w : f.walls) g << num(w.a.x) << ' ' << num(w.a.y) << '\n' << num(w.b.x) << ' ' << num(w.b.y) << "\n\n";
   g << "EOD\n";
-  const char* level_color[] = {"#999999", "#ff9f1c", "#e00000", "#8e44ad"};
-  const char* label_color[] = {"#555555", "#8a4b00", "#a00000", "#5b2370"};  // darker: text on the map
   for (int lv = 1; lv <= 3; ++lv) {
     g << "$alarm" << lv << " << EOD\n";
     int labelled = 0;
@@ -131,6 +124,12 @@ std::string gasMapScript(const std::string& png_path, const GasMapFigure& f) {
     g << "EOD\n";
   }
 
+}
+
+/// The terminal, the title (channel, lag compensation, leak estimate), the axes and the colour bar.
+void writeMapAxes(std::ostringstream& g, const std::string& png_path, const GasMapFigure& f, double lo, double hi) {
+  const Channel& ch = *f.channel;
+  const gas::Bounds& b = f.map->bounds();
   const int width_px = 1000;
   const double aspect = (b.y_max_m - b.y_min_m) / (b.x_max_m - b.x_min_m);
   const int height_px = static_cast<int>(std::clamp(760.0 * aspect + 230.0, 480.0, 1400.0));
@@ -163,6 +162,23 @@ std::string gasMapScript(const std::string& png_path, const GasMapFigure& f) {
     if (std::isfinite(th) && th >= lo && th <= hi) g << "set cbtics add (" << plot::quote(std::string(name) + " " + gasValue(th)) << " " << num(th) << ")\n";
   g << "set colorbox user origin graph 1.02, graph 0 size character 2, graph 1\nset rmargin 14\n";
   g << "set object 1 rectangle from graph 0, graph 0 to graph 1, graph 1 behind fc rgb '#b0b0b0' fs pattern 5 noborder\n";
+}
+
+std::string gasMapScript(const std::string& png_path, const GasMapFigure& f) {
+  const Channel& ch = *f.channel;
+  const gas::ConcentrationMap& m = *f.map;
+  // Colour range: the map's values, stretched to the warning threshold so that
+  // readings below A1 never look alarming; falling channels run the other way.
+  auto [lo, hi] = m.valueRange();
+  if (ch.falling && std::isfinite(ch.alarm_low)) lo = std::min(lo, ch.alarm_low);
+  if (!ch.falling && std::isfinite(ch.alarm_low)) hi = std::max(hi, ch.alarm_low);
+  if (!std::isfinite(lo) || !std::isfinite(hi)) lo = 0.0, hi = 1.0;
+  if (!(hi - lo > 1e-9)) hi = lo + 1.0;
+
+  std::ostringstream g;
+  g.precision(7);
+  writeMapData(g, f, lo, hi);
+  writeMapAxes(g, png_path, f, lo, hi);
   int label = 1;
   auto text = [&](double x, double y, const std::string& t, const std::string& color, const std::string& place) {
     g << "set label " << label++ << " " << plot::quote(t) << " at " << num(x) << "," << num(y) << " " << place
@@ -203,10 +219,10 @@ std::string gasMapScript(const std::string& png_path, const GasMapFigure& f) {
     const bool any = std::any_of(f.alarms.begin(), f.alarms.end(),
                                  [&](const AlarmSpan* a) { return a->raise.level() == lv && std::isfinite(a->x); });
     if (!any) continue;
-    g << ", $alarm" << lv << " using 1:2 with points pt 7 ps 1.5 lc rgb '" << level_color[lv] << "' title "
+    g << ", $alarm" << lv << " using 1:2 with points pt 7 ps 1.5 lc rgb '" << kLevelColor[lv] << "' title "
       << plot::quote(level_title[lv]);
     g << ", $alarm" << lv << " using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' notitle";
-    g << ", $alarm" << lv << " using 1:2:3 with labels offset 0.8,0.8 left font ',8' tc rgb '" << label_color[lv]
+    g << ", $alarm" << lv << " using 1:2:3 with labels offset 0.8,0.8 left font ',8' tc rgb '" << kLabelColor[lv]
       << "' boxed notitle";
   }
   if (f.peak.valid)
