@@ -84,96 +84,114 @@ bool fileExists(const char* p) {
   std::exit(2);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  using namespace inspect;
-  std::string config_path = fileExists("config/client.yaml") ? "config/client.yaml" : "";
-  std::string robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
-  std::string control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
-  std::string behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
-  std::string serial_dev, server, id, cmd_log, map_path, video_source;
+/// The command line's choices (kUsage); unset ones leave the config files' values.
+struct CliArgs {
+  std::string config_path, robot_path, control_path, behavior_path;
+  std::string serial_dev, server, id, cmd_log, map_path, video_source, certs_dir;
   std::optional<int> video_port, realtime_priority;
   std::optional<std::string> journal;
-  std::optional<robot::GasReaction> gas_reaction;
+  std::optional<inspect::robot::GasReaction> gas_reaction;
   bool no_video = false, plaintext = false;
-  std::string certs_dir;
+};
+
+/// Reads the command line (--help and --version print and exit 0; a usage error exits 2).
+CliArgs parseArgs(int argc, char** argv) {
+  using namespace inspect;
+  CliArgs o;
+  o.config_path = fileExists("config/client.yaml") ? "config/client.yaml" : "";
+  o.robot_path = fileExists("config/robot.yaml") ? "config/robot.yaml" : "";
+  o.control_path = fileExists("config/control.yaml") ? "config/control.yaml" : "";
+  o.behavior_path = fileExists("config/behavior.yaml") ? "config/behavior.yaml" : "";
   try {
     cli::ArgReader a(argc, argv);
     while (a.next()) {
       if (a.isHelp()) {
         std::fputs(kUsage, stdout);
-        return 0;
+        std::exit(0);
       } else if (a.is("--version")) {
         std::printf("robot_client %s\n", INSPECT_VERSION);
-        return 0;
-      } else if (a.is("--config")) config_path = a.text();  // "": built-in defaults
-      else if (a.is("--robot-config")) robot_path = a.text();
-      else if (a.is("--control-config")) control_path = a.text();
-      else if (a.is("--behavior-config")) behavior_path = a.text();  // "": people awareness off
-      else if (a.is("--serial")) serial_dev = a.path();
-      else if (a.is("--server")) server = a.path();
-      else if (a.is("--id")) id = a.path();
-      else if (a.is("--cmd-log")) cmd_log = a.path();
-      else if (a.is("--journal")) journal = a.text();
-      else if (a.is("--map")) map_path = a.path();
-      else if (a.is("--video-source")) video_source = a.path();
-      else if (a.is("--video-port")) video_port = static_cast<int>(a.integer(1, 65535));
-      else if (a.is("--certs")) certs_dir = a.path();
-      else if (a.is("--realtime-priority")) realtime_priority = static_cast<int>(a.integer(0, 99));
-      else if (a.is("--plaintext")) plaintext = true;
-      else if (a.is("--no-video")) no_video = true;
-      else if (a.is("--gas-reaction")) gas_reaction = robot::gasReactionOf(a.choice({"continue", "stop", "retreat"}));
+        std::exit(0);
+      } else if (a.is("--config")) o.config_path = a.text();  // "": built-in defaults
+      else if (a.is("--robot-config")) o.robot_path = a.text();
+      else if (a.is("--control-config")) o.control_path = a.text();
+      else if (a.is("--behavior-config")) o.behavior_path = a.text();  // "": people awareness off
+      else if (a.is("--serial")) o.serial_dev = a.path();
+      else if (a.is("--server")) o.server = a.path();
+      else if (a.is("--id")) o.id = a.path();
+      else if (a.is("--cmd-log")) o.cmd_log = a.path();
+      else if (a.is("--journal")) o.journal = a.text();
+      else if (a.is("--map")) o.map_path = a.path();
+      else if (a.is("--video-source")) o.video_source = a.path();
+      else if (a.is("--video-port")) o.video_port = static_cast<int>(a.integer(1, 65535));
+      else if (a.is("--certs")) o.certs_dir = a.path();
+      else if (a.is("--realtime-priority")) o.realtime_priority = static_cast<int>(a.integer(0, 99));
+      else if (a.is("--plaintext")) o.plaintext = true;
+      else if (a.is("--no-video")) o.no_video = true;
+      else if (a.is("--gas-reaction")) o.gas_reaction = robot::gasReactionOf(a.choice({"continue", "stop", "retreat"}));
       else a.unknown();
     }
-    if (!id.empty() && !client::validRobotId(id))
-      throw cli::UsageError("--id: '" + id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
-    if (plaintext && !certs_dir.empty()) throw cli::UsageError("--plaintext cannot be combined with --certs");
+    if (!o.id.empty() && !client::validRobotId(o.id))
+      throw cli::UsageError("--id: '" + o.id + "' must be 1-64 characters of A-Z a-z 0-9 _ -");
+    if (o.plaintext && !o.certs_dir.empty()) throw cli::UsageError("--plaintext cannot be combined with --certs");
   } catch (const cli::UsageError& e) {
     usageError(e.what());
   }
+  return o;
+}
 
+/// The command line over the client config: ids, server, TLS files, video, priority.
+void applyArgs(const CliArgs& o, inspect::client::ClientConfig& cfg) {
+  using namespace inspect;
+  if (!o.serial_dev.empty()) cfg.serial_device = o.serial_dev;
+  if (!o.map_path.empty()) cfg.map_file = o.map_path;
+  if (o.journal) cfg.events.journal = *o.journal;
+  if (o.gas_reaction) cfg.safety.gas_reaction = *o.gas_reaction;
+  if (!o.id.empty()) cfg.robot_id = o.id;
+  if (!o.server.empty()) {
+    const auto colon = o.server.rfind(':');
+    if (colon == std::string::npos || colon == 0) usageError("--server: '" + o.server + "' is not HOST:PORT");
+    cfg.server_host = o.server.substr(0, colon);
+    char* end = nullptr;
+    const long port = std::strtol(o.server.c_str() + colon + 1, &end, 10);
+    if (*end != '\0' || port < 1 || port > 65535) usageError("--server: '" + o.server + "' has no port number (1-65535)");
+    cfg.server_port = static_cast<int>(port);
+  }
+  if (!o.certs_dir.empty()) {
+    cfg.tls.ca = o.certs_dir + "/ca.pem";
+    cfg.tls.cert = o.certs_dir + "/" + cfg.robot_id + ".pem";
+    cfg.tls.key = o.certs_dir + "/" + cfg.robot_id + ".key";
+  }
+  // Unset: the robot's files beside the CA's (certs/ by default,
+  // /etc/inspect/certs in the package).
+  const auto ca_dir = std::filesystem::path(cfg.tls.ca).parent_path();
+  if (cfg.tls.cert.empty()) cfg.tls.cert = (ca_dir / (cfg.robot_id + ".pem")).string();
+  if (cfg.tls.key.empty()) cfg.tls.key = (ca_dir / (cfg.robot_id + ".key")).string();
+  if (cfg.tls.server_name.empty()) cfg.tls.server_name = cfg.server_host;
+  cfg.tls.plaintext = o.plaintext;
+  if (o.plaintext) {
+    std::fprintf(stderr, "robot_client: %s\n", net::kPlaintextWarning);
+    log::warn("main", net::kPlaintextWarning);
+  }
+  if (!o.video_source.empty()) cfg.video.source = o.video_source;
+  if (o.no_video) cfg.video.enabled = false;
+  if (o.video_port) cfg.video.port = *o.video_port;
+  if (o.realtime_priority) cfg.realtime_priority = *o.realtime_priority;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace inspect;
+  const CliArgs args = parseArgs(argc, argv);
+  const std::string& control_path = args.control_path;
+  const std::string& behavior_path = args.behavior_path;
+  const std::string& cmd_log = args.cmd_log;
   try {
     client::ClientConfig cfg;
-    if (!config_path.empty()) cfg = client::loadClientConfigFile(config_path);
+    if (!args.config_path.empty()) cfg = client::loadClientConfigFile(args.config_path);
     config::RobotConfig robot;
-    if (!robot_path.empty()) robot = config::loadRobotConfigFile(robot_path);
-    if (!serial_dev.empty()) cfg.serial_device = serial_dev;
-    if (!map_path.empty()) cfg.map_file = map_path;
-    if (journal) cfg.events.journal = *journal;
-    if (gas_reaction) cfg.safety.gas_reaction = *gas_reaction;
-    if (!id.empty()) cfg.robot_id = id;
-    if (!server.empty()) {
-      const auto colon = server.rfind(':');
-      if (colon == std::string::npos || colon == 0) usageError("--server: '" + server + "' is not HOST:PORT");
-      cfg.server_host = server.substr(0, colon);
-      char* end = nullptr;
-      const long port = std::strtol(server.c_str() + colon + 1, &end, 10);
-      if (*end != '\0' || port < 1 || port > 65535) usageError("--server: '" + server + "' has no port number (1-65535)");
-      cfg.server_port = static_cast<int>(port);
-    }
-
-    if (!certs_dir.empty()) {
-      cfg.tls.ca = certs_dir + "/ca.pem";
-      cfg.tls.cert = certs_dir + "/" + cfg.robot_id + ".pem";
-      cfg.tls.key = certs_dir + "/" + cfg.robot_id + ".key";
-    }
-    // Unset: the robot's files beside the CA's (certs/ by default,
-    // /etc/inspect/certs in the package).
-    const auto ca_dir = std::filesystem::path(cfg.tls.ca).parent_path();
-    if (cfg.tls.cert.empty()) cfg.tls.cert = (ca_dir / (cfg.robot_id + ".pem")).string();
-    if (cfg.tls.key.empty()) cfg.tls.key = (ca_dir / (cfg.robot_id + ".key")).string();
-    if (cfg.tls.server_name.empty()) cfg.tls.server_name = cfg.server_host;
-    cfg.tls.plaintext = plaintext;
-    if (plaintext) {
-      std::fprintf(stderr, "robot_client: %s\n", net::kPlaintextWarning);
-      log::warn("main", net::kPlaintextWarning);
-    }
-
-    if (!video_source.empty()) cfg.video.source = video_source;
-    if (no_video) cfg.video.enabled = false;
-    if (video_port) cfg.video.port = *video_port;
-    if (realtime_priority) cfg.realtime_priority = *realtime_priority;
+    if (!args.robot_path.empty()) robot = config::loadRobotConfigFile(args.robot_path);
+    applyArgs(args, cfg);
 
     config::ControlConfig control;
     if (!control_path.empty()) control = config::loadControlConfigFile(control_path);
