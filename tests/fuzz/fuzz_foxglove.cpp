@@ -10,6 +10,7 @@
 // point inside the input; the queue's byte count matches what it holds, the
 // control lane loses nothing, and no subscription gets a delta frame between
 // a drop and its next keyframe.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -109,12 +110,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
       case 2: {
         const auto& def = services[(r.tag / 4) % services.size()];
         const ServiceRequest q = parseServiceRequest(def.name, body);
-        if (q.ok()) {
+        if (q.ok() && q.call == ServiceRequest::Call::kConsoleLine) {
           require(!q.line.empty());
           // A line from JSON arguments never smuggles a second line or a comment.
           if (def.name != "/console") require(q.line.find_first_of("\n\r#") == std::string::npos);
         }
         // The response text is always valid JSON whatever the message.
+        if (q.ok() && q.call == ServiceRequest::Call::kGoto)  // a typed call's numbers are finite (ranges: the service)
+          require(std::isfinite(q.x_m) && std::isfinite(q.y_m) && (!q.speed_m_s || std::isfinite(*q.speed_m_s)));
         (void)serviceResponse(q.ok(), q.error + q.line);
         break;
       }

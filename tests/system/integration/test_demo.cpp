@@ -206,7 +206,8 @@ TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
   {
     const std::string layout = readFile(srcPath("config/foxglove/inspect_live.json"));
     std::set<std::string> channels;
-    for (const auto& [id, ch] : inspect::record::McapReader::open(mcap).channels()) channels.insert(ch.topic);
+    const auto run = inspect::record::McapReader::open(mcap);  // kept: channels() refers into it
+    for (const auto& [id, ch] : run.channels()) channels.insert(ch.topic);
     const std::regex re_topic(R"re("(/robot1/[A-Za-z0-9_/]+))re");
     int named = 0;
     for (auto it = std::sregex_iterator(layout.begin(), layout.end(), re_topic); it != std::sregex_iterator(); ++it) {
