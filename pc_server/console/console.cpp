@@ -208,10 +208,15 @@ CallResult Console::await(const PendingCall& pending) {
   }
 }
 
+CallResult Console::outcomeOf(const Issued& issued) {
+  if (const auto* done = std::get_if<CallResult>(&issued)) return *done;
+  const auto& pending = std::get<PendingCall>(issued);
+  if (!pending.control_note.empty()) out_ << pending.control_note << "\n";
+  return await(pending);
+}
+
 bool Console::report(const Issued& issued, bool runs) {
-  if (const auto* p = std::get_if<PendingCall>(&issued); p && !p->control_note.empty()) out_ << p->control_note << "\n";
-  const CallResult r = std::holds_alternative<CallResult>(issued) ? std::get<CallResult>(issued)
-                                                                  : await(std::get<PendingCall>(issued));
+  const CallResult r = outcomeOf(issued);
   if (r.outcome == CallOutcome::kInvalid) return fail(r.action, r.reason);
   out_ << r.text() << "\n";
   if (!r.ok()) {

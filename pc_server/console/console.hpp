@@ -212,6 +212,8 @@ class Console {
   bool report(const Issued& issued, bool runs = false);
   /// The result of a pending call, pumping while it waits (timed out when the server stops).
   CallResult await(const PendingCall& pending);
+  /// A call's result: the one it had at once, or (after printing the control note) the one awaited.
+  CallResult outcomeOf(const Issued& issued);
   /// Sleeps up to `seconds` while pumping; false if the server is stopping.
   bool sleepPumping(double seconds);
   /// Now on this console's clock, in seconds (for elapsed times).

@@ -50,8 +50,8 @@ bool Console::cmdInspect(const Args& args, const std::string&, int) {
   if (args.size() == 2) {
     const auto pv = parseNumber(args[1]);
     const double v = pv ? *pv : 0.0;
-    if (!pv || !(v > 0.0) || v > kMaxRouteSpeed_m_s)
-      return fail("inspect", "speed_m_s '" + args[1] + "' must be a number in (0, " + fmtShort(kMaxRouteSpeed_m_s) +
+    if (!pv || !(v > 0.0) || v > kMaxCommandSpeed_m_s)
+      return fail("inspect", "speed_m_s '" + args[1] + "' must be a number in (0, " + fmtShort(kMaxCommandSpeed_m_s) +
                                  "] m/s");
     r.speed_m_s = v;
   }

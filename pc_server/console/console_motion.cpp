@@ -26,11 +26,8 @@ bool Console::cmdDrive(const Args& args, const std::string&, int) {
   if (!w) return fail("drive", "'" + args[1] + "' is not a number");
   const std::string what = "drive " + fmtSigned(*v) + " m/s " + fmtSigned(*w) + " rad/s";
   // Held until stop (lease 0, docs/failsafes.md): a typed `drive` is meant to last.
-  const Issued issued = service_->teleop(session_, selected_, *v, *w, 0.0, clock_->nowNs());
-  if (const auto* done = std::get_if<CallResult>(&issued)) return report(*done);
-  const auto& pending = std::get<PendingCall>(issued);
-  if (!pending.control_note.empty()) out_ << pending.control_note << "\n";
-  const CallResult r = await(pending);
+  const CallResult r = outcomeOf(service_->teleop(session_, selected_, *v, *w, 0.0, clock_->nowNs()));
+  if (r.outcome == CallOutcome::kInvalid || r.outcome == CallOutcome::kRefused) return report(r);  // nothing sent
   if (!r.ok()) {
     service_->clearTeleop(r.robot);
     ++tally_.errors;

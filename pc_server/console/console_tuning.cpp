@@ -414,32 +414,29 @@ bool Console::pushGains(const std::string& robot, const control::GainSet& g, con
   net::toProto(g, *u->mutable_gains());
   u->set_source(source);
   if (ts->fis_imported) u->set_fis(fuzzy::formatFis(ts->fis));
-  const Issued issued = service_->send(session_, robot, "gains push", std::move(c), clock_->nowNs());
-  if (const auto* done = std::get_if<CallResult>(&issued)) return report(*done);
-  const auto& pending = std::get<PendingCall>(issued);
-  if (!pending.control_note.empty()) out_ << pending.control_note << "\n";
-  const CallResult r = await(pending);
+  const CallResult r = outcomeOf(service_->send(session_, robot, "gains push", std::move(c), clock_->nowNs()));
+  if (r.outcome == CallOutcome::kInvalid || r.outcome == CallOutcome::kRefused) return report(r);  // nothing sent
   if (r.outcome == CallOutcome::kTimedOut) {
     ++tally_.errors;
     out_ << r.text() << "\n";
     return false;
   }
-  const v1::Ack* ack = &r.ack;
-  const bool ok = ack->status() == v1::Ack::ACCEPTED;
+  const v1::Ack& ack = r.ack;
+  const bool ok = ack.status() == v1::Ack::ACCEPTED;
   if (ok) {
-    out_ << robot << ": gains v" << ack->gains_version() << " accepted (" << ack->reason() << ")\n";
+    out_ << robot << ": gains v" << ack.gains_version() << " accepted (" << ack.reason() << ")\n";
   } else {
     ++tally_.errors;
-    out_ << robot << ": gains push rejected: " << ack->reason() << " (v" << ack->gains_version() << " stays in force)\n";
+    out_ << robot << ": gains push rejected: " << ack.reason() << " (v" << ack.gains_version() << " stays in force)\n";
   }
   if (recorder_) {
     catalog::GainsPush p;
     p.robot = robot;
     p.time = std::chrono::system_clock::now();
-    p.version = ack->gains_version();
+    p.version = ack.gains_version();
     p.gains_json = config::gainsJson(g);
     p.status = ok ? "accepted" : "rejected";
-    p.reason = ok ? "" : ack->reason();
+    p.reason = ok ? "" : ack.reason();
     p.session_id = session;
     try {
       recorder_->catalog().addGainsPush(p);

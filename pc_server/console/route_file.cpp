@@ -79,7 +79,7 @@ Route readRoute(const config::ConfigNode& root) {
   r.file = root.file();
   r.name = root.string("name", stem(root.file()));
   if (r.name.empty()) root.fail("name", "must not be empty");
-  r.speed_m_s = root.number("speed_m_s", r.speed_m_s, 0.0, kMaxRouteSpeed_m_s);
+  r.speed_m_s = root.number("speed_m_s", r.speed_m_s, 0.0, kMaxCommandSpeed_m_s);
   if (root.has("speed_m_s") && r.speed_m_s <= 0.0) root.fail("speed_m_s", "must be > 0 m/s (leave it out for the robot's default)");
   const std::string map = root.string("map", "");
   if (root.has("wheel_test")) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "inspect_robot/v1/link.pb.h"
+#include "pc_server/operator/command_limits.hpp"
 #include "shared/control/wheel_profile.hpp"
 
 namespace inspect::server {
@@ -41,8 +42,6 @@ struct Route {
 
 /// Most waypoints a route may have (the robot accepts as many goals per command).
 inline constexpr int kMaxRoutePoints = 100;
-/// Fastest cruise speed a route may ask for, m/s.
-inline constexpr double kMaxRouteSpeed_m_s = 1.0;
 /// Longest dwell at one point, s.
 inline constexpr double kMaxDwell_s = 3600.0;
 

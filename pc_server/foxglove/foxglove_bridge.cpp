@@ -430,6 +430,14 @@ void FoxgloveBridge::onServiceCall(uint64_t client, const Service& service, uint
   }
   const auto op = operatorOf(client);
   if (!op) return;
+  if (!req.robot.empty()) {
+    // A robot named stays the session's choice for its next calls, typed or console lines alike.
+    {
+      std::lock_guard lk(mu_);
+      if (const auto it = clients_.find(client); it != clients_.end()) it->second.selected = req.robot;
+    }
+    if (req.call != ServiceRequest::Call::kConsoleLine) (void)op->post(req.robot, "", {});  // the console's select
+  }
   if (req.call != ServiceRequest::Call::kConsoleLine) {
     callService(client, *op, service.id, call_id, req);
     return;
@@ -446,15 +454,14 @@ void FoxgloveBridge::onServiceCall(uint64_t client, const Service& service, uint
 void FoxgloveBridge::callService(uint64_t client, const ClientOperator& op, uint32_t service_id, uint32_t call_id,
                                  const ServiceRequest& req) {
   using Call = ServiceRequest::Call;
-  // The robot: the one named (remembered as the client's selection), else
-  // for a stop the one this client drives, else the last one it named, else
-  // its console session's selected one, else the first connected.
+  // The robot: the one named, else for a stop the one this client drives,
+  // else the last one it named, else its console session's selected one,
+  // else the first connected.
   std::string robot = req.robot;
   {
     std::lock_guard lk(mu_);
     const auto it = clients_.find(client);
     if (it == clients_.end()) return;
-    if (!robot.empty()) it->second.selected = robot;
     if (robot.empty() && req.urgent()) robot = it->second.teleop_robot;
     if (robot.empty()) robot = it->second.selected;
   }

@@ -2,18 +2,12 @@
 
 #include <cmath>
 
+#include "pc_server/operator/command_limits.hpp"
 #include "shared/util/number_text.hpp"
 
 namespace inspect::server {
 
 using util::fmtShort;
-
-namespace {
-
-/// Fastest speed an operator may ask of a go-to or a track, m/s (routes: kMaxRouteSpeed_m_s, the same).
-constexpr double kMaxCommandSpeed_m_s = 1.0;
-
-}  // namespace
 
 const char* callOutcomeName(CallOutcome o) {
   switch (o) {
@@ -118,7 +112,8 @@ Issued OperatorService::goTo(uint64_t session, const std::string& robot, double 
 
 Issued OperatorService::track(uint64_t session, const std::string& robot, const TrackRequest& t, int64_t now_ns) {
   if (!(t.speed_m_s > 0) || t.speed_m_s > kMaxCommandSpeed_m_s)
-    return invalid("track", robot, "speed " + fmtShort(t.speed_m_s) + " m/s is outside (0, 1]");
+    return invalid("track", robot,
+                   "speed " + fmtShort(t.speed_m_s) + " m/s is outside (0, " + fmtShort(kMaxCommandSpeed_m_s) + "]");
   if (!t.controller.empty() && t.controller != "fuzzy_pid" && t.controller != "pid" && t.controller != "direct")
     return invalid("track", robot, "unknown controller '" + t.controller + "' (fuzzy_pid, pid, direct)");
   v1::Command c;

@@ -428,9 +428,8 @@ RunWheelData readRunWheelSeries(const std::string& mcap_path) {
   const std::string type = v1::Telemetry::descriptor()->full_name();
   for (const auto& [id, ch] : reader.channels()) {
     topics += (topics.empty() ? "" : ", ") + ch.topic;
-    // "/<robot>/telemetry" (pc_server/scene/topics) or an older run's "/telemetry".
-    if (ch.topic != "/telemetry" && !(ch.topic.ends_with("/telemetry") && ch.topic.find('/', 1) == ch.topic.size() - 10))
-      continue;
+    // "/<robot>/telemetry" (pc_server/scene/topics) or an older run's "/telemetry": no deeper topic.
+    if (!ch.topic.ends_with("/telemetry") || std::count(ch.topic.begin(), ch.topic.end(), '/') > 2) continue;
     if (ch.message_encoding != "protobuf" || ch.schema_name != type)
       throw std::runtime_error(mcap_path + ": /telemetry is not " + type + " in protobuf (encoding '" +
                                ch.message_encoding + "', schema '" + ch.schema_name + "')");
