@@ -186,6 +186,7 @@ bool Console::cmdReplay(const Args& args, const std::string&, int) {
   snap.id = d.info.robot;
   snap.connected = true;
   snap.has_telemetry = true;
+  if (log.hello) snap.hello = *log.hello;  // the gas channels' names, as the live line shows them
   const double t0 = static_cast<double>(log.telemetry.front().robot_time_us()) * 1e-6;
   double next_line = 0;
   std::size_t next_event = 0;

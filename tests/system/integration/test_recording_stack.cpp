@@ -139,6 +139,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   EXPECT_NE(readFile(first + "/csv/telemetry.csv").find("pose.x_m"), std::string::npos);
   EXPECT_NE(rout.find("replay of " + ids[0] + " done"), std::string::npos) << rout;
   EXPECT_NE(rout.find("| TELEOP |"), std::string::npos) << rout;
+  EXPECT_NE(rout.find("| gas CH4 "), std::string::npos) << "the replay names the gas channels as live: " << rout;
   {
     auto cat = inspect::catalog::Catalog::open(runs + "/catalog.sqlite");
     EXPECT_EQ(cat.integrityCheck(), "ok");
