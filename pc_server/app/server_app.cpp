@@ -348,8 +348,10 @@ int runServer(const CliOptions& options) {
   };
   std::unique_ptr<foxglove::FoxgloveBridge> bridge;
   if (config.foxglove.enabled) {
-    bridge = std::make_unique<foxglove::FoxgloveBridge>(ioc, bridgeOptions(config, copt, video.get()), registry, link,
-                                                        control, site_maps, geometry, copt, configure);
+    auto fo = bridgeOptions(config, copt, video.get());
+    fo.recorder = recorder.get();
+    bridge = std::make_unique<foxglove::FoxgloveBridge>(ioc, std::move(fo), registry, link, control, site_maps,
+                                                        geometry, copt, configure);
     const auto ep = bridge->start();  // a failure here leaves no pointer to a destroyed bridge
     bridge_ptr = bridge.get();
     announceBridge(config, options, ep.port());

@@ -9,7 +9,7 @@
 
 #include "pc_server/console/expect_check.hpp"
 #include "pc_server/link/hello_check.hpp"
-#include "pc_server/console/route_file.hpp"
+#include "pc_server/operator/route_file.hpp"
 #include "pc_server/console/status_line.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "pc_server/recording/recorder.hpp"
@@ -50,6 +50,7 @@ void Console::setSession(ControlArbiter* arbiter, uint64_t session) {
   session_ = session;
   service_.emplace(registry_, sink_, arbiter,
                    OperatorService::Options{options_.ack_timeout_s, options_.max_v_m_s, options_.max_w_rad_s});
+  service_->setRunContext(recorder_, site_maps_);
 }
 
 bool Console::fail(const std::string& cmd, const std::string& message) {
@@ -290,23 +291,18 @@ bool Console::cmdRecord(const Args& args, const std::string& rest, int) {
   if (!recorder_) return fail("record", "the server records nothing (recording.enabled: false or --no-record)");
   if (args.empty() || (args[0] != "start" && args[0] != "stop") || (args[0] == "stop" && args.size() > 1))
     return fail("record", "syntax: record start [name] | record stop");
-  if (selected_.empty()) return fail("record", "no robot selected");
+  CallResult r;
   if (args[0] == "stop") {
-    const auto id = recorder_->stop(selected_, "stopped");
-    if (!id) return fail("record", selected_ + " is not recording");
-    out_ << selected_ << ": run " << *id << " stopped\n";
-    return true;
+    r = service_->recordStop(session_, selected_);
+  } else {
+    const auto sp = rest.find("start");
+    std::string name = sp == std::string::npos ? "" : rest.substr(sp + 5);
+    name.erase(0, name.find_first_not_of(" \t"));
+    r = service_->recordStart(session_, selected_, name);
   }
-  const auto sp = rest.find("start");
-  std::string name = sp == std::string::npos ? "" : rest.substr(sp + 5);
-  name.erase(0, name.find_first_not_of(" \t"));
-  try {
-    const std::string id = recorder_->start(selected_, name);
-    out_ << selected_ << ": recording run " << id << "\n";
-    return true;
-  } catch (const std::exception& e) {
-    return fail("record", e.what());
-  }
+  if (!r.ok()) return fail("record", r.reason);
+  out_ << r.robot << ": " << r.reason << "\n";
+  return true;
 }
 
 bool Console::cmdRuns(const Args& args, const std::string&, int) {

@@ -109,9 +109,15 @@ class Console {
   /// Enables `foxglove` (the bridge's report; empty function: no bridge).
   void setFoxgloveReport(std::function<std::string()> report) { foxglove_report_ = std::move(report); }
   /// Where `inspect` and `route` note the site map of the route they send (null: nowhere).
-  void setSiteMaps(scene::SiteMaps* maps) { site_maps_ = maps; }
+  void setSiteMaps(scene::SiteMaps* maps) {
+    site_maps_ = maps;
+    service_->setRunContext(recorder_, site_maps_);
+  }
   /// Enables record/runs/run (null: the server records nothing).
-  void setRecorder(Recorder* r) { recorder_ = r; }
+  void setRecorder(Recorder* r) {
+    recorder_ = r;
+    service_->setRunContext(recorder_, site_maps_);
+  }
   Recorder* recorder() const { return recorder_; }
   /// The robot's status line with the video figures and the recording mark ("| REC <run-id>").
   std::string statusText(const std::string& robot) const;

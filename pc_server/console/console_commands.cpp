@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "pc_server/console/route_file.hpp"
+#include "pc_server/operator/route_file.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/video/video_hub.hpp"

@@ -5,7 +5,7 @@
 
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/scene/site_maps.hpp"
-#include "pc_server/console/route_file.hpp"
+#include "pc_server/operator/route_file.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/util/clock.hpp"
@@ -43,34 +43,23 @@ bool Console::cmdInspect(const Args& args, const std::string&, int) {
   if (args.empty() || args.size() > 2) return fail("inspect", "syntax: inspect <route> [speed_m_s]");
   Route r;
   try {
-    r = loadRouteFile(resolveRoute(args[0]));
+    r = openRoute(args[0]);
   } catch (const config::ConfigError& e) {
     return fail("inspect", e.what());
   }
+  std::optional<double> speed;
   if (args.size() == 2) {
-    const auto pv = parseNumber(args[1]);
-    const double v = pv ? *pv : 0.0;
-    if (!pv || !(v > 0.0) || v > kMaxCommandSpeed_m_s)
+    speed = parseNumber(args[1]);
+    if (!speed || !commandSpeedOk(*speed))
       return fail("inspect", "speed_m_s '" + args[1] + "' must be a number in (0, " + fmtShort(kMaxCommandSpeed_m_s) +
                                  "] m/s");
-    r.speed_m_s = v;
   }
   const auto robot = connectedRobot("inspect");
   if (!robot) return false;
-  if (site_maps_ && !r.map.empty()) site_maps_->set(*robot, r.map);
-  if (recorder_) {
-    if (!r.map.empty()) recorder_->setRunMap(*robot, r.map);
-  } else {
-    out_ << "inspect: note: the server records nothing (--no-record): no run, no report\n";
-  }
-  v1::Command c;
-  *c.mutable_go_to() = goToOf(r, true);
-  out_ << "inspection '" << r.name << "': " << r.points.size() << " points, " << r.inspectionPoints()
-       << " inspection points" << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string())
-       << (r.map.empty() ? std::string() : ", map " + r.map) << "\n";
-  const bool ok = sendAndReport("inspect", std::move(c), true);
-  if (!ok && recorder_) recorder_->setRunMap(*robot, "");  // refused: no run to attach the map to
-  return ok;
+  if (!recorder_) out_ << "inspect: note: the server records nothing (--no-record): no run, no report\n";
+  if (speed) r.speed_m_s = *speed;
+  out_ << routeSummary(r, true) << "\n";
+  return report(service_->inspect(session_, *robot, r, speed, clock_->nowNs()), true);
 }
 
 bool Console::cmdAlarms(const Args& args, const std::string&, int) {

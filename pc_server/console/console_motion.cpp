@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "pc_server/console/route_file.hpp"
+#include "pc_server/operator/route_file.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/scene/site_maps.hpp"
@@ -113,26 +113,12 @@ bool Console::cmdRoute(const Args& args, const std::string&, int) {
   if (args.size() != 1) return fail("route", "needs one route: route <file|name>");
   Route r;
   try {
-    // A path is read as given (its own errors); a bare name is looked up in config/routes/.
-    const bool path = args[0].find('/') != std::string::npos || args[0].ends_with(".yaml");
-    r = loadRouteFile(path ? args[0] : resolveRoute(args[0]));
+    r = openRoute(args[0]);
   } catch (const config::ConfigError& e) {
     return fail("route", e.what());
   }
-  v1::Command c;
-  if (r.isWheelTest()) {
-    *c.mutable_wheel_test() = wheelTestOf(r);
-    double total = 0.0;
-    for (const auto& g : r.wheel_test) total += g.duration_s;
-    out_ << "wheel test '" << r.name << "': " << r.wheel_test.size() << " segments, " << fmtShort(total, 1)
-         << " s of open-loop steps and chirps (identify <run> fits the plant afterwards)\n";
-    return sendAndReport("route", std::move(c), true);
-  }
-  *c.mutable_go_to() = goToOf(r);
-  if (site_maps_ && !r.map.empty() && !selected_.empty()) site_maps_->set(selected_, r.map);
-  out_ << "route '" << r.name << "': " << r.points.size() << " points"
-       << (r.speed_m_s > 0 ? " at " + fmtShort(r.speed_m_s) + " m/s" : std::string()) << "\n";
-  return sendAndReport("route", std::move(c), true);
+  out_ << routeSummary(r, false) << "\n";
+  return report(service_->route(session_, selected_, r, clock_->nowNs()), true);
 }
 
 bool Console::cmdStop(const Args& args, const std::string&, int) {

@@ -4,7 +4,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "shared/util/number_text.hpp"
 
 namespace inspect::server::foxglove {
 
@@ -135,10 +134,6 @@ ServiceRequest parseServiceRequest(const std::string& service, std::string_view 
       const double v = number(j, "speed", false);
       return std::isnan(v) ? std::nullopt : std::optional<double>(v);
     };
-    const auto speedWord = [&] {
-      const auto v = speed();
-      return v ? " " + util::shortest(*v) : std::string();
-    };
     if (service == "/stop") {
       r.call = Call::kStop;
     } else if (service == "/estop") {
@@ -151,14 +146,17 @@ ServiceRequest parseServiceRequest(const std::string& service, std::string_view 
       r.y_m = number(j, "y", true);
       r.speed_m_s = speed();
     } else if (service == "/route") {
-      r.line = "route " + word(j, "route", true);
+      r.call = Call::kRoute;
+      r.route = word(j, "route", true);
     } else if (service == "/inspect") {
-      r.line = "inspect " + word(j, "route", true) + speedWord();
+      r.call = Call::kInspect;
+      r.route = word(j, "route", true);
+      r.speed_m_s = speed();
     } else if (service == "/record_start") {
-      const std::string name = text(j, "name");
-      r.line = "record start" + (name.empty() ? std::string() : " " + name);
+      r.call = Call::kRecordStart;
+      r.name = text(j, "name");
     } else if (service == "/record_stop") {
-      r.line = "record stop";
+      r.call = Call::kRecordStop;
     } else if (service == "/control_take") {
       r.call = Call::kControlTake;
       r.force = flag(j, "force");

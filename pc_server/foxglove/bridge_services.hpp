@@ -1,10 +1,10 @@
 #pragma once
 // The services a Foxglove client may call (docs/foxglove.md, "Services"):
 // JSON arguments decoded into a typed call of the operator service (stop,
-// e-stop, resume, go to, control), run in the client's own operator session
-// with the same rules as the console (control, limits, acks); the rest
-// (route, inspect, record, console) as a console line of that session. Pure:
-// JSON in, the call out.
+// e-stop, resume, go to, route, inspect, record, control), run in the
+// client's own operator session with the same rules as the console (control,
+// limits, acks); /console as a console line of that session. Pure: JSON in,
+// the call out.
 #include <optional>
 #include <string>
 #include <string_view>
@@ -32,13 +32,27 @@ Service toService(const ServiceDef& d);
 /// service, or (kConsoleLine) one console line after selecting `robot`; or
 /// what was wrong with the request.
 struct ServiceRequest {
-  enum class Call { kConsoleLine, kStop, kEstop, kResume, kGoto, kControlTake, kControlRelease };
+  enum class Call {
+    kConsoleLine,
+    kStop,
+    kEstop,
+    kResume,
+    kGoto,
+    kRoute,
+    kInspect,
+    kRecordStart,
+    kRecordStop,
+    kControlTake,
+    kControlRelease
+  };
   Call call = Call::kConsoleLine;
   std::string robot;  // "" = the session's selected robot
   double x_m = 0.0, y_m = 0.0;         // kGoto
-  std::optional<double> speed_m_s;     // kGoto
+  std::optional<double> speed_m_s;     // kGoto, kInspect
+  std::string route;                   // kRoute, kInspect: a name in config/routes or a file
+  std::string name;                    // kRecordStart: the run's name ("" = none)
   bool force = false;                  // kControlTake
-  std::string line;   // kConsoleLine: e.g. "route lab_loop"
+  std::string line;   // kConsoleLine: e.g. "status"
   std::string error;
   bool ok() const { return error.empty(); }
   /// Stop and e-stop: sent at once, never queued behind another call.

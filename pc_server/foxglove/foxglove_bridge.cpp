@@ -1,6 +1,5 @@
 #include "pc_server/foxglove/foxglove_bridge.hpp"
 
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -8,7 +7,10 @@
 #include <nlohmann/json.hpp>
 
 #include "pc_server/foxglove/bridge_services.hpp"
+#include "pc_server/operator/command_limits.hpp"
+#include "pc_server/operator/route_file.hpp"
 #include "pc_server/scene/topics.hpp"
+#include "shared/config/config_node.hpp"
 #include "shared/record/mcap_writer.hpp"
 #include "shared/util/base64.hpp"
 #include "shared/util/clock.hpp"
@@ -43,6 +45,7 @@ FoxgloveBridge::FoxgloveBridge(asio::io_context& ioc, Options options, RobotRegi
       server_(ioc, options_.server, *this), tick_timer_(ioc), deadman_timer_(ioc),
       service_(registry, sink, &control,
                OperatorService::Options{console_options.ack_timeout_s, options_.max_v_m_s, options_.max_w_rad_s}) {
+  service_.setRunContext(options_.recorder, &maps_);
   for (const auto& d : serviceDefs()) service_ids_[d.name] = server_.addService(toService(d));
 }
 
@@ -68,16 +71,13 @@ void FoxgloveBridge::stop() {
   }
   // The timers see stopped_ at their next expiry and end their chains.
   server_.stop();
-  for (auto& [id, c] : clients)
+  for (auto& [id, c] : clients) {
     if (!c.teleop_robot.empty() && c.op) stopIfHeld(c.teleop_robot, c.op->session());
-  clients.clear();  // the sessions end (outside the lock: their workers may be finishing a call)
-  std::vector<Reaper> reapers;
-  {
-    std::lock_guard lk(mu_);
-    reapers.swap(reapers_);
+    if (c.op) c.op->end();
   }
-  for (auto& r : reapers)
-    if (r.thread.joinable()) r.thread.join();
+  clients.clear();
+  // Lines still running return at once (their sessions ended); then the sessions close.
+  console_pool_.join();
 }
 
 uint32_t FoxgloveBridge::addChannel(const std::string& topic, const google::protobuf::Descriptor* d,
@@ -279,7 +279,8 @@ bool FoxgloveBridge::stopIfHeld(const std::string& robot, uint64_t session) {
 }
 
 void FoxgloveBridge::onClientOpen(uint64_t client, const std::string& peer) {
-  auto op = std::make_shared<ClientOperator>("foxglove " + peer, registry_, sink_, control_, console_options_, configure_);
+  auto op = std::make_shared<ClientOperator>("foxglove " + peer, registry_, sink_, control_, console_options_, configure_,
+                                             console_pool_);
   log::info(kTag, "client ", client, " (", peer, ") is operator session ", op->name());
   std::lock_guard lk(mu_);
   if (stopped_) return;
@@ -297,21 +298,9 @@ void FoxgloveBridge::onClientClose(uint64_t client) {
   }
   // A client that drove a robot and went away leaves it stopped.
   if (!c.teleop_robot.empty() && c.op) stopIfHeld(c.teleop_robot, c.op->session());
-  // Ends the session off the io thread: a command of it may still run (a
-  // report, an export); waits for an Ack end at once. stop() joins these.
-  auto done = std::make_shared<std::atomic<bool>>(false);
-  std::thread t([op = std::move(c.op), done]() mutable {
-    op.reset();
-    *done = true;
-  });
-  std::lock_guard lk(mu_);
-  // Those of earlier clients that have finished are joined (at once) and forgotten.
-  std::erase_if(reapers_, [](Reaper& r) {
-    if (!*r.done) return false;
-    r.thread.join();
-    return true;
-  });
-  reapers_.push_back({std::move(t), std::move(done)});
+  // A console line of it still running is interrupted; the session closes
+  // when that line lets go of it (on the pool), or here.
+  if (c.op) c.op->end();
 }
 
 void FoxgloveBridge::onSubscribe(uint64_t, uint32_t channel) {
@@ -451,9 +440,46 @@ void FoxgloveBridge::onServiceCall(uint64_t client, const Service& service, uint
                      "busy: " + std::to_string(ClientOperator::kMaxQueued) + " calls of this client are waiting");
 }
 
+Issued FoxgloveBridge::issue(const ServiceRequest& req, uint64_t session, const std::string& robot,
+                             std::string& preface) {
+  using Call = ServiceRequest::Call;
+  const int64_t now = monoNowNs();
+  switch (req.call) {
+    case Call::kStop: return service_.stop(session, robot, now);
+    case Call::kEstop: return service_.estop(session, robot, now);
+    case Call::kResume: return service_.resume(session, robot, now);
+    case Call::kGoto: return service_.goTo(session, robot, req.x_m, req.y_m, req.speed_m_s, now);
+    case Call::kRoute:
+    case Call::kInspect: {
+      const bool inspection = req.call == Call::kInspect;
+      Route r;
+      try {
+        r = openRoute(req.route);
+      } catch (const config::ConfigError& e) {
+        CallResult bad;
+        bad.action = inspection ? "inspect" : "route";
+        bad.robot = robot;
+        bad.reason = e.what();
+        return bad;
+      }
+      if (inspection && req.speed_m_s && commandSpeedOk(*req.speed_m_s)) r.speed_m_s = *req.speed_m_s;
+      preface = routeSummary(r, inspection) + "\n";
+      return inspection ? service_.inspect(session, robot, r, req.speed_m_s, now) : service_.route(session, robot, r, now);
+    }
+    case Call::kRecordStart: return service_.recordStart(session, robot, req.name);
+    case Call::kRecordStop: return service_.recordStop(session, robot);
+    case Call::kControlTake: return service_.takeControl(session, robot, req.force, now);
+    case Call::kControlRelease: return service_.releaseControl(session, robot);
+    case Call::kConsoleLine: break;
+  }
+  CallResult bad;
+  bad.action = "console";
+  bad.reason = "not a typed call";
+  return bad;
+}
+
 void FoxgloveBridge::callService(uint64_t client, const ClientOperator& op, uint32_t service_id, uint32_t call_id,
                                  const ServiceRequest& req) {
-  using Call = ServiceRequest::Call;
   // The robot: the one named, else for a stop the one this client drives,
   // else the last one it named, else its console session's selected one,
   // else the first connected.
@@ -467,35 +493,23 @@ void FoxgloveBridge::callService(uint64_t client, const ClientOperator& op, uint
   }
   if (robot.empty()) robot = op.selected();
   if (robot.empty()) robot = registry_.firstConnected();
-  const uint64_t session = op.session();
-  const int64_t now = monoNowNs();
-  CallResult done;
-  switch (req.call) {
-    case Call::kControlTake: done = service_.takeControl(session, robot, req.force, now); break;
-    case Call::kControlRelease: done = service_.releaseControl(session, robot); break;
-    default: {
-      const Issued issued = req.call == Call::kStop    ? service_.stop(session, robot, now)
-                            : req.call == Call::kEstop ? service_.estop(session, robot, now)
-                            : req.call == Call::kResume
-                                ? service_.resume(session, robot, now)
-                                : service_.goTo(session, robot, req.x_m, req.y_m, req.speed_m_s, now);
-      if (const auto* p = std::get_if<PendingCall>(&issued)) {
-        awaitCall(client, service_id, call_id, *p);
-        return;
-      }
-      done = std::get<CallResult>(issued);
-    }
+  std::string preface;
+  const Issued issued = issue(req, op.session(), robot, preface);
+  if (const auto* p = std::get_if<PendingCall>(&issued)) {
+    awaitCall(client, service_id, call_id, *p, std::move(preface));
+    return;
   }
-  // Control take/release answer with the console's line ("robot1: controlled by ...").
-  const bool control = req.call == Call::kControlTake || req.call == Call::kControlRelease;
+  const CallResult& done = std::get<CallResult>(issued);
+  // Calls done at once (control, record) answer with the console's line ("robot1: recording run ...").
   server_.respond(client, service_id, call_id,
-                  serviceResponse(done.ok(), control && done.ok() ? done.robot + ": " + done.reason : done.text()));
+                  serviceResponse(done.ok(), preface + (done.ok() ? done.robot + ": " + done.reason : done.text())));
 }
 
-void FoxgloveBridge::awaitCall(uint64_t client, uint32_t service_id, uint32_t call_id, PendingCall pending) {
+void FoxgloveBridge::awaitCall(uint64_t client, uint32_t service_id, uint32_t call_id, PendingCall pending,
+                               std::string preface) {
   if (const auto r = service_.settle(pending, monoNowNs())) {
     const std::string note = r->control_note.empty() ? "" : r->control_note + "\n";
-    server_.respond(client, service_id, call_id, serviceResponse(r->ok(), note + r->text()));
+    server_.respond(client, service_id, call_id, serviceResponse(r->ok(), preface + note + r->text()));
     return;
   }
   auto timer = std::make_shared<asio::steady_timer>(ioc_, kCallPollPeriod);
@@ -505,10 +519,10 @@ void FoxgloveBridge::awaitCall(uint64_t client, uint32_t service_id, uint32_t ca
     std::erase_if(call_timers_, [](const auto& w) { return w.expired(); });
     call_timers_.push_back(timer);
   }
-  timer->async_wait([this, timer, client, service_id, call_id, pending = std::move(pending)](
-                        const boost::system::error_code& ec) mutable {
+  timer->async_wait([this, timer, client, service_id, call_id, pending = std::move(pending),
+                     preface = std::move(preface)](const boost::system::error_code& ec) mutable {
     if (ec) return;  // stop(): the bridge is going
-    awaitCall(client, service_id, call_id, std::move(pending));
+    awaitCall(client, service_id, call_id, std::move(pending), std::move(preface));
   });
 }
 

@@ -4,7 +4,6 @@
 // protocol, and from the clients teleop set-points and service calls, each
 // client an operator session of its own (it observes until it takes control;
 // stop and e-stop always work; teleop lapses when the client stops sending).
-#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -13,7 +12,6 @@
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <boost/asio/io_context.hpp>
@@ -32,6 +30,8 @@ namespace inspect::server::foxglove {
 
 class FoxgloveBridge : public WsServer::Handler {
  public:
+  /// At most this many /console lines run at once, whatever the number of clients.
+  static constexpr std::size_t kConsoleThreads = 2;
   struct Options {
     WsServer::Options server;
     double scene_hz = 10;          // SceneUpdate per robot
@@ -39,6 +39,8 @@ class FoxgloveBridge : public WsServer::Handler {
     double teleop_timeout_s = 0.3; // a set-point not renewed this long lapses to zero (the session's lease)
     double max_v_m_s = 1.0;        // teleop limits (the console's)
     double max_w_rad_s = 2.0;
+    /// Where /record_start, /record_stop and /inspect record (null: the server records nothing).
+    Recorder* recorder = nullptr;
     /// The server's receive figures of a robot's stream (VideoHub), for
     /// /<robot>/video_stats once a second; unset or nullopt = none.
     std::function<std::optional<v1::VideoReceiveStats>(const std::string& robot)> video_stats;
@@ -114,8 +116,12 @@ class FoxgloveBridge : public WsServer::Handler {
   /// A typed service call through the operator service; the answer is sent when it settles.
   void callService(uint64_t client, const ClientOperator& op, uint32_t service_id, uint32_t call_id,
                    const ServiceRequest& req);
-  /// Polls a pending call every kCallPollPeriod until the robot's Ack or the deadline; then answers.
-  void awaitCall(uint64_t client, uint32_t service_id, uint32_t call_id, PendingCall pending);
+  /// The operator service's call for a typed request; `preface` gets a line
+  /// to print before its result (a route's summary).
+  Issued issue(const ServiceRequest& req, uint64_t session, const std::string& robot, std::string& preface);
+  /// Polls a pending call every kCallPollPeriod until the robot's Ack or the
+  /// deadline; then answers with preface, the control note and the result.
+  void awaitCall(uint64_t client, uint32_t service_id, uint32_t call_id, PendingCall pending, std::string preface);
   /// Stops `robot` if `session` still holds its control; false (nothing sent) otherwise.
   bool stopIfHeld(const std::string& robot, uint64_t session);
 
@@ -140,12 +146,8 @@ class FoxgloveBridge : public WsServer::Handler {
   std::map<std::string, RobotState> robots_;
   std::map<uint64_t, Client> clients_;
   std::map<std::string, std::string> schemas_;  // message type -> base64 FileDescriptorSet
-  /// Threads ending the sessions of clients that left (never joined on an io thread).
-  struct Reaper {
-    std::thread thread;
-    std::shared_ptr<std::atomic<bool>> done;
-  };
-  std::vector<Reaper> reapers_;
+  /// The threads of the clients' /console lines (bounded; one line at a time per client).
+  ConsolePool console_pool_{kConsoleThreads};
 };
 
 }  // namespace inspect::server::foxglove

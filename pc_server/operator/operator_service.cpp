@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "pc_server/operator/command_limits.hpp"
+#include "pc_server/recording/recorder.hpp"
+#include "pc_server/scene/site_maps.hpp"
 #include "shared/util/number_text.hpp"
 
 namespace inspect::server {
@@ -255,6 +257,76 @@ CallResult OperatorService::releaseControl(uint64_t session, const std::string& 
   return r;
 }
 
+void OperatorService::setRunContext(Recorder* recorder, scene::SiteMaps* site_maps) {
+  recorder_ = recorder;
+  site_maps_ = site_maps;
+}
+
+Issued OperatorService::route(uint64_t session, const std::string& robot, const Route& r, int64_t now_ns) {
+  v1::Command c;
+  if (r.isWheelTest())
+    *c.mutable_wheel_test() = wheelTestOf(r);
+  else
+    *c.mutable_go_to() = goToOf(r);
+  Issued issued = send(session, robot, "route", std::move(c), now_ns);
+  if (site_maps_ && !r.map.empty() && std::holds_alternative<PendingCall>(issued)) site_maps_->set(robot, r.map);
+  return issued;
+}
+
+Issued OperatorService::inspect(uint64_t session, const std::string& robot, Route r, std::optional<double> speed_m_s,
+                                int64_t now_ns) {
+  if (speed_m_s) {
+    if (!commandSpeedOk(*speed_m_s))
+      return invalid("inspect", robot,
+                     "speed_m_s '" + fmtShort(*speed_m_s) + "' must be a number in (0, " +
+                         fmtShort(kMaxCommandSpeed_m_s) + "] m/s");
+    r.speed_m_s = *speed_m_s;
+  }
+  if (r.isWheelTest()) return invalid("inspect", robot, "'" + r.name + "' is a wheel test, not an inspection route");
+  if (auto bad = checkConnected("inspect", robot, now_ns)) return *bad;
+  // The map goes to the run before the command: the robot's Ack starts the run.
+  const bool run_map = recorder_ && !r.map.empty();
+  if (run_map) recorder_->setRunMap(robot, r.map);
+  v1::Command c;
+  *c.mutable_go_to() = goToOf(r, true);
+  Issued issued = send(session, robot, "inspect", std::move(c), now_ns);
+  if (auto* p = std::get_if<PendingCall>(&issued)) {
+    p->forget_run_map = run_map;
+    if (site_maps_ && !r.map.empty()) site_maps_->set(robot, r.map);
+  } else if (run_map) {
+    recorder_->setRunMap(robot, "");  // nothing sent: no run to attach the map to
+  }
+  return issued;
+}
+
+CallResult OperatorService::recordStart(uint64_t, const std::string& robot, const std::string& name) {
+  if (!recorder_) return invalid("record", robot, "the server records nothing (recording.enabled: false or --no-record)");
+  if (robot.empty()) return invalid("record", robot, "no robot selected");
+  try {
+    CallResult r;
+    r.outcome = CallOutcome::kCompleted;
+    r.action = "record start";
+    r.robot = robot;
+    r.reason = "recording run " + recorder_->start(robot, name);
+    return r;
+  } catch (const std::exception& e) {
+    return invalid("record", robot, e.what());
+  }
+}
+
+CallResult OperatorService::recordStop(uint64_t, const std::string& robot) {
+  if (!recorder_) return invalid("record", robot, "the server records nothing (recording.enabled: false or --no-record)");
+  if (robot.empty()) return invalid("record", robot, "no robot selected");
+  const auto id = recorder_->stop(robot, "stopped");
+  if (!id) return invalid("record", robot, robot + " is not recording");
+  CallResult r;
+  r.outcome = CallOutcome::kCompleted;
+  r.action = "record stop";
+  r.robot = robot;
+  r.reason = "run " + *id + " stopped";
+  return r;
+}
+
 std::optional<CallResult> OperatorService::settle(const PendingCall& p, int64_t now_ns) const {
   CallResult r;
   r.action = p.action;
@@ -266,6 +338,7 @@ std::optional<CallResult> OperatorService::settle(const PendingCall& p, int64_t 
     if (now_ns < p.deadline_ns) return std::nullopt;
     r.outcome = CallOutcome::kTimedOut;
     r.ack_timeout_s = options_.ack_timeout_s;
+    if (p.forget_run_map && recorder_) recorder_->setRunMap(p.robot, "");
     return r;
   }
   r.ack_status = ack->status();
@@ -283,6 +356,7 @@ std::optional<CallResult> OperatorService::settle(const PendingCall& p, int64_t 
       r.reason = "an Ack with an unknown status " + std::to_string(ack->status());
       break;
   }
+  if (p.forget_run_map && !r.ok() && recorder_) recorder_->setRunMap(p.robot, "");
   return r;
 }
 

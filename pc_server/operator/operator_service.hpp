@@ -21,8 +21,14 @@
 #include "pc_server/link/command_sink.hpp"
 #include "pc_server/link/robot_registry.hpp"
 #include "pc_server/operator/control_arbiter.hpp"
+#include "pc_server/operator/route_file.hpp"
 
 namespace inspect::server {
+
+class Recorder;
+namespace scene {
+class SiteMaps;
+}
 
 /// What became of a call.
 enum class CallOutcome {
@@ -59,6 +65,7 @@ struct PendingCall {
   uint64_t command_id = 0;
   int64_t deadline_ns = 0;
   std::string control_note;
+  bool forget_run_map = false;  // inspect: the run's pending map is forgotten if the robot does not take it
 };
 
 /// A call's first answer: done at once, or pending on the robot.
@@ -134,6 +141,28 @@ class OperatorService {
   CallResult takeControl(uint64_t session, const std::string& robot, bool force, int64_t now_ns);
   CallResult releaseControl(uint64_t session, const std::string& robot);
 
+  /// Where the run calls record and draw: the recorder (null: the server
+  /// records nothing) and the site maps of the live view (null: none). Set
+  /// before the first call.
+  void setRunContext(Recorder* recorder, scene::SiteMaps* site_maps);
+  Recorder* recorder() const { return recorder_; }
+
+  /// `route`: a route's points (GoTo) or its wheel test; the route's site
+  /// map is drawn for the robot once the command is sent. Needs control.
+  Issued route(uint64_t session, const std::string& robot, const Route& r, int64_t now_ns);
+  /// `inspect`: a recorded gas inspection round (docs/gas.md): the route with
+  /// the gas reaction and dwells, its map attached to the run the robot's
+  /// Ack starts (forgotten again when the robot does not take it). speed_m_s
+  /// overrides the route's, within (0, kMaxCommandSpeed_m_s]. Needs control.
+  Issued inspect(uint64_t session, const std::string& robot, Route r, std::optional<double> speed_m_s,
+                 int64_t now_ns);
+  /// `record start [name]` / `record stop`: a run of the robot's messages
+  /// (no control needed: recording moves nothing). kCompleted with reason
+  /// "recording run <id>" / "run <id> stopped"; kInvalid when the server
+  /// records nothing, the robot is (not) recording, or the run cannot start.
+  CallResult recordStart(uint64_t session, const std::string& robot, const std::string& name);
+  CallResult recordStop(uint64_t session, const std::string& robot);
+
   /// The result once the robot's Ack is in or the deadline passed; nullopt meanwhile.
   std::optional<CallResult> settle(const PendingCall& p, int64_t now_ns) const;
   /// Moves with every Ack: what a waiting caller may sleep on between settle() calls.
@@ -155,6 +184,8 @@ class OperatorService {
   CommandSink& sink_;
   ControlArbiter* control_;
   Options options_;
+  Recorder* recorder_ = nullptr;
+  scene::SiteMaps* site_maps_ = nullptr;
 };
 
 }  // namespace inspect::server

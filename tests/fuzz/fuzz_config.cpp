@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <string>
 
-#include "pc_server/console/route_file.hpp"
+#include "pc_server/operator/route_file.hpp"
 #include "pc_server/app/server_config.hpp"
 #include "robot_client/client_config.hpp"
 #include "shared/world/robot_map.hpp"

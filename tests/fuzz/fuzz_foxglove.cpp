@@ -10,6 +10,7 @@
 // point inside the input; the queue's byte count matches what it holds, the
 // control lane loses nothing, and no subscription gets a delta frame between
 // a drop and its next keyframe.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -118,6 +119,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
         // The response text is always valid JSON whatever the message.
         if (q.ok() && q.call == ServiceRequest::Call::kGoto)  // a typed call's numbers are finite (ranges: the service)
           require(std::isfinite(q.x_m) && std::isfinite(q.y_m) && (!q.speed_m_s || std::isfinite(*q.speed_m_s)));
+        // A route is one printable word; a run's name printable text without '#'.
+        if (q.ok() && (q.call == ServiceRequest::Call::kRoute || q.call == ServiceRequest::Call::kInspect))
+          require(!q.route.empty() && std::none_of(q.route.begin(), q.route.end(), [](unsigned char c) {
+            return c <= ' ' || c == 0x7f || c == '#';
+          }));
+        if (q.ok() && q.call == ServiceRequest::Call::kRecordStart)
+          require(std::none_of(q.name.begin(), q.name.end(), [](unsigned char c) { return c < ' ' || c == '#'; }));
         (void)serviceResponse(q.ok(), q.error + q.line);
         break;
       }

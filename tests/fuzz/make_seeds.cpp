@@ -20,7 +20,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "inspect_robot/v1/link.pb.h"
-#include "pc_server/console/route_file.hpp"
+#include "pc_server/operator/route_file.hpp"
 #include "robot_client/client_config.hpp"
 #include "shared/robot/robot_core.hpp"
 #include "shared/config/control_config.hpp"

@@ -369,6 +369,18 @@ async function main() {
   const resume = await a.call("/resume", {});
   check(resume.ok, `/resume: ${JSON.stringify(resume)}`);
   check(await until(() => a.mode() === MODE.IDLE, 2000), "telemetry did not show IDLE after /resume");
+  // Recording and routes are typed calls of the operator service as well.
+  const rec = await a.call("/record_start", { name: "foxglove check" });
+  check(rec.ok && new RegExp(`^${robot}: recording run \\S+$`).test(rec.message), `/record_start: ${JSON.stringify(rec)}`);
+  const recStop = await a.call("/record_stop", {});
+  check(recStop.ok && /^\S+: run \S+ stopped$/.test(recStop.message), `/record_stop: ${JSON.stringify(recStop)}`);
+  const recAgain = await a.call("/record_stop", {});
+  check(!recAgain.ok && /is not recording/.test(recAgain.message), `a second /record_stop: ${JSON.stringify(recAgain)}`);
+  const noRoute = await a.call("/route", { route: "no_such_route" });
+  check(!noRoute.ok && /^route: no route 'no_such_route'/.test(noRoute.message), `/route to no route: ${JSON.stringify(noRoute)}`);
+  const labRound = path.resolve(__dirname, "../../config/routes/gas_lab_inspection.yaml");
+  const fast = await a.call("/inspect", { route: labRound, speed: 3 });
+  check(!fast.ok && /speed_m_s '3' must be a number in \(0, 1\]/.test(fast.message), `/inspect too fast: ${JSON.stringify(fast)}`);
   const bad = await a.call("/goto", { x: "one" });
   check(!bad.ok && /number/.test(bad.message), `/goto with a bad request: ${JSON.stringify(bad)}`);
   const rel = await a.call("/control_release", {});

@@ -18,7 +18,7 @@
 
 #include "pc_server/console/console.hpp"
 #include "pc_server/operator/line_reader.hpp"
-#include "pc_server/console/route_file.hpp"
+#include "pc_server/operator/route_file.hpp"
 #include "pc_server/console/status_line.hpp"
 #include "shared/util/clock.hpp"
 #include "tests/pc_server/console/manual_clock.hpp"

@@ -39,12 +39,21 @@ TEST(BridgeServices, RequestsBecomeTypedCallsOrConsoleLines) {
   EXPECT_TRUE(r.urgent());
   EXPECT_TRUE(parseServiceRequest("/estop", "{}").urgent());
   EXPECT_EQ(parseServiceRequest("/resume", "{}").call, Call::kResume);
-  EXPECT_EQ(parseServiceRequest("/inspect", R"({"route": "gas_lab_inspection"})").line, "inspect gas_lab_inspection");
+  const auto inspect = parseServiceRequest("/inspect", R"({"route": "gas_lab_inspection", "speed": 0.4})");
+  EXPECT_EQ(inspect.call, Call::kInspect);
+  EXPECT_EQ(inspect.route, "gas_lab_inspection");
+  EXPECT_EQ(inspect.speed_m_s, 0.4);
+  EXPECT_EQ(parseServiceRequest("/route", R"({"route": "lab_loop"})").call, Call::kRoute);
+  EXPECT_EQ(parseServiceRequest("/route", R"({"route": "lab_loop"})").route, "lab_loop");
   const auto take = parseServiceRequest("/control_take", R"({"force": true})");
   EXPECT_EQ(take.call, Call::kControlTake);
   EXPECT_TRUE(take.force);
   EXPECT_EQ(parseServiceRequest("/control_release", "{}").call, Call::kControlRelease);
-  EXPECT_EQ(parseServiceRequest("/record_start", R"({"name": "night round B"})").line, "record start night round B");
+  const auto start = parseServiceRequest("/record_start", R"({"name": "night round B"})");
+  EXPECT_EQ(start.call, Call::kRecordStart);
+  EXPECT_EQ(start.name, "night round B");
+  EXPECT_EQ(parseServiceRequest("/record_start", "{}").name, "");
+  EXPECT_EQ(parseServiceRequest("/record_stop", "{}").call, Call::kRecordStop);
   EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status"})").call, Call::kConsoleLine);
   EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status"})").line, "status");
   // The urgent flag travels with the advertised service (the server's rate limit skips them).

@@ -4,9 +4,14 @@
 // the real registry when the test says so.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <variant>
 
 #include "pc_server/operator/operator_service.hpp"
+#include "pc_server/recording/recorder.hpp"
+#include "pc_server/scene/site_maps.hpp"
+#include "shared/util/clock.hpp"
+#include "tests/support/paths.hpp"
 
 using namespace inspect;
 using namespace inspect::server;
@@ -224,3 +229,81 @@ TEST_F(OperatorServiceTest, AForcedTakeOverStopsTheRobotAndNamesThePreviousHolde
 }
 
 }  // namespace
+
+TEST_F(OperatorServiceTest, ARouteSendsItsPointsNeedsControlAndDrawsItsMapOnceSent) {
+  scene::SiteMaps maps;
+  service_.setRunContext(nullptr, &maps);
+  const Route r = loadRouteText("name: loop\nspeed_m_s: 0.3\nmap: " +
+                                    inspect::test::srcPath("config/worlds/gas_lab.yaml") +
+                                    "\nwaypoints_m: [1, 0, 1, 1, 0, 1]\n",
+                                "loop.yaml");
+  const Issued refused_first = service_.route(bob_, "", r, now_);
+  EXPECT_EQ(done(refused_first).text(), "route: no robot selected");
+  const Issued sent = service_.route(alice_, "robot1", r, now_);
+  EXPECT_EQ(pending(sent).action, "route");
+  ASSERT_EQ(sink_.sent.size(), 1u);
+  const auto& g = sink_.sent[0].second.go_to();
+  EXPECT_EQ(g.points_size(), 3);
+  EXPECT_FALSE(g.inspection());
+  EXPECT_DOUBLE_EQ(g.speed_m_s(), 0.3);
+  EXPECT_NE(maps.get("robot1").version, 0u) << "the route's map is drawn for the robot";
+  const Issued refused = service_.route(bob_, "robot1", r, now_);
+  EXPECT_EQ(done(refused).outcome, CallOutcome::kRefused);
+  EXPECT_EQ(maps.get("robot2").version, 0u);
+  EXPECT_EQ(sink_.sent.size(), 1u);
+}
+
+TEST_F(OperatorServiceTest, InspectChecksItsSpeedAndSendsTheInspectionRound) {
+  const Route r = loadRouteText("name: round\npoints:\n  - {at: [1, 0], dwell_s: 2}\n  - {at: [2, 0]}\n", "round.yaml");
+  const Issued fast = service_.inspect(alice_, "robot1", r, 3.0, now_);
+  EXPECT_EQ(done(fast).text(), "inspect: speed_m_s '3' must be a number in (0, 1] m/s");
+  const Issued gone = service_.inspect(alice_, "robot9", r, std::nullopt, now_);
+  EXPECT_EQ(done(gone).text(), "inspect: robot9 is not connected");
+  const Route wheels = loadRouteText("name: wheels\nwheel_test: {standard: 2}\n", "wheels.yaml");
+  const Issued not_round = service_.inspect(alice_, "robot1", wheels, std::nullopt, now_);
+  EXPECT_EQ(done(not_round).text(), "inspect: 'wheels' is a wheel test, not an inspection route");
+  EXPECT_TRUE(sink_.sent.empty());
+
+  const Issued issued = service_.inspect(alice_, "robot1", r, 0.25, now_);
+  ASSERT_EQ(sink_.sent.size(), 1u);
+  const auto& g = sink_.sent[0].second.go_to();
+  EXPECT_TRUE(g.inspection());
+  EXPECT_DOUBLE_EQ(g.speed_m_s(), 0.25);
+  EXPECT_DOUBLE_EQ(g.points(0).dwell_s(), 2);
+  robotAnswers(issued, v1::Ack::ACCEPTED);
+  const auto result = service_.settle(pending(issued), now_);
+  ASSERT_TRUE(result);
+  EXPECT_EQ(result->text(), "robot1: inspect accepted");
+}
+
+TEST_F(OperatorServiceTest, RecordStartAndStopCompleteAtOnceWithTheRunsId) {
+  EXPECT_EQ(service_.recordStart(alice_, "robot1", "x").text(),
+            "record: the server records nothing (recording.enabled: false or --no-record)");
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("inspect-opsvc-" + std::to_string(::getpid()) + "-" +
+                                                    std::to_string(monoNowNs()));
+  {
+    RecordingConfig rc;
+    rc.dir = dir.string();
+    Recorder rec(rc, "test");
+    service_.setRunContext(&rec, nullptr);
+    EXPECT_EQ(service_.recordStart(alice_, "", "x").text(), "record: no robot selected");
+    // Recording moves nothing: an observer may record a robot another session controls.
+    (void)pending(service_.goTo(alice_, "robot1", 1, 1, std::nullopt, now_));
+    const CallResult started = service_.recordStart(bob_, "robot1", "night round");
+    ASSERT_EQ(started.outcome, CallOutcome::kCompleted) << started.text();
+    const auto id = rec.activeRun("robot1");
+    ASSERT_TRUE(id);
+    EXPECT_EQ(started.reason, "recording run " + *id);
+    EXPECT_EQ(rec.catalog().run(*id)->info.name, "night round");
+    const CallResult again = service_.recordStart(alice_, "robot1", "");
+    EXPECT_EQ(again.outcome, CallOutcome::kInvalid);
+    EXPECT_NE(again.reason.find("already"), std::string::npos) << again.reason;
+    const CallResult stopped = service_.recordStop(alice_, "robot1");
+    EXPECT_EQ(stopped.outcome, CallOutcome::kCompleted);
+    EXPECT_EQ(stopped.reason, "run " + *id + " stopped");
+    EXPECT_EQ(service_.recordStop(alice_, "robot1").text(), "record: robot1 is not recording");
+    service_.setRunContext(nullptr, nullptr);
+  }
+  fs::remove_all(dir);
+}

@@ -1,5 +1,5 @@
 #pragma once
-// Route files for the console's `route <file>` and `inspect <route>`
+// Route files for the operator's `route <file>` and `inspect <route>`
 // (config/routes/*.yaml): a name, an optional cruise speed, the site map the
 // points refer to, and the points in the robot's odometry frame - either as a
 // flat `waypoints_m` list or as `points` with inspection dwell times, camera
@@ -54,6 +54,14 @@ Route loadRouteText(const std::string& yaml, const std::string& name);
 /// `inspect`'s argument: a file path, or a name looked up as config/routes/<name>.yaml
 /// (relative to the working directory). Returns the path; throws config::ConfigError when none exists.
 std::string resolveRoute(const std::string& name_or_path);
+/// The route an operator names (`route`, `inspect`, the Foxglove /route and
+/// /inspect): a path (with a '/' or ending in .yaml) is read as given, with
+/// its own errors; a bare name is looked up as resolveRoute does. Throws config::ConfigError.
+Route openRoute(const std::string& name_or_path);
+/// The operator's line about a route about to be sent: "route 'lab_loop': 5
+/// points at 0.3 m/s", "inspection 'gas_lab': 9 points, 4 inspection points,
+/// map ...", "wheel test 'identification': 12 segments, 40.0 s of ...".
+std::string routeSummary(const Route& r, bool inspection);
 
 /// The WheelTest command body of a wheel-test route.
 v1::WheelTest wheelTestOf(const Route& r);

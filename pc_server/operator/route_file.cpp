@@ -1,9 +1,10 @@
-#include "pc_server/console/route_file.hpp"
+#include "pc_server/operator/route_file.hpp"
 
 #include <cmath>
 #include <sys/stat.h>
 
 #include "shared/config/config_node.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::server {
 
@@ -169,6 +170,24 @@ std::string resolveRoute(const std::string& name_or_path) {
   }
   throw config::ConfigError("no route '" + name_or_path + "': neither a file nor config/routes/" + name_or_path +
                             ".yaml");
+}
+
+Route openRoute(const std::string& name_or_path) {
+  const bool path = name_or_path.find('/') != std::string::npos || name_or_path.ends_with(".yaml");
+  return loadRouteFile(path ? name_or_path : resolveRoute(name_or_path));
+}
+
+std::string routeSummary(const Route& r, bool inspection) {
+  const std::string speed = r.speed_m_s > 0 ? " at " + util::fmtShort(r.speed_m_s) + " m/s" : std::string();
+  if (r.isWheelTest()) {
+    double total = 0.0;
+    for (const auto& g : r.wheel_test) total += g.duration_s;
+    return "wheel test '" + r.name + "': " + std::to_string(r.wheel_test.size()) + " segments, " +
+           util::fmtShort(total, 1) + " s of open-loop steps and chirps (identify <run> fits the plant afterwards)";
+  }
+  if (!inspection) return "route '" + r.name + "': " + std::to_string(r.points.size()) + " points" + speed;
+  return "inspection '" + r.name + "': " + std::to_string(r.points.size()) + " points, " +
+         std::to_string(r.inspectionPoints()) + " inspection points" + speed + (r.map.empty() ? "" : ", map " + r.map);
 }
 
 v1::WheelTest wheelTestOf(const Route& r) {
