@@ -77,31 +77,25 @@ bool Console::cmdAlarms(const Args& args, const std::string&, int) {
 
 bool Console::cmdAck(const Args& args, const std::string&, int) {
   if (args.size() != 1) return fail("ack", "syntax: ack <number>|all (alarms lists the numbers)");
-  const int64_t now = clock_->nowNs();
-  std::vector<AlarmRecord> done;
-  if (args[0] == "all") {
-    done = registry_.ackAllAlarms(now);
-    if (done.empty()) {
-      out_ << "ack: nothing to acknowledge\n";
-      return true;
-    }
-  } else {
+  std::optional<int> number;
+  if (args[0] != "all") {
     std::string n = args[0];
     if (!n.empty() && n[0] == '#') n.erase(0, 1);
     const auto pv = parseNumber(n);
     const double v = pv ? *pv : 0.0;
     if (!pv || v < 1 || v != std::floor(v) || v > 1e9)
       return fail("ack", "'" + args[0] + "' is not an alarm number (alarms lists them)");
-    const auto r = registry_.ackAlarm(static_cast<int>(v), now);
-    if (!r) return fail("ack", "no alarm #" + n + " (alarms lists them)");
-    done.push_back(*r);
+    number = static_cast<int>(v);
   }
-  for (const auto& r : done) {
-    const std::string text = "alarm #" + std::to_string(r.number) + " (" + r.alarm.channel_name() + " " +
-                             v1::GasAlarm::Level_Name(r.alarm.level()) + ") acknowledged by the operator";
-    out_ << r.robot_id << ": " << text << "\n";
-    if (recorder_) recorder_->noteAlarmAck(r.robot_id, r.alarm, text);
+  const auto acks = service_->acknowledgeAlarms(session_, number, clock_->nowNs());
+  if (!acks.error.empty()) {
+    if (!number) {  // nothing left to acknowledge is not an error
+      out_ << "ack: " << acks.error << "\n";
+      return true;
+    }
+    return fail("ack", acks.error);
   }
+  for (const auto& [r, text] : acks.acked) out_ << r.robot_id << ": " << text << "\n";
   return true;
 }
 

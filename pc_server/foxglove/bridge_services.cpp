@@ -88,6 +88,9 @@ const std::vector<ServiceDef>& serviceDefs() {
       {"/record_start", "inspect/RecordStart", schema(R"("name": {"type": "string", "description": "run name, optional"})"),
        "start recording a run"},
       {"/record_stop", "inspect/RecordStop", schema(""), "end the run being recorded"},
+      {"/alarm_ack", "inspect/AlarmAck",
+       schema(R"("number": {"type": "integer", "minimum": 1, "description": "the alarm's number (/alarms); omitted: every unacknowledged alarm"})"),
+       "acknowledge gas alarms"},
       {"/control_take", "inspect/ControlTake",
        schema(R"("force": {"type": "boolean", "description": "take over from another session"})"),
        "take control of the robot (motion needs it)"},
@@ -157,6 +160,13 @@ ServiceRequest parseServiceRequest(const std::string& service, std::string_view 
       r.name = text(j, "name");
     } else if (service == "/record_stop") {
       r.call = Call::kRecordStop;
+    } else if (service == "/alarm_ack") {
+      r.call = Call::kAlarmAck;
+      const double n = number(j, "number", false);
+      if (!std::isnan(n)) {
+        if (n < 1 || n > 1e9 || n != std::floor(n)) throw BadRequest{"\"number\" must be an alarm number (1, 2, ...)"};
+        r.alarm = static_cast<int>(n);
+      }
     } else if (service == "/control_take") {
       r.call = Call::kControlTake;
       r.force = flag(j, "force");

@@ -1,7 +1,7 @@
 #pragma once
 // The services a Foxglove client may call (docs/foxglove.md, "Services"):
 // JSON arguments decoded into a typed call of the operator service (stop,
-// e-stop, resume, go to, route, inspect, record, control), run in the
+// e-stop, resume, go to, route, inspect, record, alarm ack, control), run in the
 // client's own operator session with the same rules as the console (control,
 // limits, acks); /console as a console line of that session. Pure: JSON in,
 // the call out.
@@ -42,6 +42,7 @@ struct ServiceRequest {
     kInspect,
     kRecordStart,
     kRecordStop,
+    kAlarmAck,
     kControlTake,
     kControlRelease
   };
@@ -51,6 +52,7 @@ struct ServiceRequest {
   std::optional<double> speed_m_s;     // kGoto, kInspect
   std::string route;                   // kRoute, kInspect: a name in config/routes or a file
   std::string name;                    // kRecordStart: the run's name ("" = none)
+  std::optional<int> alarm;            // kAlarmAck: the alarm's number (nullopt = all unacknowledged)
   bool force = false;                  // kControlTake
   std::string line;   // kConsoleLine: e.g. "status"
   std::string error;

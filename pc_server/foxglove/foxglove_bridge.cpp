@@ -468,6 +468,20 @@ Issued FoxgloveBridge::issue(const ServiceRequest& req, uint64_t session, const 
     }
     case Call::kRecordStart: return service_.recordStart(session, robot, req.name);
     case Call::kRecordStop: return service_.recordStop(session, robot);
+    case Call::kAlarmAck: {
+      const auto acks = service_.acknowledgeAlarms(session, req.alarm, now);
+      CallResult r;
+      r.action = "ack";
+      r.reason = acks.error;
+      if (acks.error.empty()) {
+        r.outcome = CallOutcome::kCompleted;
+        r.robot = acks.acked.front().first.robot_id;
+        r.reason = acks.acked.front().second;
+        for (std::size_t i = 1; i < acks.acked.size(); ++i)
+          r.reason += "\n" + acks.acked[i].first.robot_id + ": " + acks.acked[i].second;
+      }
+      return r;
+    }
     case Call::kControlTake: return service_.takeControl(session, robot, req.force, now);
     case Call::kControlRelease: return service_.releaseControl(session, robot);
     case Call::kConsoleLine: break;

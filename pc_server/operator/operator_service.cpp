@@ -327,6 +327,26 @@ CallResult OperatorService::recordStop(uint64_t, const std::string& robot) {
   return r;
 }
 
+OperatorService::AlarmAcks OperatorService::acknowledgeAlarms(uint64_t, std::optional<int> number, int64_t now_ns) {
+  AlarmAcks out;
+  std::vector<AlarmRecord> done;
+  if (!number) {
+    done = registry_.ackAllAlarms(now_ns);
+    if (done.empty()) out.error = "nothing to acknowledge";
+  } else if (const auto r = registry_.ackAlarm(*number, now_ns)) {
+    done.push_back(*r);
+  } else {
+    out.error = "no alarm #" + std::to_string(*number) + " (alarms lists them)";
+  }
+  for (const auto& r : done) {
+    std::string text = "alarm #" + std::to_string(r.number) + " (" + r.alarm.channel_name() + " " +
+                       v1::GasAlarm::Level_Name(r.alarm.level()) + ") acknowledged by the operator";
+    if (recorder_) recorder_->noteAlarmAck(r.robot_id, r.alarm, text);
+    out.acked.emplace_back(r, std::move(text));
+  }
+  return out;
+}
+
 std::optional<CallResult> OperatorService::settle(const PendingCall& p, int64_t now_ns) const {
   CallResult r;
   r.action = p.action;

@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "inspect_robot/v1/link.pb.h"
 #include "pc_server/link/command_sink.hpp"
@@ -162,6 +163,17 @@ class OperatorService {
   /// records nothing, the robot is (not) recording, or the run cannot start.
   CallResult recordStart(uint64_t session, const std::string& robot, const std::string& name);
   CallResult recordStop(uint64_t session, const std::string& robot);
+
+  /// `ack <number>|all`: the operator acknowledges gas alarms (number
+  /// nullopt = every unacknowledged one), each noted in its robot's run.
+  /// Any session may (acknowledging moves nothing). The alarms acknowledged
+  /// and the line for each ("alarm #3 (H2S HIGH) acknowledged by the
+  /// operator"), or the reason nothing was ("no alarm #9 (alarms lists them)").
+  struct AlarmAcks {
+    std::vector<std::pair<AlarmRecord, std::string>> acked;
+    std::string error;
+  };
+  AlarmAcks acknowledgeAlarms(uint64_t session, std::optional<int> number, int64_t now_ns);
 
   /// The result once the robot's Ack is in or the deadline passed; nullopt meanwhile.
   std::optional<CallResult> settle(const PendingCall& p, int64_t now_ns) const;

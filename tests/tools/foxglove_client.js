@@ -238,7 +238,7 @@ async function main() {
   check(a.serverInfo && a.serverInfo.sessionId, "serverInfo has no sessionId");
   for (const t of ["telemetry", "events", "acks", "alarms", "camera", "camera_people", "tf", "scene", "log", "video_stats"])
     check([...a.channels.values()].some((c) => c.topic === `/${robot}/${t}`), `no channel /${robot}/${t}`);
-  for (const s of ["/stop", "/estop", "/resume", "/goto", "/route", "/inspect", "/record_start", "/record_stop",
+  for (const s of ["/stop", "/estop", "/resume", "/goto", "/route", "/inspect", "/record_start", "/record_stop", "/alarm_ack",
                    "/control_take", "/control_release"])
     check(a.services.has(s), `no service ${s}`);
   a.subscribeAll();
@@ -381,6 +381,8 @@ async function main() {
   const labRound = path.resolve(__dirname, "../../config/routes/gas_lab_inspection.yaml");
   const fast = await a.call("/inspect", { route: labRound, speed: 3 });
   check(!fast.ok && /speed_m_s '3' must be a number in \(0, 1\]/.test(fast.message), `/inspect too fast: ${JSON.stringify(fast)}`);
+  const noAlarm = await a.call("/alarm_ack", {});
+  check(!noAlarm.ok && noAlarm.message === "ack: nothing to acknowledge", `/alarm_ack without alarms: ${JSON.stringify(noAlarm)}`);
   const bad = await a.call("/goto", { x: "one" });
   check(!bad.ok && /number/.test(bad.message), `/goto with a bad request: ${JSON.stringify(bad)}`);
   const rel = await a.call("/control_release", {});

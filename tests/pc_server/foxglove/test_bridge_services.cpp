@@ -54,6 +54,9 @@ TEST(BridgeServices, RequestsBecomeTypedCallsOrConsoleLines) {
   EXPECT_EQ(start.name, "night round B");
   EXPECT_EQ(parseServiceRequest("/record_start", "{}").name, "");
   EXPECT_EQ(parseServiceRequest("/record_stop", "{}").call, Call::kRecordStop);
+  EXPECT_EQ(parseServiceRequest("/alarm_ack", R"({"number": 3})").alarm, 3);
+  EXPECT_EQ(parseServiceRequest("/alarm_ack", "{}").call, Call::kAlarmAck);
+  EXPECT_FALSE(parseServiceRequest("/alarm_ack", "{}").alarm);
   EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status"})").call, Call::kConsoleLine);
   EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status"})").line, "status");
   // The urgent flag travels with the advertised service (the server's rate limit skips them).
@@ -72,6 +75,8 @@ TEST(BridgeServices, NamesWhatIsWrong) {
             "/control_take: \"force\" must be true or false");
   EXPECT_EQ(parseServiceRequest("/console", R"({"command": "status\nestop"})").error,
             "/console: \"command\" must be one line without control characters");
+  EXPECT_EQ(parseServiceRequest("/alarm_ack", R"({"number": 1.5})").error,
+            "/alarm_ack: \"number\" must be an alarm number (1, 2, ...)");
   EXPECT_EQ(parseServiceRequest("/record_start", R"({"name": "a # b"})").error,
             "/record_start: \"name\" must be text of 1-200 printable characters without #");
 }

@@ -307,3 +307,28 @@ TEST_F(OperatorServiceTest, RecordStartAndStopCompleteAtOnceWithTheRunsId) {
   }
   fs::remove_all(dir);
 }
+
+TEST_F(OperatorServiceTest, AnySessionAcknowledgesAlarmsByNumberOrAll) {
+  const auto raise = [&](uint64_t id, const std::string& ch) {
+    v1::Event e;
+    e.set_kind(v1::Event::ALARM_RAISED);
+    auto* a = e.mutable_gas_alarm();
+    a->set_id(id);
+    a->set_channel_name(ch);
+    a->set_level(v1::GasAlarm::HIGH);
+    a->set_active(true);
+    registry_.onEvent("robot1", kLinkSerial, e, now_);
+  };
+  EXPECT_EQ(service_.acknowledgeAlarms(bob_, std::nullopt, now_).error, "nothing to acknowledge");
+  raise(1, "CH4");
+  raise(2, "H2S");
+  EXPECT_EQ(service_.acknowledgeAlarms(bob_, 9, now_).error, "no alarm #9 (alarms lists them)");
+  const auto one = service_.acknowledgeAlarms(bob_, 2, now_);
+  ASSERT_EQ(one.acked.size(), 1u);
+  EXPECT_EQ(one.acked[0].first.robot_id, "robot1");
+  EXPECT_EQ(one.acked[0].second, "alarm #2 (H2S HIGH) acknowledged by the operator");
+  const auto rest = service_.acknowledgeAlarms(alice_, std::nullopt, now_);
+  ASSERT_EQ(rest.acked.size(), 1u) << "#2 was acknowledged already";
+  EXPECT_EQ(rest.acked[0].first.number, 1);
+  EXPECT_TRUE(sink_.sent.empty()) << "acknowledging sends the robot nothing";
+}
