@@ -312,40 +312,23 @@ void Recorder::noteLocked(Run& r, const std::string& robot, const std::string& t
                      kind, text);
 }
 
-void Recorder::onEnvelope(const std::string& robot, const std::string& address, const v1::Envelope& env,
-                          bool inbound, uint64_t time_us) {
-  std::lock_guard lk(mu_);
-  auto it = runs_.find(robot);
-  if (!inbound && env.has_command() && it == runs_.end() && config_.auto_start) {
-    const auto& c = env.command();
-    std::string name;
-    if (c.has_track()) name = "track";
-    if (c.has_wheel_test()) name = "identification " + c.wheel_test().name();
-    if (c.has_go_to())
-      name = c.go_to().name().empty() ? "goto"
-                                      : (c.go_to().inspection() ? "inspection " : "route ") + c.go_to().name();
-    if (!name.empty()) {
-      try {
-        startLocked(robot, name,
-                    c.has_go_to() ? c.go_to().name() : c.has_wheel_test() ? c.wheel_test().name() : "", c.id());
-        it = runs_.find(robot);
-      } catch (const std::exception& e) {
-        log::error(log::tag::kRecord, robot, ": cannot start a run: ", e.what());
-      }
-    }
+void Recorder::autoStartLocked(const std::string& robot, const v1::Command& c) {
+  std::string name;
+  if (c.has_track()) name = "track";
+  if (c.has_wheel_test()) name = "identification " + c.wheel_test().name();
+  if (c.has_go_to())
+    name = c.go_to().name().empty() ? "goto" : (c.go_to().inspection() ? "inspection " : "route ") + c.go_to().name();
+  if (name.empty()) return;
+  try {
+    startLocked(robot, name, c.has_go_to() ? c.go_to().name() : c.has_wheel_test() ? c.wheel_test().name() : "",
+                c.id());
+  } catch (const std::exception& e) {
+    log::error(log::tag::kRecord, robot, ": cannot start a run: ", e.what());
   }
-  // When it happened: the receive time, or for an event or ack the robot
-  // stored during an outage its own time (store-and-forward).
-  const uint64_t log_ns = monoUsToWallNs(time_us);
-  const auto when = std::chrono::system_clock::time_point(
-      std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::nanoseconds(log_ns)));
-  // A stored entry from before the current run (or from a run that has
-  // ended) is filed in the catalog under the run recording then; that run's
-  // MCAP is closed and is not reopened (docs/store-and-forward.md).
-  const bool in_open_run = it != runs_.end() && !(inbound && when < it->second->info.start);
-  const std::string run_id = in_open_run             ? it->second->info.id
-                             : inbound && isLate(env) ? runAt(robot, when)
-                                                      : std::string();
+}
+
+void Recorder::catalogAlarmLocked(const std::string& robot, const v1::Envelope& env, bool inbound,
+                                       const std::string& run_id, catalog::Time when) {
   // Gas alarms go into the catalog during runs and outside them.
   if (inbound && env.has_event() && env.event().has_gas_alarm()) {
     const auto& a = env.event().gas_alarm();
@@ -356,6 +339,75 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
       log::error(log::tag::kRecord, robot, ": alarm not in the catalog: ", e.what());
     }
   }
+}
+
+void Recorder::recordTelemetryLocked(Run& r, const std::string& robot, const v1::Envelope& env, uint64_t time_us,
+                                     uint64_t log_ns) {
+  const auto& t = env.telemetry();
+  // A telemetry gap (the link was down, or the robot silent) is marked in the run.
+  if (r.last_telemetry_ns && log_ns > r.last_telemetry_ns + kTelemetryGapNs) {
+    const double gap_s = static_cast<double>(log_ns - r.last_telemetry_ns) * 1e-9;
+    noteLocked(r, robot, "telemetry gap: " + fmtShort(gap_s, 2) + " s without telemetry from " + robot, "gap", log_ns);
+  }
+  r.last_telemetry_ns = std::max(r.last_telemetry_ns, log_ns);
+  r.stats.add(t);
+  // The gains in force, as soon as the robot tracks with them.
+  if (!r.gains_known && t.mode() == v1::TRACKING && !t.track_controller().empty()) {
+    // The full set (from Hello / GAINS_APPLIED) keeps its values; the
+    // controller, and kp/ki/kd for robots that announce no set, come from telemetry.
+    const auto from_t = nlohmann::json::parse(gainsJson(t), nullptr, false);
+    if (from_t.is_object())
+      for (const auto& [k, v] : from_t.items())
+        if (!r.gains.contains(k)) r.gains[k] = v;
+    catalog_->setGains(r.info.id, r.gains.dump());
+    r.gains_known = true;
+  }
+  r.mcap.write(r.ch_telemetry, log_ns, env.send_time_us() * 1000, t);
+  r.scene->onTelemetry(t);
+  if (const auto capture_ns = r.people_clock.fresh(
+          t, static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us()), monoUsToWallNs)) {
+    r.mcap.write(r.ch_camera_people, log_ns, *capture_ns,
+                 scene::cameraPeople(t.perception(), t.video().width(), t.video().height(), *capture_ns));
+  }
+  writeScene(r, robot, log_ns, true);
+}
+
+void Recorder::recordEventLocked(Run& r, const std::string& robot, const v1::Event& e, uint64_t publish_ns,
+                                 uint64_t log_ns, catalog::Time when) {
+  r.mcap.write(r.ch_event, log_ns, publish_ns, e);
+  r.scene->onEvent(e);
+  r.mcap.write(r.ch_log, log_ns, log_ns, scene::RobotScene::log(robot, e, log_ns));
+  if (e.kind() == v1::Event::GAINS_APPLIED && e.has_gains()) {
+    // New gains during the run: the catalog keeps the latest set and counts the changes.
+    const std::string controller = r.gains.value("controller", "");
+    const int changes = r.gains.value("changes_in_run", 0) + 1;
+    r.gains = nlohmann::json::parse(runGainsJson(e.gains(), e.gains_version()));
+    if (!controller.empty()) r.gains["controller"] = controller;
+    r.gains["changes_in_run"] = changes;
+    catalog_->setGains(r.info.id, r.gains.dump());
+  }
+  catalog_->addEvent(r.info.id, robot, when, v1::Event::Kind_Name(e.kind()), e.text());
+}
+
+void Recorder::onEnvelope(const std::string& robot, const std::string& address, const v1::Envelope& env,
+                          bool inbound, uint64_t time_us) {
+  std::lock_guard lk(mu_);
+  if (!inbound && env.has_command() && config_.auto_start && !runs_.contains(robot))
+    autoStartLocked(robot, env.command());
+  const auto it = runs_.find(robot);
+  // When it happened: the receive time, or for an event or ack the robot
+  // stored during an outage its own time (store-and-forward).
+  const uint64_t log_ns = monoUsToWallNs(time_us);
+  const auto when = catalog::Time(
+      std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::nanoseconds(log_ns)));
+  // A stored entry from before the current run (or from a run that has
+  // ended) is filed in the catalog under the run recording then; that run's
+  // MCAP is closed and is not reopened (docs/store-and-forward.md).
+  const bool in_open_run = it != runs_.end() && !(inbound && when < it->second->info.start);
+  const std::string run_id = in_open_run             ? it->second->info.id
+                             : inbound && isLate(env) ? runAt(robot, when)
+                                                      : std::string();
+  catalogAlarmLocked(robot, env, inbound, run_id, when);
   if (!in_open_run) {
     if (inbound && env.has_event() && !run_id.empty()) {
       try {
@@ -376,58 +428,13 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
   const uint64_t publish_ns = env.send_time_us() * 1000;  // the sender's clock
   try {
     switch (env.body_case()) {
-      case v1::Envelope::kTelemetry:
-        // A telemetry gap (the link was down, or the robot silent) is marked in the run.
-        if (r.last_telemetry_ns && log_ns > r.last_telemetry_ns + kTelemetryGapNs) {
-          const double gap_s = static_cast<double>(log_ns - r.last_telemetry_ns) * 1e-9;
-          noteLocked(r, robot, "telemetry gap: " + fmtShort(gap_s, 2) + " s without telemetry from " + robot, "gap",
-                     log_ns);
-        }
-        r.last_telemetry_ns = std::max(r.last_telemetry_ns, log_ns);
-        r.stats.add(env.telemetry());
-        // The gains in force, as soon as the robot tracks with them.
-        if (!r.gains_known && env.telemetry().mode() == v1::TRACKING && !env.telemetry().track_controller().empty()) {
-          const auto& t = env.telemetry();
-          // The full set (from Hello / GAINS_APPLIED) keeps its values; the
-          // controller, and kp/ki/kd for robots that announce no set, come from telemetry.
-          const auto from_t = nlohmann::json::parse(gainsJson(t), nullptr, false);
-          if (from_t.is_object())
-            for (const auto& [k, v] : from_t.items())
-              if (!r.gains.contains(k)) r.gains[k] = v;
-          catalog_->setGains(r.info.id, r.gains.dump());
-          r.gains_known = true;
-        }
-        r.mcap.write(r.ch_telemetry, log_ns, publish_ns, env.telemetry());
-        r.scene->onTelemetry(env.telemetry());
-        if (const auto capture_ns = r.people_clock.fresh(
-                env.telemetry(), static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us()),
-                monoUsToWallNs)) {
-          const auto& t = env.telemetry();
-          r.mcap.write(r.ch_camera_people, log_ns, *capture_ns,
-                       scene::cameraPeople(t.perception(), t.video().width(), t.video().height(), *capture_ns));
-        }
-        writeScene(r, robot, log_ns, true);
-        break;
+      case v1::Envelope::kTelemetry: recordTelemetryLocked(r, robot, env, time_us, log_ns); break;
       case v1::Envelope::kCommand:
         r.mcap.write(r.ch_command, log_ns, publish_ns, env.command());
         r.scene->onCommand(env.command());
         break;
       case v1::Envelope::kAck: r.mcap.write(r.ch_ack, log_ns, publish_ns, env.ack()); break;
-      case v1::Envelope::kEvent:
-        r.mcap.write(r.ch_event, log_ns, publish_ns, env.event());
-        r.scene->onEvent(env.event());
-        r.mcap.write(r.ch_log, log_ns, log_ns, scene::RobotScene::log(robot, env.event(), log_ns));
-        if (env.event().kind() == v1::Event::GAINS_APPLIED && env.event().has_gains()) {
-          // New gains during the run: the catalog keeps the latest set and counts the changes.
-          const std::string controller = r.gains.value("controller", "");
-          const int changes = r.gains.value("changes_in_run", 0) + 1;
-          r.gains = nlohmann::json::parse(runGainsJson(env.event().gains(), env.event().gains_version()));
-          if (!controller.empty()) r.gains["controller"] = controller;
-          r.gains["changes_in_run"] = changes;
-          catalog_->setGains(r.info.id, r.gains.dump());
-        }
-        catalog_->addEvent(r.info.id, robot, when, v1::Event::Kind_Name(env.event().kind()), env.event().text());
-        break;
+      case v1::Envelope::kEvent: recordEventLocked(r, robot, env.event(), publish_ns, log_ns, when); break;
       default: break;
     }
   } catch (const std::exception& e) {

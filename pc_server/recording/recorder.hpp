@@ -93,6 +93,15 @@ class Recorder {
   /// `wall_ns` (0 = now).
   void noteLocked(Run& r, const std::string& robot, const std::string& text, const std::string& kind = "server",
                   uint64_t wall_ns = 0);
+  /// A run started by a command the server sends (config auto_start): track, go-to, a wheel test.
+  void autoStartLocked(const std::string& robot, const v1::Command& c);
+  /// A gas alarm goes into the catalog whether or not a run records it (run_id "" = none).
+  void catalogAlarmLocked(const std::string& robot, const v1::Envelope& env, bool inbound,
+                               const std::string& run_id, catalog::Time when);
+  void recordTelemetryLocked(Run& r, const std::string& robot, const v1::Envelope& env, uint64_t time_us,
+                             uint64_t log_ns);
+  void recordEventLocked(Run& r, const std::string& robot, const v1::Event& e, uint64_t publish_ns, uint64_t log_ns,
+                         catalog::Time when);
   /// A stored event or ack the robot sent late (store-and-forward).
   static bool isLate(const v1::Envelope& env);
   /// The id of the robot's run recording at `t` (catalog), "" = none.

@@ -247,33 +247,30 @@ void RobotScene::onEvent(const v1::Event& e) {
   return out;
 }
 
-::foxglove::SceneUpdate RobotScene::scene(uint64_t ns) const {
-  ::foxglove::SceneUpdate u;
+void RobotScene::addMap(::foxglove::SceneUpdate& u, uint64_t ns) const {
   // The site map, in the world frame: always sent (empty without a map), so a
   // map that is taken away or changed leaves nothing of the old one drawn.
-  {
-    auto* walls = entity(u, "map/walls", "map", ns);
-    auto* obst = entity(u, "map/obstacles", "map", ns);
-    auto* fl = entity(u, "map/floor_lines", "map", ns);
-    if (map_) {
-      for (const auto& s : map_->walls) addWall(walls, s, kWallHeightM, 0.06, {0.72, 0.72, 0.76, 0.9});
-      for (const auto& s : map_->obstacles) addWall(obst, s, kObstacleHeightM, 0.04, {0.55, 0.42, 0.30, 0.95});
-      if (!map_->floor_lines.empty()) {
-        auto* l = fl->add_lines();
-        l->set_type(::foxglove::LinePrimitive::LINE_LIST);
-        setPose(l->mutable_pose(), 0, 0, 0.005);
-        l->set_thickness(0.03);
-        setColor(l->mutable_color(), 0.1, 0.1, 0.1, 1);
-        for (const auto& s : map_->floor_lines) {
-          addPoint(l, s.a.x, s.a.y, 0);
-          addPoint(l, s.b.x, s.b.y, 0);
-        }
+  auto* walls = entity(u, "map/walls", "map", ns);
+  auto* obst = entity(u, "map/obstacles", "map", ns);
+  auto* fl = entity(u, "map/floor_lines", "map", ns);
+  if (map_) {
+    for (const auto& s : map_->walls) addWall(walls, s, kWallHeightM, 0.06, {0.72, 0.72, 0.76, 0.9});
+    for (const auto& s : map_->obstacles) addWall(obst, s, kObstacleHeightM, 0.04, {0.55, 0.42, 0.30, 0.95});
+    if (!map_->floor_lines.empty()) {
+      auto* l = fl->add_lines();
+      l->set_type(::foxglove::LinePrimitive::LINE_LIST);
+      setPose(l->mutable_pose(), 0, 0, 0.005);
+      l->set_thickness(0.03);
+      setColor(l->mutable_color(), 0.1, 0.1, 0.1, 1);
+      for (const auto& s : map_->floor_lines) {
+        addPoint(l, s.a.x, s.a.y, 0);
+        addPoint(l, s.b.x, s.b.y, 0);
       }
     }
   }
-  if (!have_telemetry_) return u;
-  const auto& t = last_;
+}
 
+void RobotScene::addBody(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const {
   // The robot's body, heading and status, following base_link.
   auto* body = entity(u, "robot/body", frame("base_link"), ns, true);
   auto* cyl = body->add_cylinders();
@@ -295,7 +292,9 @@ void RobotScene::onEvent(const v1::Event& e) {
   status += t.has_v_m_s() ? " " + fmt(t.v_m_s()) + " m/s" : " speed unknown";
   if (t.has_speed_factor() && t.speed_factor() < 0.999) status += " x" + fmt(t.speed_factor());
   addText(body, status, 0, 0, g_.body_height_m + 0.35);
+}
 
+void RobotScene::addSonars(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const {
   // The four sonar beams to their ranges (no echo: a faint cone to the maximum range).
   for (int i = 0; i < 4; ++i) {
     const double r = i < t.ultrasonic_m_size() ? t.ultrasonic_m(i) : -1;
@@ -316,7 +315,9 @@ void RobotScene::onEvent(const v1::Event& e) {
     setColor(tri->mutable_color(), 0.3 + 0.7 * near, 0.8 - 0.6 * near, 0.3, echo ? 0.35 : 0.08);
     if (echo) addText(e, fmt(r) + " m", range, 0, 0.1, 0.12);
   }
+}
 
+void RobotScene::addPeople(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const {
   // Tracked people (odometry frame): an upright figure, velocity, pattern, proxemic rings.
   auto* people = entity(u, "people", frame("odom"), ns);
   for (const auto& p : t.people()) {
@@ -358,7 +359,9 @@ void RobotScene::onEvent(const v1::Event& e) {
       }
     }
   }
+}
 
+void RobotScene::addCameraPeople(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const {
   // The camera's detections of the latest picture (robot frame): a ray along each bearing from
   // the lens, to the feet when the range is known, else dimmed to kBearingRayM.
   auto* seen = entity(u, "camera_people", frame("base_link"), ns);
@@ -380,7 +383,9 @@ void RobotScene::onEvent(const v1::Event& e) {
               x1, y1, 0.3, 0.14);
     }
   }
+}
 
+void RobotScene::addRoute(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const {
   // The route and its goals (odometry frame), labelled; reached goals dimmed.
   auto* route = entity(u, "route", frame("odom"), ns);
   if (!route_.empty()) {
@@ -406,7 +411,9 @@ void RobotScene::onEvent(const v1::Event& e) {
       addText(route, label, g.x_m(), g.y_m(), 0.4, 0.15);
     }
   }
+}
 
+void RobotScene::addAlarms(::foxglove::SceneUpdate& u, uint64_t ns) const {
   // Gas alarms where they were raised (odometry frame): red while raised, grey once cleared.
   auto* alarms = entity(u, "gas/alarms", frame("odom"), ns);
   for (const auto& [id, a] : alarms_) {
@@ -427,6 +434,19 @@ void RobotScene::onEvent(const v1::Event& e) {
     if (!a.active) text += " (cleared)";
     addText(alarms, text, x, y, 2.2, 0.16);
   }
+}
+
+::foxglove::SceneUpdate RobotScene::scene(uint64_t ns) const {
+  ::foxglove::SceneUpdate u;
+  addMap(u, ns);
+  if (!have_telemetry_) return u;
+  const auto& t = last_;
+  addBody(u, t, ns);
+  addSonars(u, t, ns);
+  addPeople(u, t, ns);
+  addCameraPeople(u, t, ns);
+  addRoute(u, t, ns);
+  addAlarms(u, ns);
   return u;
 }
 

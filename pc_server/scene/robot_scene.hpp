@@ -93,6 +93,15 @@ class RobotScene {
   static ::foxglove::Log log(const std::string& robot, const v1::Event& e, uint64_t ns);
 
  private:
+  // The parts of scene(), each its own entities.
+  /// The site map, in the world frame: always sent (empty without a map).
+  void addMap(::foxglove::SceneUpdate& u, uint64_t ns) const;
+  void addBody(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const;
+  void addSonars(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const;
+  void addPeople(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const;
+  void addCameraPeople(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const;
+  void addRoute(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const;
+  void addAlarms(::foxglove::SceneUpdate& u, uint64_t ns) const;
   struct Channel {
     v1::GasChannelInfo info;
     gas::LiveConcentrationMap map;

@@ -367,34 +367,32 @@ std::string comparisonTable(const Comparison& c) {
   return os.str();
 }
 
-SessionFiles writeTuningSession(const std::string& dir, const TuneSetup& setup, const TuneResult& result,
-                                const Comparison& c, const fuzzy::Fis& fis) {
-  SessionFiles out;
-  out.dir = dir;
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw std::runtime_error("cannot create " + dir + ": " + ec.message());
-  const fs::path d(dir);
+namespace {
 
-  // Tuned gains, with the fuzzy system they belong to.
+/// The plots drawn: file, what it shows.
+using Drawn = std::vector<std::pair<std::string, std::string>>;
+
+/// Tuned gains, with the fuzzy system they belong to: gains_tuned.yaml and .fis.
+void writeTunedGains(const fs::path& d, const TuneSetup& setup, const TuneResult& result, const Comparison& c,
+                     const fuzzy::Fis& fis, SessionFiles& out) {
   const fs::path yaml = d / "gains_tuned.yaml";
-  {
-    std::ostringstream comment;
-    comment << "Tracking gains tuned by pc_server's tuner (docs/tuning.md).\n"
-            << "Reference: " << c.reference << "\nPlant: " << c.plant_description << "\n"
-            << "Tuned: ";
-    for (std::size_t i = 0; i < setup.params.size(); ++i) comment << (i ? ", " : "") << setup.params[i];
-    comment << "; cost " << fmtG(result.initial_eval.cost) << " -> " << fmtG(result.best_eval.cost) << " after "
-            << result.evals << " evaluations (" << result.algorithm << (result.cancelled ? ", cancelled" : "") << ")";
-    config::exportGains(result.best, fis, yaml.string(), comment.str());
-    out.files.push_back((d / "gains_tuned.fis").string());
-    out.files.push_back(yaml.string());
-  }
+  std::ostringstream comment;
+  comment << "Tracking gains tuned by pc_server's tuner (docs/tuning.md).\n"
+          << "Reference: " << c.reference << "\nPlant: " << c.plant_description << "\n"
+          << "Tuned: ";
+  for (std::size_t i = 0; i < setup.params.size(); ++i) comment << (i ? ", " : "") << setup.params[i];
+  comment << "; cost " << fmtG(result.initial_eval.cost) << " -> " << fmtG(result.best_eval.cost) << " after "
+          << result.evals << " evaluations (" << result.algorithm << (result.cancelled ? ", cancelled" : "") << ")";
+  config::exportGains(result.best, fis, yaml.string(), comment.str());
+  out.files.push_back((d / "gains_tuned.fis").string());
+  out.files.push_back(yaml.string());
+}
 
-  writeText(d / "traces.csv", tracesCsv(c), out);
-
-  // Plots; a failure keeps the script with its data and says why.
-  std::vector<std::pair<std::string, std::string>> drawn;  // file, what it shows
+/// The session's plots; a failure keeps the script with its data and says why (a note).
+Drawn drawSessionPlots(const fs::path& d, const TuneSetup& setup, const TuneResult& result, const Comparison& c,
+                       SessionFiles& out) {
+  Drawn drawn;
+  std::error_code ec;
   const auto draw = [&](const std::string& file, const std::vector<plot::Panel>& panels, const std::string& what,
                         int width_px, int height_px) {
     const std::string png = (d / file).string();
@@ -428,139 +426,159 @@ SessionFiles writeTuningSession(const std::string& dir, const TuneSetup& setup, 
     draw("cost_history.png", {costPanel(result)}, "best cost after each evaluation", 1000, 450);
   else
     out.notes.push_back("cost_history.png not drawn: no evaluations");
+  return drawn;
+}
 
-  // results.json: the same figures, machine-readable.
+/// results.json: the session's figures, machine-readable.
+std::string sessionResultsJson(const TuneSetup& setup, const TuneResult& result, const Comparison& c, int scenarios,
+                               const Drawn& drawn, const std::vector<std::string>& notes) {
+  Json j;
+  j["reference"] = c.reference;
+  j["plant"] = {{"left", wheelJson(setup.plant.left)},
+                {"right", wheelJson(setup.plant.right)},
+                {"description", c.plant_description}};
+  Json params = Json::array();
+  for (const auto& name : setup.params) {
+    const auto [lo, hi] = boundsOf(setup, name);
+    params.push_back({{"name", name},
+                      {"lower", lo},
+                      {"upper", hi},
+                      {"initial", numberOrNull(control::gainValue(result.initial, name))},
+                      {"best", numberOrNull(control::gainValue(result.best, name))}});
+  }
+  j["params"] = params;
+  const auto& w = setup.weights;
+  j["cost_weights"] = {{"max_pos", w.max_pos},         {"rms_pos", w.rms_pos}, {"max_ang", w.max_ang},
+                       {"rms_ang", w.rms_ang},         {"convergence", w.convergence},
+                       {"effort", w.effort},           {"saturation", w.saturation}};
+  j["scenarios"] = {{"count", scenarios},
+                    {"plant_variations", setup.plant_variations},
+                    {"seeds", setup.seeds},
+                    {"gain_spread", setup.gain_spread},
+                    {"tau_spread", setup.tau_spread},
+                    {"dead_spread_s", setup.dead_spread_s},
+                    {"seed", setup.seed}};
+  j["algorithm"] = result.algorithm;
+  j["max_evals"] = setup.max_evals;
+  j["global_fraction"] = setup.global_fraction;
+  j["evals"] = result.evals;
+  j["wall_s"] = result.wall_s;
+  j["cancelled"] = result.cancelled;
+  j["initial"] = {{"cost", numberOrNull(result.initial_eval.cost)}, {"gains", gainsObject(result.initial)}};
+  j["best"] = {{"cost", numberOrNull(result.best_eval.cost)}, {"gains", gainsObject(result.best)}};
+  Json rows = Json::array();
+  for (const auto& row : c.rows) {
+    Json r;
+    r["label"] = row.label;
+    r["controller"] = control::toString(row.wheel_control);
+    r["gains"] = gainsObject(row.gains);
+    r["cost"] = numberOrNull(row.eval.cost);
+    r["scenarios"] = row.eval.scenarios;
+    Json table_row;
+    for (const auto& m : kRows) table_row[m.key] = numberOrNull(m.value(row));  // null: not converged
+    for (const auto& m : kRobustRows) table_row[m.key] = numberOrNull(m.value(row));
+    r["table"] = table_row;
+    r["nominal_trace"] = metricsJson(row.trace.metrics);
+    r["mean"] = metricsJson(row.eval.mean);
+    r["worst"] = metricsJson(row.eval.worst);
+    rows.push_back(std::move(r));
+  }
+  j["comparison"] = rows;
+  j["convergence_bands"] = {{"position_m", kLoopDefaults.settle_position_m},
+                            {"angle_rad", kLoopDefaults.settle_angle_rad}};
+  Json hist = Json::array();
+  for (const double v : result.best_cost_history) hist.push_back(numberOrNull(v));
+  j["best_cost_history"] = hist;
+  j["plots"] = Json::array();
+  for (const auto& [file, what] : drawn) j["plots"].push_back(file);
+  j["notes"] = notes;
+  return j.dump(2) + "\n";
+}
+
+/// summary.md: the session for people.
+std::string sessionSummaryMd(const TuneSetup& setup, const TuneResult& result, const Comparison& c, int scenarios,
+                             const std::string& table, const Drawn& drawn, const std::vector<std::string>& notes) {
+  std::ostringstream md;
+  md << "# Tuning session\n\n## Set-up\n\n";
+  md << "- Reference: " << c.reference << " (start (0, 0, 0))\n";
+  md << "- Plant tuned for: left wheel " << describeWheel(setup.plant.left) << "; right wheel "
+     << describeWheel(setup.plant.right) << "\n";
+  md << "- Scenarios per evaluation: " << describeScenarios(setup, scenarios) << "; seed " << setup.seed << "\n";
+  md << "- Algorithm: " << (result.algorithm.empty() ? "-" : result.algorithm) << "; evaluations: " << result.evals
+     << " of at most " << setup.max_evals << " (global share " << fmtG(setup.global_fraction) << "); wall time "
+     << fmtOrNotConverged(result.wall_s, 1) << " s; " << (result.cancelled ? "**cancelled** (best so far kept)" : "not cancelled")
+     << "\n";
+  md << "- Cost: " << fmtG(result.initial_eval.cost) << " (initial gains) -> " << fmtG(result.best_eval.cost)
+     << " (best)";
+  if (result.initial_eval.cost > 0 && std::isfinite(result.initial_eval.cost))
+    md << ", " << fmtOrNotConverged(100.0 * (result.initial_eval.cost - result.best_eval.cost) / result.initial_eval.cost, 1)
+       << " % lower";
+  md << "\n\n";
+
+  md << "### Parameters and bounds\n\n| parameter | lower | upper | initial | best |\n|---|---|---|---|---|\n";
+  for (const auto& name : setup.params) {
+    const auto [lo, hi] = boundsOf(setup, name);
+    md << "| " << name << " | " << fmtG(lo) << " | " << fmtG(hi) << " | "
+       << fmtG(control::gainValue(result.initial, name)) << " | " << fmtG(control::gainValue(result.best, name))
+       << " |\n";
+  }
+  const auto& w = setup.weights;
+  md << "\n### Cost weights\n\nEach term is normalised by its scale (pc_server/tuning/tuner.hpp `CostWeights`); "
+        "the cost of an evaluation is the mean over the scenarios plus the worst one.\n\n"
+        "| term | scale | weight |\n|---|---|---|\n"
+     << "| max position error | 0.05 m | " << fmtG(w.max_pos) << " |\n"
+     << "| RMS position error | 0.01 m | " << fmtG(w.rms_pos) << " |\n"
+     << "| max angle error | 0.05 rad | " << fmtG(w.max_ang) << " |\n"
+     << "| RMS angle error | 0.01 rad | " << fmtG(w.rms_ang) << " |\n"
+     << "| convergence (position + angle) / 2 | 10 s | " << fmtG(w.convergence) << " |\n"
+     << "| max(0, effort / the reference's own effort - 1) | 1 | " << fmtG(w.effort) << " |\n"
+     << "| fraction of the run saturated | 0.1 | " << fmtG(w.saturation) << " |\n"
+     << "\nPlus 50 for each of position and angle still outside its band at the end of a run; a diverged run "
+        "(max position error over 1 m, or a non-finite figure) costs 10^4 or more.\n";
+
+  md << "\n## Comparison\n\nNominal rows: the plant above, noise seed 1 (the plotted runs). Convergence: the time "
+        "after which the error stays within the band (position "
+     << fmtG(kLoopDefaults.settle_position_m) << " m, angle " << fmtG(kLoopDefaults.settle_angle_rad)
+     << " rad) to the end; `not conv.` if it ends outside. Effort = integral of (u_l^2 + u_r^2) dt; saturation "
+        "time = time with a wheel command at the limit.\n\n```\n"
+     << table << "```\n\n";
+
+  md << "## Gains\n\n| gain | initial | best | |\n|---|---|---|---|\n";
+  for (const char* name : control::kGainNames) {
+    const double a = control::gainValue(result.initial, name), b = control::gainValue(result.best, name);
+    md << "| " << name << " | " << fmtG(a) << " | " << fmtG(b) << " | "
+       << (isTuned(setup, name) ? (a != b ? "tuned, changed" : "tuned") : "fixed") << " |\n";
+  }
+  md << "\nThe best gains are in [gains_tuned.yaml](gains_tuned.yaml) (with the fuzzy system "
+        "[gains_tuned.fis](gains_tuned.fis)); every figure above is in [results.json](results.json), the "
+        "plotted runs sample by sample in [traces.csv](traces.csv).\n\n";
+
+  md << "## Plots\n\n";
+  if (drawn.empty()) md << "No plots were drawn.\n";
+  for (const auto& [file, what] : drawn) md << "- [" << file << "](" << file << "): " << what << "\n";
+  for (const auto& n : notes) md << "- " << mdCell(n) << "\n";
+  md << "\n";
+  for (const auto& [file, what] : drawn) md << "![" << file << "](" << file << ")\n\n";
+  return md.str();
+}
+
+}  // namespace
+
+SessionFiles writeTuningSession(const std::string& dir, const TuneSetup& setup, const TuneResult& result,
+                                const Comparison& c, const fuzzy::Fis& fis) {
+  SessionFiles out;
+  out.dir = dir;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create " + dir + ": " + ec.message());
+  const fs::path d(dir);
+  writeTunedGains(d, setup, result, c, fis, out);
+  writeText(d / "traces.csv", tracesCsv(c), out);
+  const Drawn drawn = drawSessionPlots(d, setup, result, c, out);
   const std::string table = comparisonTable(c);
   const int scenarios = result.best_eval.scenarios > 0 ? result.best_eval.scenarios : scenarioCount(setup);
-  {
-    Json j;
-    j["reference"] = c.reference;
-    j["plant"] = {{"left", wheelJson(setup.plant.left)},
-                  {"right", wheelJson(setup.plant.right)},
-                  {"description", c.plant_description}};
-    Json params = Json::array();
-    for (const auto& name : setup.params) {
-      const auto [lo, hi] = boundsOf(setup, name);
-      params.push_back({{"name", name},
-                        {"lower", lo},
-                        {"upper", hi},
-                        {"initial", numberOrNull(control::gainValue(result.initial, name))},
-                        {"best", numberOrNull(control::gainValue(result.best, name))}});
-    }
-    j["params"] = params;
-    const auto& w = setup.weights;
-    j["cost_weights"] = {{"max_pos", w.max_pos},         {"rms_pos", w.rms_pos}, {"max_ang", w.max_ang},
-                         {"rms_ang", w.rms_ang},         {"convergence", w.convergence},
-                         {"effort", w.effort},           {"saturation", w.saturation}};
-    j["scenarios"] = {{"count", scenarios},
-                      {"plant_variations", setup.plant_variations},
-                      {"seeds", setup.seeds},
-                      {"gain_spread", setup.gain_spread},
-                      {"tau_spread", setup.tau_spread},
-                      {"dead_spread_s", setup.dead_spread_s},
-                      {"seed", setup.seed}};
-    j["algorithm"] = result.algorithm;
-    j["max_evals"] = setup.max_evals;
-    j["global_fraction"] = setup.global_fraction;
-    j["evals"] = result.evals;
-    j["wall_s"] = result.wall_s;
-    j["cancelled"] = result.cancelled;
-    j["initial"] = {{"cost", numberOrNull(result.initial_eval.cost)}, {"gains", gainsObject(result.initial)}};
-    j["best"] = {{"cost", numberOrNull(result.best_eval.cost)}, {"gains", gainsObject(result.best)}};
-    Json rows = Json::array();
-    for (const auto& row : c.rows) {
-      Json r;
-      r["label"] = row.label;
-      r["controller"] = control::toString(row.wheel_control);
-      r["gains"] = gainsObject(row.gains);
-      r["cost"] = numberOrNull(row.eval.cost);
-      r["scenarios"] = row.eval.scenarios;
-      Json table_row;
-      for (const auto& m : kRows) table_row[m.key] = numberOrNull(m.value(row));  // null: not converged
-      for (const auto& m : kRobustRows) table_row[m.key] = numberOrNull(m.value(row));
-      r["table"] = table_row;
-      r["nominal_trace"] = metricsJson(row.trace.metrics);
-      r["mean"] = metricsJson(row.eval.mean);
-      r["worst"] = metricsJson(row.eval.worst);
-      rows.push_back(std::move(r));
-    }
-    j["comparison"] = rows;
-    j["convergence_bands"] = {{"position_m", kLoopDefaults.settle_position_m},
-                              {"angle_rad", kLoopDefaults.settle_angle_rad}};
-    Json hist = Json::array();
-    for (const double v : result.best_cost_history) hist.push_back(numberOrNull(v));
-    j["best_cost_history"] = hist;
-    j["plots"] = Json::array();
-    for (const auto& [file, what] : drawn) j["plots"].push_back(file);
-    j["notes"] = out.notes;
-    writeText(d / "results.json", j.dump(2) + "\n", out);
-  }
-
-  // summary.md, for people.
-  {
-    std::ostringstream md;
-    md << "# Tuning session\n\n## Set-up\n\n";
-    md << "- Reference: " << c.reference << " (start (0, 0, 0))\n";
-    md << "- Plant tuned for: left wheel " << describeWheel(setup.plant.left) << "; right wheel "
-       << describeWheel(setup.plant.right) << "\n";
-    md << "- Scenarios per evaluation: " << describeScenarios(setup, scenarios) << "; seed " << setup.seed << "\n";
-    md << "- Algorithm: " << (result.algorithm.empty() ? "-" : result.algorithm) << "; evaluations: " << result.evals
-       << " of at most " << setup.max_evals << " (global share " << fmtG(setup.global_fraction) << "); wall time "
-       << fmtOrNotConverged(result.wall_s, 1) << " s; " << (result.cancelled ? "**cancelled** (best so far kept)" : "not cancelled")
-       << "\n";
-    md << "- Cost: " << fmtG(result.initial_eval.cost) << " (initial gains) -> " << fmtG(result.best_eval.cost)
-       << " (best)";
-    if (result.initial_eval.cost > 0 && std::isfinite(result.initial_eval.cost))
-      md << ", " << fmtOrNotConverged(100.0 * (result.initial_eval.cost - result.best_eval.cost) / result.initial_eval.cost, 1)
-         << " % lower";
-    md << "\n\n";
-
-    md << "### Parameters and bounds\n\n| parameter | lower | upper | initial | best |\n|---|---|---|---|---|\n";
-    for (const auto& name : setup.params) {
-      const auto [lo, hi] = boundsOf(setup, name);
-      md << "| " << name << " | " << fmtG(lo) << " | " << fmtG(hi) << " | "
-         << fmtG(control::gainValue(result.initial, name)) << " | " << fmtG(control::gainValue(result.best, name))
-         << " |\n";
-    }
-    const auto& w = setup.weights;
-    md << "\n### Cost weights\n\nEach term is normalised by its scale (pc_server/tuning/tuner.hpp `CostWeights`); "
-          "the cost of an evaluation is the mean over the scenarios plus the worst one.\n\n"
-          "| term | scale | weight |\n|---|---|---|\n"
-       << "| max position error | 0.05 m | " << fmtG(w.max_pos) << " |\n"
-       << "| RMS position error | 0.01 m | " << fmtG(w.rms_pos) << " |\n"
-       << "| max angle error | 0.05 rad | " << fmtG(w.max_ang) << " |\n"
-       << "| RMS angle error | 0.01 rad | " << fmtG(w.rms_ang) << " |\n"
-       << "| convergence (position + angle) / 2 | 10 s | " << fmtG(w.convergence) << " |\n"
-       << "| max(0, effort / the reference's own effort - 1) | 1 | " << fmtG(w.effort) << " |\n"
-       << "| fraction of the run saturated | 0.1 | " << fmtG(w.saturation) << " |\n"
-       << "\nPlus 50 for each of position and angle still outside its band at the end of a run; a diverged run "
-          "(max position error over 1 m, or a non-finite figure) costs 10^4 or more.\n";
-
-    md << "\n## Comparison\n\nNominal rows: the plant above, noise seed 1 (the plotted runs). Convergence: the time "
-          "after which the error stays within the band (position "
-       << fmtG(kLoopDefaults.settle_position_m) << " m, angle " << fmtG(kLoopDefaults.settle_angle_rad)
-       << " rad) to the end; `not conv.` if it ends outside. Effort = integral of (u_l^2 + u_r^2) dt; saturation "
-          "time = time with a wheel command at the limit.\n\n```\n"
-       << table << "```\n\n";
-
-    md << "## Gains\n\n| gain | initial | best | |\n|---|---|---|---|\n";
-    for (const char* name : control::kGainNames) {
-      const double a = control::gainValue(result.initial, name), b = control::gainValue(result.best, name);
-      md << "| " << name << " | " << fmtG(a) << " | " << fmtG(b) << " | "
-         << (isTuned(setup, name) ? (a != b ? "tuned, changed" : "tuned") : "fixed") << " |\n";
-    }
-    md << "\nThe best gains are in [gains_tuned.yaml](gains_tuned.yaml) (with the fuzzy system "
-          "[gains_tuned.fis](gains_tuned.fis)); every figure above is in [results.json](results.json), the "
-          "plotted runs sample by sample in [traces.csv](traces.csv).\n\n";
-
-    md << "## Plots\n\n";
-    if (drawn.empty()) md << "No plots were drawn.\n";
-    for (const auto& [file, what] : drawn) md << "- [" << file << "](" << file << "): " << what << "\n";
-    for (const auto& n : out.notes) md << "- " << mdCell(n) << "\n";
-    md << "\n";
-    for (const auto& [file, what] : drawn) md << "![" << file << "](" << file << ")\n\n";
-    writeText(d / "summary.md", md.str(), out);
-  }
+  writeText(d / "results.json", sessionResultsJson(setup, result, c, scenarios, drawn, out.notes), out);
+  writeText(d / "summary.md", sessionSummaryMd(setup, result, c, scenarios, table, drawn, out.notes), out);
   return out;
 }
 

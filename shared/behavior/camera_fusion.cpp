@@ -23,6 +23,7 @@
 // (not at its edge, not hidden behind a closer track) without finding it.
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "shared/behavior/human_tracker.hpp"
 
@@ -79,6 +80,35 @@ void HumanTracker::addPersonEvidence(HumanTrack& t, double logodds) {
   if (denied && !t.camera_denied) ++counters_.camera_denials;
   t.camera_denied = denied;
   t.camera_doubted = t.camera_hits == 0 && t.person_logodds < 0 && t.person_logodds <= c.doubt_logodds;
+}
+
+void HumanTracker::countCameraMisses(const control::Pose2& pose, const CameraLook& look, const Eigen::Vector2d& lens,
+                                     std::span<const bool> matched) {
+  const CameraFusionParams& c = p_.camera;
+  // Another track hides one when it is on the same bearing and at least a
+  // body's depth closer (two tracks side by side, as the two front sonars make
+  // of one wide object, do not hide each other).
+  constexpr double kPersonDepth_m = 0.5;
+  const double axis = pose.theta_rad + look.axis_rad;
+  const double half = look.half_fov_rad - c.edge_margin_deg * M_PI / 180.0;
+  for (std::size_t j = 0; j < matched.size(); ++j) {
+    if (matched[j]) continue;
+    HumanTrack& t = tracks_[j];
+    const Polar pr = polarFrom(lens, t);
+    const double recall = c.recallAt(pr.range);
+    if (recall <= 0.0 || std::abs(wrapAngle(pr.bearing - axis)) > half) continue;
+    // Hidden behind a closer track on the same bearing?
+    bool hidden = false;
+    for (std::size_t o = 0; o < tracks_.size() && !hidden; ++o) {
+      if (o == j) continue;
+      const Polar po = polarFrom(lens, tracks_[o]);
+      hidden = po.range + kPersonDepth_m < pr.range && std::abs(wrapAngle(po.bearing - pr.bearing)) < std::atan2(c.occluder_width_m, po.range);
+    }
+    if (hidden) continue;
+    ++t.camera_misses;
+    ++counters_.camera_misses;
+    addPersonEvidence(t, std::log(1.0 - std::min(recall, 0.99)));
+  }
 }
 
 void HumanTracker::observeCamera(const control::Pose2& pose, const CameraLook& look) {
@@ -179,31 +209,8 @@ void HumanTracker::observeCamera(const control::Pose2& pose, const CameraLook& l
     tracks_.push_back(t);
     ++counters_.camera_tracks_created;
   }
-  // 4. The tracks this picture should have shown and did not. Another track
-  // hides one when it is on the same bearing and at least a body's depth
-  // closer (two tracks side by side, as the two front sonars make of one wide
-  // object, do not hide each other).
-  constexpr double kPersonDepth_m = 0.5;
-  const double axis = pose.theta_rad + look.axis_rad;
-  const double half = look.half_fov_rad - c.edge_margin_deg * M_PI / 180.0;
-  for (std::size_t j = 0; j < before; ++j) {
-    if (matched[j]) continue;
-    HumanTrack& t = tracks_[j];
-    const Polar pr = polarFrom(lens, t);
-    const double recall = c.recallAt(pr.range);
-    if (recall <= 0.0 || std::abs(wrapAngle(pr.bearing - axis)) > half) continue;
-    // Hidden behind a closer track on the same bearing?
-    bool hidden = false;
-    for (std::size_t o = 0; o < tracks_.size() && !hidden; ++o) {
-      if (o == j) continue;
-      const Polar po = polarFrom(lens, tracks_[o]);
-      hidden = po.range + kPersonDepth_m < pr.range && std::abs(wrapAngle(po.bearing - pr.bearing)) < std::atan2(c.occluder_width_m, po.range);
-    }
-    if (hidden) continue;
-    ++t.camera_misses;
-    ++counters_.camera_misses;
-    addPersonEvidence(t, std::log(1.0 - std::min(recall, 0.99)));
-  }
+  // 4. The tracks this picture should have shown and did not.
+  countCameraMisses(pose, look, lens, std::span<const bool>(matched.data(), before));
   for (std::size_t j = before; j-- > 0;)
     if (merged[j]) tracks_.erase(tracks_.begin() + static_cast<std::ptrdiff_t>(j));
 }

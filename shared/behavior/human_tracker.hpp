@@ -20,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -201,6 +202,11 @@ class HumanTracker {
   Eigen::Matrix2d rangeOnly(const SonarEcho& e) const;
   /// The track the camera saw lately that echo `e` lies within one detection's error of (chi2 gate).
   HumanTrack* cameraTrackNear(const control::Pose2& pose, const SonarEcho& e, double t_s);
+  /// observeCamera's last phase: the tracks in view that the picture did not
+  /// show (matched[j]: track j had a detection) lose person evidence by the
+  /// detector's recall at their range, unless a closer track hides them.
+  void countCameraMisses(const control::Pose2& pose, const CameraLook& look, const Eigen::Vector2d& lens,
+                         std::span<const bool> matched);
   /// Camera evidence on a track's log-odds (and its denial).
   void addPersonEvidence(HumanTrack& t, double logodds);
   /// Records sensor i's echo point and says whether its recent points trace a wall (wall_trace).

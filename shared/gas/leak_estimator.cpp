@@ -379,16 +379,64 @@ Posterior posteriorOf(const Grid& g, double sse_min, double sigma2, const Search
   return p;
 }
 
-}  // namespace
-
-LeakEstimate estimateLeak(const std::vector<GasSample>& samples, double tau_s, double background,
-                          const Bounds& bounds, const LeakOptions& o) {
-  LeakEstimate e;
+// The samples with finite numbers, in time order.
+std::vector<GasSample> finiteSortedSamples(const std::vector<GasSample>& samples) {
   std::vector<GasSample> s;
   s.reserve(samples.size());
   for (const auto& x : samples)
     if (std::isfinite(x.t_s) && std::isfinite(x.x_m) && std::isfinite(x.y_m) && std::isfinite(x.value)) s.push_back(x);
   std::stable_sort(s.begin(), s.end(), [](const GasSample& a, const GasSample& b) { return a.t_s < b.t_s; });
+  return s;
+}
+
+// Residuals closer in time than 1 / independent_rate_hz are correlated
+// (sensor lag, plume meander): one counts per such slot.
+double independentBins(const std::vector<Bin>& bins, double t0_s, double independent_rate_hz) {
+  std::vector<long long> slots;
+  for (const auto& b : bins) slots.push_back(static_cast<long long>(std::floor((b.t_s - t0_s) * independent_rate_hz)));
+  return static_cast<double>(std::unique(slots.begin(), slots.end()) - slots.begin());
+}
+
+// The refinement: a fine grid over every coarse cell that is not negligible
+// (log weight lw above 1e-4 of the best), one coarse step around them.
+Grid fineGridAround(Model& model, const SearchArea& area, const Grid& cg, const std::vector<double>& lw,
+                    const LeakOptions& o) {
+  const double coarse = cg.step;
+  double lo_x = kInf, lo_y = kInf, hi_x = -kInf, hi_y = -kInf;
+  for (std::size_t j = 0; j < cg.ny; ++j)
+    for (std::size_t i = 0; i < cg.nx; ++i)
+      if (lw[j * cg.nx + i] > std::log(1e-4)) {
+        lo_x = std::min(lo_x, cg.x(i)), hi_x = std::max(hi_x, cg.x(i));
+        lo_y = std::min(lo_y, cg.y(j)), hi_y = std::max(hi_y, cg.y(j));
+      }
+  lo_x -= coarse, lo_y -= coarse, hi_x += coarse, hi_y += coarse;
+  const double span = std::max(hi_x - lo_x, hi_y - lo_y);
+  const double fine = std::max(o.fine_step_m, span / static_cast<double>(std::max<std::size_t>(o.max_fine_cells, 2)));
+  const auto fnx = static_cast<std::size_t>(std::floor((hi_x - lo_x) / fine)) + 1;
+  const auto fny = static_cast<std::size_t>(std::floor((hi_y - lo_y) / fine)) + 1;
+  return searchGrid(model, area, lo_x, lo_y, fine, fnx, fny);
+}
+
+// What a found estimate's reader should know: "" or caveats joined by "; ".
+std::string leakCaveats(const LeakEstimate& e, const SearchArea& area) {
+  std::vector<std::string> caveats;
+  if (e.rim_fraction > 0.05) caveats.push_back("the estimate reaches the edge of the searched area: the source may lie beyond it");
+  if (e.split)
+    caveats.push_back("the likely positions fall apart (e.g. either side of a straight pass): the circle holds them all");
+  else if (area.bearingGap(e.x_m, e.y_m) > std::numbers::pi + 0.2)
+    caveats.push_back("seen from one side only: the distance from the path rests on the plume-shape model (a pass on "
+                      "the other side pins it)");
+  std::string out;
+  for (const auto& c : caveats) out += (out.empty() ? "" : "; ") + c;
+  return out;
+}
+
+}  // namespace
+
+LeakEstimate estimateLeak(const std::vector<GasSample>& samples, double tau_s, double background,
+                          const Bounds& bounds, const LeakOptions& o) {
+  LeakEstimate e;
+  const std::vector<GasSample> s = finiteSortedSamples(samples);
   e.samples = s.size();
   e.noise_sd = noiseSd(s);
   if (!std::isfinite(background)) background = 0.0;
@@ -409,13 +457,7 @@ LeakEstimate estimateLeak(const std::vector<GasSample>& samples, double tau_s, d
 
   const double sign = o.falling ? -1.0 : 1.0;
   std::vector<Bin> bins = binSamples(s, o.fit_rate_hz, sign, background);
-  // Residuals closer in time than 1 / independent_rate_hz are correlated
-  // (sensor lag, plume meander): count one per such slot.
-  {
-    std::vector<long long> slots;
-    for (const auto& b : bins) slots.push_back(static_cast<long long>(std::floor((b.t_s - s.front().t_s) * o.independent_rate_hz)));
-    e.n_eff = static_cast<double>(std::unique(slots.begin(), slots.end()) - slots.begin());
-  }
+  e.n_eff = independentBins(bins, s.front().t_s, o.independent_rate_hz);
   if (e.n_eff < 2.0 * kParams + 5.0) {
     e.reason = "too few independent samples";
     return e;
@@ -456,20 +498,8 @@ LeakEstimate estimateLeak(const std::vector<GasSample>& samples, double tau_s, d
   };
 
   // Refine around every coarse cell that is not negligible.
-  const auto lw = logWeights(cg, best.fit.sse, sigma2Of(best));
-  double lo_x = kInf, lo_y = kInf, hi_x = -kInf, hi_y = -kInf;
-  for (std::size_t j = 0; j < cg.ny; ++j)
-    for (std::size_t i = 0; i < cg.nx; ++i)
-      if (lw[j * cg.nx + i] > std::log(1e-4)) {
-        lo_x = std::min(lo_x, cg.x(i)), hi_x = std::max(hi_x, cg.x(i));
-        lo_y = std::min(lo_y, cg.y(j)), hi_y = std::max(hi_y, cg.y(j));
-      }
-  lo_x -= coarse, lo_y -= coarse, hi_x += coarse, hi_y += coarse;
-  const double span = std::max(hi_x - lo_x, hi_y - lo_y);
-  const double fine = std::max(o.fine_step_m, span / static_cast<double>(std::max<std::size_t>(o.max_fine_cells, 2)));
-  const auto fnx = static_cast<std::size_t>(std::floor((hi_x - lo_x) / fine)) + 1;
-  const auto fny = static_cast<std::size_t>(std::floor((hi_y - lo_y) / fine)) + 1;
-  const Grid fg = searchGrid(model, area, lo_x, lo_y, fine, fnx, fny);
+  const Grid fg = fineGridAround(model, area, cg, logWeights(cg, best.fit.sse, sigma2Of(best)), o);
+  const double fine = fg.step;
   if (const Best fb = bestOf(fg); fb.fit.sse < best.fit.sse) best = fb;
   const double sigma2 = sigma2Of(best);
   e.search_step_m = fine;
@@ -499,14 +529,7 @@ LeakEstimate estimateLeak(const std::vector<GasSample>& samples, double tau_s, d
     return e;
   }
   e.found = true;
-  std::vector<std::string> caveats;
-  if (e.rim_fraction > 0.05) caveats.push_back("the estimate reaches the edge of the searched area: the source may lie beyond it");
-  if (e.split)
-    caveats.push_back("the likely positions fall apart (e.g. either side of a straight pass): the circle holds them all");
-  else if (area.bearingGap(e.x_m, e.y_m) > std::numbers::pi + 0.2)
-    caveats.push_back("seen from one side only: the distance from the path rests on the plume-shape model (a pass on "
-                      "the other side pins it)");
-  for (const auto& c : caveats) e.reason += (e.reason.empty() ? "" : "; ") + c;
+  e.reason = leakCaveats(e, area);
   return e;
 }
 

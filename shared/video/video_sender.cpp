@@ -287,6 +287,58 @@ void VideoSender::captureLoop() {
   }
 }
 
+void VideoSender::prepareEncoder(std::unique_ptr<H264Encoder>& enc, uint64_t& enc_generation, uint64_t gen,
+                                 const EncoderSettings& es) {
+  if (enc && gen == enc_generation &&
+      (es.width != enc->settings().width || es.height != enc->settings().height || es.fps != enc->settings().fps))
+    enc_generation = ~0ull;  // a new level: reopened with an IDR
+  if (enc && gen == enc_generation && es.bitrate_kbps != enc->settings().bitrate_kbps) {
+    try {
+      if (!enc->setBitrate(es.bitrate_kbps)) enc_generation = ~0ull;  // no in-place change: reopen
+    } catch (const VideoError& e) {
+      setError(e.what());
+    }
+  }
+  if (enc && gen == enc_generation) return;
+  try {
+    enc.reset();
+    enc = std::make_unique<H264Encoder>(es);
+    enc_generation = gen;
+    keyframe_requested_ = true;
+    std::string why;
+    {
+      std::lock_guard rl(mu_);
+      if (rate_.state().changes > 0) why = " (rate adaptation: " + rate_.state().reason + ")";
+    }
+    log::info(log::tag::kVideo, "encoder ", enc->codecName(), " ", es.width, "x", es.height, " @ ", es.fps, " fps, ",
+              es.bitrate_kbps, " kbit/s, GOP ", es.gop, es.intra_refresh ? ", intra refresh" : "", why);
+  } catch (const VideoError& e) {
+    enc.reset();
+    setError(e.what());
+  }
+}
+
+void VideoSender::sendFrame(H264Packetizer& packetizer, const EncodedFrame& out, uint64_t capture_us,
+                            std::vector<std::vector<uint8_t>>& packets, SentFigures& f) {
+  packets.clear();
+  const auto ts = static_cast<uint32_t>(capture_us * 9 / 100);  // 90 kHz from microseconds
+  packetizer.packetize(out.annexb, ts, capture_us, packets);
+  const uint64_t now_us = monoNowUs();
+  for (const auto& p : packets) {
+    if (!net_->send(p, &f.error)) {
+      ++f.send_errors;
+      continue;
+    }
+    ++f.packets;
+    f.bytes += p.size();
+    std::lock_guard hl(net_->history_mu);
+    net_->history.remember(static_cast<uint16_t>(p[2] << 8 | p[3]), p, now_us);
+    net_->last_rtp_ts = ts;
+    ++net_->packets_sent;
+    net_->octets_sent += static_cast<uint32_t>(p.size() - kRtpHeaderSize);
+  }
+}
+
 void VideoSender::encodeLoop() {
   std::unique_ptr<H264Encoder> enc;
   uint64_t enc_generation = ~0ull;
@@ -323,39 +375,11 @@ void VideoSender::encodeLoop() {
     if (divisor == 1) skip_phase = 0;
     lk.unlock();
 
-    if (current && enc && gen == enc_generation &&
-        (es.width != enc->settings().width || es.height != enc->settings().height || es.fps != enc->settings().fps))
-      enc_generation = ~0ull;  // a new level: reopened with an IDR
-    if (current && enc && gen == enc_generation && es.bitrate_kbps != enc->settings().bitrate_kbps) {
-      try {
-        if (!enc->setBitrate(es.bitrate_kbps)) enc_generation = ~0ull;  // no in-place change: reopen
-      } catch (const VideoError& e) {
-        setError(e.what());
-      }
-    }
-    if (current && (!enc || gen != enc_generation)) {
-      try {
-        enc.reset();
-        enc = std::make_unique<H264Encoder>(es);
-        enc_generation = gen;
-        keyframe_requested_ = true;
-        std::string why;
-        {
-          std::lock_guard rl(mu_);
-          if (rate_.state().changes > 0) why = " (rate adaptation: " + rate_.state().reason + ")";
-        }
-        log::info(log::tag::kVideo, "encoder ", enc->codecName(), " ", es.width, "x", es.height, " @ ", es.fps, " fps, ",
-                  es.bitrate_kbps, " kbit/s, GOP ", es.gop, es.intra_refresh ? ", intra refresh" : "", why);
-      } catch (const VideoError& e) {
-        enc.reset();
-        setError(e.what());
-      }
-    }
+    if (current) prepareEncoder(enc, enc_generation, gen, es);
     if (!packetizer) packetizer = std::make_unique<H264Packetizer>(ssrc_, mtu - kOverhead, static_cast<uint16_t>(ssrc_));
     bool sent = false;
-    uint64_t bytes = 0, npackets = 0, send_errors = 0;
+    SentFigures sent_figures;
     double ms = 0;
-    std::string send_error;
     if (current && frame.cols == source_width && frame.rows == source_height &&
         (frame.cols != es.width || frame.rows != es.height))
       cv::resize(frame, frame, cv::Size(es.width, es.height), 0, 0, cv::INTER_AREA);
@@ -369,35 +393,17 @@ void VideoSender::encodeLoop() {
         enc.reset();  // reopened with the next frame
       }
       ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-      if (sent) {
-        packets.clear();
-        const auto ts = static_cast<uint32_t>(capture_us * 9 / 100);  // 90 kHz from microseconds
-        packetizer->packetize(out.annexb, ts, capture_us, packets);
-        const uint64_t now_us = monoNowUs();
-        for (const auto& p : packets) {
-          if (!net_->send(p, &send_error)) {
-            ++send_errors;
-            continue;
-          }
-          ++npackets;
-          bytes += p.size();
-          std::lock_guard hl(net_->history_mu);
-          net_->history.remember(static_cast<uint16_t>(p[2] << 8 | p[3]), p, now_us);
-          net_->last_rtp_ts = ts;
-          ++net_->packets_sent;
-          net_->octets_sent += static_cast<uint32_t>(p.size() - kRtpHeaderSize);
-        }
-      }
+      if (sent) sendFrame(*packetizer, out, capture_us, packets, sent_figures);
     }
-    if (!send_error.empty()) setError(send_error);
+    if (!sent_figures.error.empty()) setError(sent_figures.error);
     lk.lock();
     if (!current) ++st_.dropped;  // captured with the settings before a change
     if (sent) {
       ++st_.encoded;
       if (out.keyframe) ++st_.keyframes;
-      st_.packets += npackets;
-      st_.bytes += bytes;
-      st_.send_errors += send_errors;
+      st_.packets += sent_figures.packets;
+      st_.bytes += sent_figures.bytes;
+      st_.send_errors += sent_figures.send_errors;
       if (enc) st_.encoder = enc->codecName();
       window_ms += ms;
       ++window_n;

@@ -23,6 +23,7 @@
 #include "shared/video/frame_source.hpp"
 #include "shared/video/h264_codec.hpp"
 #include "shared/video/rate_controller.hpp"
+#include "shared/video/rtp_h264.hpp"
 
 namespace inspect::video {
 
@@ -124,6 +125,18 @@ class VideoSender {
  private:
   void captureLoop();
   void encodeLoop();
+  /// Opens the encoder for settings generation `gen`, or changes its bitrate
+  /// in place; reopens it (with an IDR) when the size or rate changed.
+  void prepareEncoder(std::unique_ptr<H264Encoder>& enc, uint64_t& enc_generation, uint64_t gen,
+                      const EncoderSettings& es);
+  /// What sending one encoded frame did.
+  struct SentFigures {
+    uint64_t packets = 0, bytes = 0, send_errors = 0;
+    std::string error;  // the last send error ("" = none)
+  };
+  /// Packetizes a frame, sends its packets and keeps them for retransmission.
+  void sendFrame(H264Packetizer& packetizer, const EncodedFrame& out, uint64_t capture_us,
+                 std::vector<std::vector<uint8_t>>& packets, SentFigures& f);
   void feedbackLoop();
   void onFeedback(std::span<const uint8_t> datagram);
   void sendSenderReport();
