@@ -45,7 +45,7 @@ namespace {
 constexpr const char* kDefaultConfig = "config/server.yaml";
 constexpr int kIoThreads = 2;
 // The console thread checks in every 20-50 ms; a stall this long means it hangs.
-constexpr std::chrono::milliseconds kConsoleWatchdog{500};
+constexpr std::chrono::milliseconds kConsoleWatchdog{300};
 
 enum class ConsoleMode { kNone, kScript, kInteractive, kStream };
 

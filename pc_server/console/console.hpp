@@ -52,6 +52,11 @@ class Console {
     // link's console watchdog listens to the consoles operators type in).
     bool allow_drive = true;
     bool feeds_watchdog = true;
+    // > 0: `drive`'s set-point lapses this long after the operator's last
+    // sign of presence (operatorPresent(): an attached console's every line
+    // and keep-alive); 0: held until stop (the server's own console, whose
+    // thread the console watchdog watches).
+    double drive_lease_s = 0.0;
   };
   /// Runs keyboard teleop on the selected robot until the operator leaves; false on failure.
   using TeleopHandler = std::function<bool(KeyboardTeleop::Mode mode, const std::string& robot_id)>;
@@ -77,6 +82,9 @@ class Console {
   std::string background();
   /// background() printed to the output, then the idle hook; used while waiting.
   void pump();
+  /// The operator is there (a line or a keep-alive came): the lease of this
+  /// session's `drive` set-point starts again, while it still holds the robot.
+  void operatorPresent();
   /// The clock this console reads and waits on (default: the real one; tests
   /// pass one they advance themselves). Must outlive the console.
   void setClock(ConsoleClock& clock) { clock_ = &clock; }
@@ -237,6 +245,7 @@ class Console {
   std::function<void()> idle_hook_;
   TeleopHandler teleop_handler_;
   VideoHub* video_ = nullptr;
+  std::string drive_robot_;  // the robot this session's last accepted `drive` went to
   Recorder* recorder_ = nullptr;
   std::function<std::string()> foxglove_report_;
   scene::SiteMaps* site_maps_ = nullptr;

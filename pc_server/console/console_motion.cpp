@@ -25,8 +25,11 @@ bool Console::cmdDrive(const Args& args, const std::string&, int) {
   const auto w = parseNumber(args[1]);
   if (!w) return fail("drive", "'" + args[1] + "' is not a number");
   const std::string what = "drive " + fmtSigned(*v) + " m/s " + fmtSigned(*w) + " rad/s";
-  // Held until stop (lease 0, docs/failsafes.md): a typed `drive` is meant to last.
-  const CallResult r = outcomeOf(service_->teleop(session_, selected_, *v, *w, 0.0, clock_->nowNs()));
+  // A typed `drive` is meant to last: held until stop on the server's own
+  // console (its thread is watched); while the operator is present (leased,
+  // renewed by operatorPresent) on an attached one (docs/failsafes.md).
+  const double lease = options_.drive_lease_s;
+  const CallResult r = outcomeOf(service_->teleop(session_, selected_, *v, *w, lease, clock_->nowNs()));
   if (r.outcome == CallOutcome::kInvalid || r.outcome == CallOutcome::kRefused) return report(r);  // nothing sent
   if (!r.ok()) {
     service_->clearTeleop(r.robot);
@@ -37,8 +40,21 @@ bool Console::cmdDrive(const Args& args, const std::string&, int) {
       out_ << r.robot << ": " << what << " rejected: " << r.reason << "\n";
     return false;
   }
-  out_ << r.robot << ": " << what << " accepted (re-sent until stop)\n";
+  drive_robot_ = r.robot;
+  out_ << r.robot << ": " << what << " accepted ("
+       << (lease > 0 ? "re-sent while this session is active; it lapses " + fmtShort(lease) + " s after its last input"
+                     : std::string("re-sent until stop"))
+       << ")\n";
   return true;
+}
+
+void Console::operatorPresent() {
+  if (!(options_.drive_lease_s > 0) || drive_robot_.empty()) return;
+  if (control_) {
+    const auto h = control_->holder(drive_robot_);
+    if (!h || h->session != session_) return;  // taken over or released: not ours to keep moving
+  }
+  sink_.renewTeleop(drive_robot_, options_.drive_lease_s);
 }
 
 bool Console::cmdTeleop(const Args& args, const std::string&, int) {

@@ -19,6 +19,12 @@ class CommandSink {
   virtual uint64_t setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s, double lease_s) = 0;
   /// Stops re-sending the set-point (sends nothing).
   virtual void clearTeleop(const std::string& robot_id) = 0;
+  /// Renews a leased set-point's lease from now (an operator's keep-alive);
+  /// sends nothing, and does nothing without an active leased set-point.
+  virtual void renewTeleop(const std::string& robot_id, double lease_s) {
+    (void)robot_id;
+    (void)lease_s;
+  }
   /// Assigns a new id to `cmd` and sends it; Stop and EStop also clear the set-point.
   /// Returns the id, 0 if the robot is not connected.
   virtual uint64_t sendCommand(const std::string& robot_id, v1::Command cmd) = 0;

@@ -155,6 +155,10 @@ uint64_t LinkServer::setTeleop(const std::string& robot_id, double v_m_s, double
   return id;
 }
 
+void LinkServer::renewTeleop(const std::string& robot_id, double lease_s) {
+  if (const auto s = find(robot_id)) s->renewTeleop(lease_s);
+}
+
 void LinkServer::clearTeleop(const std::string& robot_id) {
   if (const auto s = find(robot_id)) s->clearTeleop();
 }

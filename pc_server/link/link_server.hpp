@@ -51,6 +51,7 @@ class LinkServer : public CommandSink {
 
   uint64_t setTeleop(const std::string& robot_id, double v_m_s, double w_rad_s, double lease_s) override;
   void clearTeleop(const std::string& robot_id) override;
+  void renewTeleop(const std::string& robot_id, double lease_s) override;
   uint64_t sendCommand(const std::string& robot_id, v1::Command cmd) override;
   void consoleAlive() override;
 

@@ -188,6 +188,17 @@ void RobotSession::lapseTeleop() {
   sendTeleopNow(server_.nextCommandId());
 }
 
+void RobotSession::renewTeleop(double lease_s) {
+  if (!(lease_s > 0)) return;
+  const auto lapse_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(seconds(lease_s));
+  asio::post(strand_, [self = shared_from_this(), lease_s, lapse_at] {
+    // The timer fires at the old lapse time at the latest, sees it moved and re-sends.
+    if (!self->teleop_.active || self->teleop_.lease_s <= 0) return;
+    self->teleop_.lease_s = lease_s;
+    self->teleop_.lapse_at = std::max(self->teleop_.lapse_at, lapse_at);
+  });
+}
+
 void RobotSession::clearTeleop() {
   asio::post(strand_, [self = shared_from_this()] {
     self->teleop_.active = false;

@@ -53,6 +53,9 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   void setTeleop(double v_m_s, double w_rad_s, uint64_t first_id, double lease_s);
   /// Stops re-sending the set-point. Thread-safe.
   void clearTeleop();
+  /// The operator is still there: a leased set-point's lease starts again
+  /// from now (lease_s); nothing when no leased set-point is active. Thread-safe.
+  void renewTeleop(double lease_s);
 
   uint64_t serial() const { return serial_; }
   /// Peer "ip:port" (fixed at construction).

@@ -19,7 +19,9 @@ class KeyboardTeleop {
     double max_w_rad_s = 2.0;
     double hold_v_m_s = 0.3;             // hold mode: speed while w/s is held
     double hold_w_rad_s = 1.0;           // hold mode: yaw rate while a/d is held
-    double first_repeat_timeout_s = 0.6; // longest auto-repeat delay a terminal uses
+    // Operator silence stops the robot within 300 ms of the last key (a
+    // terminal whose auto-repeat delay is longer pauses once as a hold starts).
+    double first_repeat_timeout_s = 0.3;
     double repeat_timeout_s = 0.2;       // several missed repeats at >= 10 Hz
   };
 

@@ -2,11 +2,13 @@
 
 #include <poll.h>
 #include <pwd.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <iostream>
@@ -179,7 +181,9 @@ void OperatorSocket::runSession(Session& s) {
   FdBuf buf(s.fd);
   std::ostream out(&buf);
   {
-    Console console(registry_, sink_, out, s.stop, options_);
+    Console::Options o = options_;
+    o.drive_lease_s = kDriveLease_s;  // silence from the attached operator stops its `drive`
+    Console console(registry_, sink_, out, s.stop, o);
     console.setSession(&control_, id);
     console.eventsFromNow();
     if (configure_) configure_(console);
@@ -187,13 +191,27 @@ void OperatorSocket::runSession(Session& s) {
         << ". 'help' lists the commands, 'control' shows who controls each robot, 'quit' detaches.\n";
     out.flush();
     LineReader reader(s.fd, s.stop, kMaxLine);
+    // While a command runs (a wait, an Ack), input still arriving on the
+    // socket (keep-alives, the next lines) says the operator is there.
+    int pending = 0;
+    console.setIdleHook([&] {
+      int n = 0;
+      if (::ioctl(s.fd, FIONREAD, &n) == 0 && n > pending) console.operatorPresent();
+      pending = std::max(pending, n);
+    });
     int line_no = 0;
     while (!console.quitRequested()) {
       std::string line;
       const auto r = reader.nextLine(line, 100);
+      pending = 0;  // what was queued is being read
       if (r == LineReader::Result::kStopped || r == LineReader::Result::kEof) break;  // EOF: the operator left
       if (r == LineReader::Result::kTimeout) {
         console.pump();  // events and notes keep printing while the operator is quiet
+        continue;
+      }
+      console.operatorPresent();  // every line, the attach client's keep-alives included
+      if (r == LineReader::Result::kData && (line.empty() || line == "\r")) {  // a keep-alive
+        console.pump();  // events and notes keep printing
         continue;
       }
       ++line_no;
@@ -229,10 +247,20 @@ int attachToOperatorSocket(const std::string& path) {
     return 3;
   }
   bool stdin_open = true;
+  bool at_line_start = true;  // a keep-alive never splits a line being forwarded
   char buf[4096];
+  auto next_keepalive = std::chrono::steady_clock::now();
   for (;;) {
+    // While this process runs, an empty line every kKeepAlivePeriod says the
+    // operator is there (their `drive` stays leased); a stopped or hung attach
+    // lets it lapse within OperatorSocket::kDriveLease_s.
+    if (stdin_open && at_line_start && std::chrono::steady_clock::now() >= next_keepalive) {
+      if (::send(fd, "\n", 1, MSG_NOSIGNAL) != 1) break;
+      next_keepalive = std::chrono::steady_clock::now() + OperatorSocket::kKeepAlivePeriod;
+    }
     pollfd p[2] = {{fd, POLLIN, 0}, {0, static_cast<short>(stdin_open ? POLLIN : 0), 0}};
-    if (::poll(p, stdin_open ? 2 : 1, -1) < 0) {
+    const int timeout_ms = static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(OperatorSocket::kKeepAlivePeriod).count());
+    if (::poll(p, stdin_open ? 2 : 1, timeout_ms) < 0) {
       if (errno == EINTR) continue;
       break;
     }
@@ -249,6 +277,7 @@ int attachToOperatorSocket(const std::string& path) {
         ::shutdown(fd, SHUT_WR);  // the session runs what it has, then ends
         continue;
       }
+      at_line_start = buf[n - 1] == '\n';
       for (ssize_t off = 0; off < n;) {
         const ssize_t w = ::send(fd, buf + off, static_cast<std::size_t>(n - off), MSG_NOSIGNAL);
         if (w <= 0) break;

@@ -7,6 +7,7 @@
 // robot's control (ControlArbiter). File permissions are the authentication:
 // operators log in to the PC (e.g. over ssh) to attach.
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <list>
 #include <memory>
@@ -40,6 +41,10 @@ class OperatorSocket {
   static constexpr std::size_t kMaxLine = 4096;
   /// At most this many sessions at once; more are told so and closed.
   static constexpr int kMaxSessions = 16;
+  /// An attached session's `drive` set-point lapses this long after its last
+  /// line or keep-alive (`pc_server --attach` sends one every kKeepAlivePeriod).
+  static constexpr double kDriveLease_s = 0.3;
+  static constexpr std::chrono::milliseconds kKeepAlivePeriod{100};
 
  private:
   struct Session {

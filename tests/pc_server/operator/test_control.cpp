@@ -144,6 +144,55 @@ TEST_F(ControlTest, TakeForceStopsTheRobotAndTellsTheOldHolder) {
   EXPECT_TRUE(bob_.console->execute("drive 0.1 0", 2));
 }
 
+TEST_F(ControlTest, AnAttachedSessionsDriveLapsesWhenItsOperatorFallsSilent) {
+  // An attached console's session (pc_server/operator/operator_socket): its
+  // drive lasts while lines or keep-alives keep coming, then lapses.
+  Session carol;
+  server::Console::Options o;
+  o.ack_timeout_s = 2.0;
+  o.drive_lease_s = 0.3;
+  carol.console = std::make_unique<server::Console>(registry_, *link_, carol.out, carol.stop, o);
+  carol.console->setSession(&control_, control_.openSession("carol"));
+  carol.console->pump();
+  carol.take();
+  ASSERT_TRUE(carol.console->execute("drive 0.25 0", 1));
+  EXPECT_NE(carol.take().find("accepted (re-sent while this session is active; it lapses 0.3 s after its last input)"),
+            std::string::npos);
+  auto last = std::chrono::steady_clock::now();
+  for (int k = 0; k < 8; ++k) {  // the attach client's keep-alives, every 100 ms
+    std::this_thread::sleep_for(100ms);
+    carol.console->operatorPresent();
+    last = std::chrono::steady_clock::now();
+  }
+  EXPECT_GE(teleopsWithV(0.25), 14) << "re-sent at 20 Hz while the operator was there";
+  // Silent now: one zero set-point, 0.3 s after the last keep-alive.
+  ASSERT_TRUE(eventually([&] { return teleopsWithV(0.0) > 0; }));
+  std::chrono::steady_clock::time_point zero_at{};
+  for (const auto& r : robot_.received())
+    if (r.env.has_command() && r.env.command().has_teleop() && r.env.command().teleop().v_m_s() == 0.0) {
+      zero_at = r.t;
+      break;
+    }
+  const auto lapse_ms = std::chrono::duration_cast<std::chrono::milliseconds>(zero_at - last).count();
+  RecordProperty("lapse_ms", static_cast<int>(lapse_ms));
+  EXPECT_GE(lapse_ms, 250) << "not before the lease ran out";
+  EXPECT_LT(lapse_ms, 600) << "the lease, not later (a loaded machine's room)";
+  const int moving = teleopsWithV(0.25);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(teleopsWithV(0.25), moving) << "no re-send after the lapse";
+  // A keep-alive after the lapse does not start it again; nor one after control passed on.
+  carol.console->operatorPresent();
+  ASSERT_TRUE(carol.console->execute("drive 0.25 0", 2));
+  EXPECT_TRUE(bob_.console->execute("control take force", 1));
+  ASSERT_TRUE(bob_.console->execute("drive 0.15 0", 2));
+  for (int k = 0; k < 3; ++k) carol.console->operatorPresent();
+  std::this_thread::sleep_for(500ms);
+  const int after = teleopsWithV(0.25);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(teleopsWithV(0.25), after) << "carol's set-point is gone with her control";
+  EXPECT_GT(teleopsWithV(0.15), 0);
+}
+
 TEST_F(ControlTest, ReleaseAndLeavingFreeTheRobot) {
   ASSERT_TRUE(alice_.console->execute("drive 0.2 0", 1));
   EXPECT_TRUE(alice_.console->execute("control release", 2));

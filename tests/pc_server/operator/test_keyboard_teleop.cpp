@@ -49,8 +49,8 @@ TEST(KeyboardTeleopHold, SinglePressStopsAfterFirstRepeatTimeout) {
   KeyboardTeleop kt(Mode::kHold);
   EXPECT_TRUE(kt.onKey(Key::kForward, 10.0));
   EXPECT_DOUBLE_EQ(kt.v(), 0.3);
-  EXPECT_FALSE(kt.tick(10.5)) << "the auto-repeat may take up to 600 ms to start";
-  EXPECT_TRUE(kt.tick(10.61));
+  EXPECT_FALSE(kt.tick(10.25)) << "a tap drives until the first-repeat timeout";
+  EXPECT_TRUE(kt.tick(10.31)) << "operator silence stops within 300 ms of the last key";
   EXPECT_EQ(kt.v(), 0.0);
 }
 
@@ -85,8 +85,8 @@ TEST(KeyboardTeleopHold, OtherKeySwitchesDirectionAndRestartsRepeatDetection) {
   kt.onKey(Key::kForward, 0.4);  // repeat seen
   EXPECT_TRUE(kt.onKey(Key::kBack, 0.45));
   EXPECT_DOUBLE_EQ(kt.v(), -0.3);
-  EXPECT_FALSE(kt.tick(0.45 + 0.3)) << "new key: back to the 600 ms first-repeat timeout";
-  EXPECT_TRUE(kt.tick(0.45 + 0.61));
+  EXPECT_FALSE(kt.tick(0.45 + 0.25)) << "new key: back to the 300 ms first-repeat timeout";
+  EXPECT_TRUE(kt.tick(0.45 + 0.31));
 }
 
 TEST(KeyboardTeleopHold, SpaceZeroesAtOnce) {
