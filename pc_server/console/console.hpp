@@ -149,7 +149,14 @@ class Console {
     const char* details;
     Handler run;
   };
+  /// Every command, by family (help lists them in this order).
   static const std::vector<CommandDef>& commands();
+  static std::vector<CommandDef> sessionCommands();
+  static std::vector<CommandDef> motionCommands();
+  static std::vector<CommandDef> gasCommands();
+  static std::vector<CommandDef> tuningCommands();
+  static std::vector<CommandDef> runCommands();
+  static std::vector<CommandDef> scriptCommands();
   static const CommandDef* findCommand(const std::string& name);
 
   bool cmdHelp(const Args& args, const std::string& rest, int line_no);

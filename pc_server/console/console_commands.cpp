@@ -14,225 +14,266 @@
 
 namespace inspect::server {
 
-const std::vector<Console::CommandDef>& Console::commands() {
-  static const std::vector<CommandDef> kCommands = {
-      {"help", "help [command]", "list the commands, or explain one",
-       "  help          lists every command\n"
-       "  help drive    explains one command\n",
-       &Console::cmdHelp},
-      {"robots", "robots", "table of robots: id, connected, address, telemetry Hz, mode, telemetry age",
-       "  Lists every robot that connected since the server started; '*' marks the selected one.\n",
-       &Console::cmdRobots},
-      {"select", "select <robot>", "choose the robot that drive/stop/estop/resume/status/expect act on",
-       "  The robot need not be connected yet. With no selection, the first robot to connect\n"
-       "  is selected automatically.\n"
-       "  example: select robot2\n",
-       &Console::cmdSelect},
-      {"status", "status [robot]", "one status line of the selected (or named) robot",
-       "  example: status\n"
-       "  robot1 | TELEOP | v +0.30 w +0.00 | x 1.20 y 0.00 th +0.00 | us 1.23 2.01 -- 0.88 | faults none |"
-       " tlm 50 Hz | serial ok\n",
-       &Console::cmdStatus},
-      {"drive", "drive <v_m_s> <w_rad_s>", "set the teleop set-point; re-sent at teleop_resend_hz until stop",
-       "  v in [-1, 1] m/s (forward positive), w in [-2, 2] rad/s (counter-clockwise positive).\n"
-       "  The server re-sends the set-point (default 20 Hz) so the robot's 300 ms deadman stays\n"
-       "  quiet while the console and link work. Waits up to 1 s for the robot's Ack of the first\n"
-       "  command; a rejection or no Ack clears the set-point and is an error.\n"
-       "  example: drive 0.3 0      (straight ahead at 0.3 m/s)\n"
-       "  example: drive 0 0.5      (turn on the spot, 0.5 rad/s to the left)\n",
-       &Console::cmdDrive},
-      {"teleop", "teleop [step|hold]", "keyboard teleop (interactive terminal only)",
-       "  step (default): w/s or Up/Down step v by 0.05 m/s, a/d or Left/Right step w by 0.1 rad/s\n"
-       "    (clamped to +-1.0 m/s, +-2.0 rad/s); the set-point stays until changed.\n"
-       "  hold: hold w/s/a/d (or arrows) to drive at 0.3 m/s or 1.0 rad/s; releasing the key\n"
-       "    zeroes the set-point (deadman: 600 ms before the first auto-repeat, 200 ms after).\n"
-       "  Both: space (or x, 0) zeroes at once; q or Esc leaves teleop and sends stop.\n",
-       &Console::cmdTeleop},
-      {"track", "track circle <radius_m> [speed_m_s] [laps] [controller] | track line <length_m> [speed_m_s] [controller]",
-       "track a reference path from the robot's current pose (Eqs 10-15)",
-       "  circle: radius > 0 turns left (counter-clockwise), < 0 right; speed default 0.5 m/s, laps 1.\n"
-       "  line: straight ahead. controller: fuzzy_pid, pid or direct (default: the robot's config).\n"
-       "  Waits for the Ack; the robot acks again (COMPLETED) when the path is done and goes IDLE.\n"
-       "  Telemetry then carries the reference pose and the errors (expect pos_err, max_pos_err, ...).\n"
-       "  example: track circle 3.5 0.5\n"
-       "  example: track line 4 0.3 pid\n",
-       &Console::cmdTrack},
-      {"goto", "goto <x_m> <y_m> [speed_m_s]", "navigate to a point, going round obstacles",
-       "  The robot's navigation automaton (go-to-goal, avoid, boundary following) drives to (x, y)\n"
-       "  in its odometry frame (origin and x axis = its pose when robot_client started) at up to\n"
-       "  speed_m_s (default: the robot's, 0.5 m/s; at most 1). People slow it down (Eq 9).\n"
-       "  Waits for the Ack; the robot acks again (COMPLETED) within 0.1 m of the goal and goes IDLE,\n"
-       "  and the console prints 'robot1: goto completed'. stop, estop or teleop end it.\n"
-       "  Telemetry: expect nav_mode, goal_dist, goal_index, goal_count, nav_switches.\n"
-       "  example: goto 2 0\n"
-       "  example: goto 3.5 -1 0.3\n",
-       &Console::cmdGoto},
-      {"route", "route <file|name>", "navigate through the waypoints of a route file, or play its wheel test",
-       "  The file is YAML (example: config/routes/warehouse_tour.yaml):\n"
-       "    name: tour                          # optional, default: the file name\n"
-       "    speed_m_s: 0.4                      # optional, default: the robot's (0.5 m/s)\n"
-       "    waypoints_m: [x0, y0, x1, y1, ...]  # odometry frame, 1 to 100 points\n"
-       "  A bad file is an error naming the file and the key. Acked like goto; COMPLETED after the\n"
-       "  last point ('robot1: route completed'); goal_index counts the points reached.\n"
-       "  A name without '/' is looked up as config/routes/<name>.yaml.\n"
-       "  A route with `wheel_test:` instead of points plays open-loop wheel steps and chirps for\n"
-       "  plant identification (mode WHEEL_TEST; recorded as a run; then `identify <run>`).\n"
-       "  example: route config/routes/warehouse_tour.yaml\n"
-       "  example: route identification\n",
-       &Console::cmdRoute},
-      {"inspect", "inspect <route> [speed_m_s]", "run a gas inspection route as a recorded run",
-       "  <route> is a file or a name in config/routes/ (config/routes/<name>.yaml). The route's\n"
-       "  points may carry dwell_s (the robot stops there), a camera preset (ptz: {pan_deg,\n"
-       "  tilt_deg} or {home: true}) and a label; `map` names the site's world file, which the\n"
-       "  run's report draws the concentration maps on. The robot navigates with the behaviour\n"
-       "  strategy (people get right of way, Eq 9) and reacts to a gas HIGH alarm as configured\n"
-       "  (client.yaml safety.gas_reaction: continue, stop = hold until resume, retreat). The run\n"
-       "  is recorded (named 'inspection <name>') and ends with the route. Then: report <run-id>.\n"
-       "  example: inspect gas_lab_inspection\n",
-       &Console::cmdInspect},
-      {"alarms", "alarms [all]", "gas alarms and gas sensor faults: active and unacknowledged ones, or all",
-       "  One line per alarm: #number, robot, gas, level (LOW = A1, HIGH = A2, SENSOR_FAULT with\n"
-       "  stuck, out_of_range or no_data), the reading and threshold, the worst reading, where the\n"
-       "  robot was, how long ago it was raised, whether it is still active and acknowledged.\n"
-       "  The robot raises and clears alarms (thresholds with hysteresis, minimum duration); the\n"
-       "  operator acknowledges them with ack. Raised alarms print at once, in red with a bell on a\n"
-       "  terminal, and the status line shows '| ALARM ...' while they are active.\n",
-       &Console::cmdAlarms},
-      {"ack", "ack <number>|all", "acknowledge a gas alarm (alarms lists the numbers)",
-       "  Acknowledging does not clear an alarm (the robot does, when the gas is gone); it records\n"
-       "  that the operator has seen it (catalog and run).\n"
-       "  example: ack 3\n",
-       &Console::cmdAck},
-      {"identify", "identify <run-id>|last", "fit the hub-motor model to a recorded run (for tune)",
-       "  Fits each wheel's gain, time constant, dead time and saturation to the commanded and\n"
-       "  measured wheel speeds of the run's telemetry (an output-error fit), prints the model and\n"
-       "  its fit (100 % = perfect), saves <run>/plant.yaml and makes it the plant tune uses.\n"
-       "  'last' = the newest identification run. Record one with `route identification`.\n"
-       "  example: identify last\n",
-       &Console::cmdIdentify},
-      {"tune", "tune [key=value ...] | tune list", "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
-       "  Closed-loop simulations of the robot's own tracker on the plant (nominal, or the last\n"
-       "  `identify`), each candidate over plant variations x noise seeds; cost = weighted max/RMS\n"
-       "  position and angle error, convergence time, effort and saturation (docs/tuning.md).\n"
-       "  Options: ref=circle|line|waypoints radius=3.5 speed=0.5 laps=1 length=10\n"
-       "           params=kp,ki,kd,ke,kec,k1,k2,k3 (or all, adds a1,a2,a3) evals=1000\n"
-       "           plant=current|nominal|<run-id>|<plant.yaml> variations=4 seeds=2 threads=0 seed=1\n"
-       "           start=working|paper|tuned\n"
-       "  Shows a progress bar and the best cost; Ctrl-C stops and keeps the best so far. Then\n"
-       "  prints PID vs fuzzy-PID (paper gains) vs tuned, writes plots and summary.md into\n"
-       "  runs/tuning/<session>/, books the session in the catalog and makes the tuned set the\n"
-       "  working set (gains push sends it). `tune list`: the sessions in the catalog.\n"
-       "  example: tune evals=300 speed=0.5\n",
-       &Console::cmdTune},
-      {"gains", "gains show [robot] | gains set <name>=<value>...|paper|tuned|robot | gains push [robot] | "
-                "gains revert [robot] | gains export <file.yaml> | gains import <file.yaml>",
-       "the tracking gains: working set, push to a robot, revert, files",
-       "  show: working set, the robot's set in force (with its version), the paper's, the tuned.\n"
-       "  set: edit the working set (kp ki kd ke kec k1 k2 k3 a1 a2 a3; bounds are checked).\n"
-       "  push: send the working set; the robot checks it, applies it at its next control tick\n"
-       "    (also to a path being tracked) and answers with the version now in force, or why not.\n"
-       "  revert: push the set the robot had in force before its current one.\n"
-       "  export/import: a YAML file of the gains plus the .fis fuzzy system beside it; an\n"
-       "    imported .fis that differs from the loaded one is pushed with the gains.\n"
-       "  example: gains set kp=12 ki=3\n  example: gains push\n",
-       &Console::cmdGains},
-      {"control", "control [take [force] | release]", "who controls each robot; take or release the selected robot",
-       "  One session (console) at a time controls a robot: only its motion commands (drive, teleop,\n"
-       "  track, goto, route, inspect, resume, ptz, gains push) reach the robot; the first such command\n"
-       "  takes a free robot. Other sessions observe: status, events and runs; stop and estop always work.\n"
-       "  control               this session's name and every robot's controlling session\n"
-       "  control take          take the selected robot (refused while another session holds it)\n"
-       "  control take force    take it over from another session: the robot is stopped first and\n"
-       "                        the other session is told\n"
-       "  control release       let go of the selected robot (its teleop set-point is cleared)\n",
-       &Console::cmdControl},
-      {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
-       "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
-       "  'robot1: no ack within 1 s' (the last two are errors).\n",
-       &Console::cmdStop},
-      {"estop", "estop", "emergency stop, latched until resume",
-       "  Clears the set-point and sends EStop; waits up to 1 s for the Ack.\n", &Console::cmdEstop},
-      {"resume", "resume", "clear a latched e-stop or failsafe",
-       "  Waits up to 1 s for the Ack; e.g. 'robot1: resume rejected: <reason>'.\n", &Console::cmdResume},
-      {"video", "video on|off|keyframe|stats | video res <W>x<H> | video fps <n> | video bitrate <kbit/s>",
-       "control the selected robot's camera stream; show its figures",
-       "  on/off start and stop streaming; keyframe asks for an IDR now (the server also asks by\n"
-       "  itself, at most every 0.3 s, when it lost part of a picture).\n"
-       "  res: even width and height, 64 to 4096 (e.g. 1280x720); fps: 1 to 120; bitrate: 50 to\n"
-       "  50000 kbit/s. A new size or bitrate restarts the robot's encoder with an IDR.\n"
-       "  stats: received/decoded fps, kbit/s, packet loss, glass-to-glass latency (mean, p50, p99),\n"
-       "  counters, the SDP file for players, and the robot's encoder figures.\n"
-       "  Play the stream elsewhere: ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer\n"
-       "    -flags low_delay video/robot1.sdp   (the server forwards the RTP to the SDP's port)\n"
-       "  example: video res 1280x720\n",
-       &Console::cmdVideo},
-      {"ptz", "ptz <pan_deg> <tilt_deg> | ptz home", "point the camera mount (sent to the MCU)",
-       "  pan counter-clockwise positive, [-180, 180] degrees; tilt up positive, [-90, 90].\n"
-       "  example: ptz 30 -10\n",
-       &Console::cmdPtz},
-      {"snapshot", "snapshot [file.png]", "save the selected robot's latest decoded picture as PNG",
-       "  Default file: <video.dir>/<robot>_<n>.png. Without a display the server also keeps\n"
-       "  <video.dir>/<robot>_latest.png fresh (video.snapshot_period_s).\n",
-       &Console::cmdSnapshot},
-      {"foxglove", "foxglove", "the Foxglove bridge: clients, subscriptions, send queues, drops",
-       "  One line per connected Foxglove/Lichtblick client (its operator session, how long it has\n"
-       "  been connected, subscriptions, queued messages and bytes, messages sent, data and video\n"
-       "  messages dropped for a slow reader, its messages refused), then the topics it subscribed\n"
-       "  to and publishes on. docs/foxglove.md.\n",
-       &Console::cmdFoxglove},
-      {"record", "record start [name] | record stop", "record a run of the selected robot",
-       "  A run is written to <recording.dir>/<run-id>/: run.mcap (telemetry, commands, acks, events,\n"
-       "  camera frames; Foxglove opens it) and video.mp4, and listed in catalog.sqlite with its\n"
-       "  summary. track, goto and route start one by themselves (recording.auto_start) and end it\n"
-       "  when they complete or fail; record stop ends it ('stopped'). The status line shows REC.\n"
-       "  example: record start night round B\n",
-       &Console::cmdRecord},
-      {"runs", "runs [robot|outcome|text] [limit]", "list recorded runs, newest first",
-       "  A filter word is a robot id, an outcome (completed, stopped, failed, incomplete,\n"
-       "  running) or text in the run's name. Default limit 20.\n"
-       "  example: runs robot1\n",
-       &Console::cmdRuns},
-      {"run", "run show <run-id>", "a recorded run's summary, files and counts",
-       "  example: run show 20261122-083015-robot1\n", &Console::cmdRun},
-      {"report", "report <run-id>", "write a run's report: PNG plots and summary.md in <run>/report/",
-       "  Plots: trajectory (with the tracking reference), speed and nearest person with the proxemic\n"
-       "  zones, tracking errors, gas concentrations; summary.md links them and the run's files.\n"
-       "  example: report 20261122-083015-robot1\n",
-       &Console::cmdReport},
-      {"export", "export <run-id> csv [dir]", "one CSV per channel of a run's MCAP file (default <run>/csv/)",
-       "  Columns: log_time_s, publish_time_s, then every field, nested ones dotted (pose.x_m).\n",
-       &Console::cmdExport},
-      {"replay", "replay <run-id> [speed]", "play a run's telemetry back as status lines (speed 0.1-100, default 1)",
-       "  One status line per second of run time, and the run's events as they came.\n"
-       "  example: replay 1 10\n",
-       &Console::cmdReplay},
-      {"wait", "wait <seconds>", "pause the console (events still print)",
-       "  example: wait 2.5\n", &Console::cmdWait},
-      {"expect", "expect <field> <op> <value> [<tol>] [within <seconds>]", "check a value (scripts, tests)",
-       "  ops: == != < <= > >= ~   ('~' needs a tolerance: |field - value| <= tol; '+-' before it is optional)\n"
-       "  within: poll every 20 ms until true or the time runs out (default: check once).\n"
-       "  fields of the selected robot: x y theta v w cmd_v cmd_w wheel_l wheel_r mode faults mcu_faults\n"
-       "    connected telemetry_hz telemetry_age sensor_hz battery serial_bad_crc serial_frames_ok\n"
-       "    tracking: pos_err ang_err max_pos_err max_ang_err progress ref_x ref_y kp ki kd\n"
-       "    people: pattern (0 none, 1 crossing, 2 encountering, 3 leading, 4 confronting) person_m\n"
-       "      speed_factor people\n"
-       "    navigation: nav_mode goal_dist goal_index goal_count nav_switches dwell\n"
-       "    gas: gas0 gas1 gas2 gas3 (channel values) alarms alarms_high (active on the robot)\n"
-       "    tuning: gains_version wheel_test_progress\n"
-       "  and: robots (number of connected robots).\n"
-       "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING, WHEEL_TEST; nav_mode takes NONE,\n"
-       "  GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL; integer fields take 0x.. too.\n"
-       "  a field the robot left out reads 'unknown' and fails every comparison; '== unknown' checks that.\n"
-       "  examples: expect robots >= 1 within 5\n"
-       "            expect x ~ 2.0 0.05 within 10\n"
-       "            expect mode == ESTOP within 1\n"
-       "            expect nav_mode == FOLLOW_CW within 20\n",
-       &Console::cmdExpect},
-      {"echo", "echo <text>", "print text (to label script output)", "  example: echo --- leg 2 ---\n",
-       &Console::cmdEcho},
-      {"quit", "quit", "leave the console and shut the server down ('exit' too)", "", &Console::cmdQuit},
-      {"exit", "exit", "same as quit", "", &Console::cmdQuit},
+// Commands of the session: help, robots, selection, status, control.
+std::vector<Console::CommandDef> Console::sessionCommands() {
+  return {
+    {"help", "help [command]", "list the commands, or explain one",
+     "  help          lists every command\n"
+     "  help drive    explains one command\n",
+     &Console::cmdHelp},
+    {"robots", "robots", "table of robots: id, connected, address, telemetry Hz, mode, telemetry age",
+     "  Lists every robot that connected since the server started; '*' marks the selected one.\n",
+     &Console::cmdRobots},
+    {"select", "select <robot>", "choose the robot that drive/stop/estop/resume/status/expect act on",
+     "  The robot need not be connected yet. With no selection, the first robot to connect\n"
+     "  is selected automatically.\n"
+     "  example: select robot2\n",
+     &Console::cmdSelect},
+    {"status", "status [robot]", "one status line of the selected (or named) robot",
+     "  example: status\n"
+     "  robot1 | TELEOP | v +0.30 w +0.00 | x 1.20 y 0.00 th +0.00 | us 1.23 2.01 -- 0.88 | faults none |"
+     " tlm 50 Hz | serial ok\n",
+     &Console::cmdStatus},
+    {"control", "control [take [force] | release]", "who controls each robot; take or release the selected robot",
+     "  One session (console) at a time controls a robot: only its motion commands (drive, teleop,\n"
+     "  track, goto, route, inspect, resume, ptz, gains push) reach the robot; the first such command\n"
+     "  takes a free robot. Other sessions observe: status, events and runs; stop and estop always work.\n"
+     "  control               this session's name and every robot's controlling session\n"
+     "  control take          take the selected robot (refused while another session holds it)\n"
+     "  control take force    take it over from another session: the robot is stopped first and\n"
+     "                        the other session is told\n"
+     "  control release       let go of the selected robot (its teleop set-point is cleared)\n",
+     &Console::cmdControl},
   };
+}
+
+// Commands of moving the robot and its camera.
+std::vector<Console::CommandDef> Console::motionCommands() {
+  return {
+    {"drive", "drive <v_m_s> <w_rad_s>", "set the teleop set-point; re-sent at teleop_resend_hz until stop",
+     "  v in [-1, 1] m/s (forward positive), w in [-2, 2] rad/s (counter-clockwise positive).\n"
+     "  The server re-sends the set-point (default 20 Hz) so the robot's 300 ms deadman stays\n"
+     "  quiet while the console and link work; in an attached console (--attach) it lapses\n"
+     "  0.3 s after the session's last line or keep-alive. Waits up to 1 s for the robot's Ack of the first\n"
+     "  command; a rejection or no Ack clears the set-point and is an error.\n"
+     "  example: drive 0.3 0      (straight ahead at 0.3 m/s)\n"
+     "  example: drive 0 0.5      (turn on the spot, 0.5 rad/s to the left)\n",
+     &Console::cmdDrive},
+    {"teleop", "teleop [step|hold]", "keyboard teleop (interactive terminal only)",
+     "  step (default): w/s or Up/Down step v by 0.05 m/s, a/d or Left/Right step w by 0.1 rad/s\n"
+     "    (clamped to +-1.0 m/s, +-2.0 rad/s); the set-point stays until changed.\n"
+     "  hold: hold w/s/a/d (or arrows) to drive at 0.3 m/s or 1.0 rad/s; releasing the key\n"
+     "    zeroes the set-point (deadman: 300 ms before the first auto-repeat, 200 ms after).\n"
+     "  Both: space (or x, 0) zeroes at once; q or Esc leaves teleop and sends stop.\n",
+     &Console::cmdTeleop},
+    {"track", "track circle <radius_m> [speed_m_s] [laps] [controller] | track line <length_m> [speed_m_s] [controller]",
+     "track a reference path from the robot's current pose (Eqs 10-15)",
+     "  circle: radius > 0 turns left (counter-clockwise), < 0 right; speed default 0.5 m/s, laps 1.\n"
+     "  line: straight ahead. controller: fuzzy_pid, pid or direct (default: the robot's config).\n"
+     "  Waits for the Ack; the robot acks again (COMPLETED) when the path is done and goes IDLE.\n"
+     "  Telemetry then carries the reference pose and the errors (expect pos_err, max_pos_err, ...).\n"
+     "  example: track circle 3.5 0.5\n"
+     "  example: track line 4 0.3 pid\n",
+     &Console::cmdTrack},
+    {"goto", "goto <x_m> <y_m> [speed_m_s]", "navigate to a point, going round obstacles",
+     "  The robot's navigation automaton (go-to-goal, avoid, boundary following) drives to (x, y)\n"
+     "  in its odometry frame (origin and x axis = its pose when robot_client started) at up to\n"
+     "  speed_m_s (default: the robot's, 0.5 m/s; at most 1). People slow it down (Eq 9).\n"
+     "  Waits for the Ack; the robot acks again (COMPLETED) within 0.1 m of the goal and goes IDLE,\n"
+     "  and the console prints 'robot1: goto completed'. stop, estop or teleop end it.\n"
+     "  Telemetry: expect nav_mode, goal_dist, goal_index, goal_count, nav_switches.\n"
+     "  example: goto 2 0\n"
+     "  example: goto 3.5 -1 0.3\n",
+     &Console::cmdGoto},
+    {"route", "route <file|name>", "navigate through the waypoints of a route file, or play its wheel test",
+     "  The file is YAML (example: config/routes/warehouse_tour.yaml):\n"
+     "    name: tour                          # optional, default: the file name\n"
+     "    speed_m_s: 0.4                      # optional, default: the robot's (0.5 m/s)\n"
+     "    waypoints_m: [x0, y0, x1, y1, ...]  # odometry frame, 1 to 100 points\n"
+     "  A bad file is an error naming the file and the key. Acked like goto; COMPLETED after the\n"
+     "  last point ('robot1: route completed'); goal_index counts the points reached.\n"
+     "  A name without '/' is looked up as config/routes/<name>.yaml.\n"
+     "  A route with `wheel_test:` instead of points plays open-loop wheel steps and chirps for\n"
+     "  plant identification (mode WHEEL_TEST; recorded as a run; then `identify <run>`).\n"
+     "  example: route config/routes/warehouse_tour.yaml\n"
+     "  example: route identification\n",
+     &Console::cmdRoute},
+    {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
+     "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
+     "  'robot1: no ack within 1 s' (the last two are errors).\n",
+     &Console::cmdStop},
+    {"estop", "estop", "emergency stop, latched until resume",
+     "  Clears the set-point and sends EStop; waits up to 1 s for the Ack.\n", &Console::cmdEstop},
+    {"resume", "resume", "clear a latched e-stop or failsafe",
+     "  Waits up to 1 s for the Ack; e.g. 'robot1: resume rejected: <reason>'.\n", &Console::cmdResume},
+    {"video", "video on|off|keyframe|stats | video res <W>x<H> | video fps <n> | video bitrate <kbit/s>",
+     "control the selected robot's camera stream; show its figures",
+     "  on/off start and stop streaming; keyframe asks for an IDR now (the server also asks by\n"
+     "  itself, at most every 0.3 s, when it lost part of a picture).\n"
+     "  res: even width and height, 64 to 4096 (e.g. 1280x720); fps: 1 to 120; bitrate: 50 to\n"
+     "  50000 kbit/s. A new size or bitrate restarts the robot's encoder with an IDR.\n"
+     "  stats: received/decoded fps, kbit/s, packet loss, glass-to-glass latency (mean, p50, p99),\n"
+     "  counters, the SDP file for players, and the robot's encoder figures.\n"
+     "  Play the stream elsewhere: ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer\n"
+     "    -flags low_delay video/robot1.sdp   (the server forwards the RTP to the SDP's port)\n"
+     "  example: video res 1280x720\n",
+     &Console::cmdVideo},
+    {"ptz", "ptz <pan_deg> <tilt_deg> | ptz home", "point the camera mount (sent to the MCU)",
+     "  pan counter-clockwise positive, [-180, 180] degrees; tilt up positive, [-90, 90].\n"
+     "  example: ptz 30 -10\n",
+     &Console::cmdPtz},
+    {"snapshot", "snapshot [file.png]", "save the selected robot's latest decoded picture as PNG",
+     "  Default file: <video.dir>/<robot>_<n>.png. Without a display the server also keeps\n"
+     "  <video.dir>/<robot>_latest.png fresh (video.snapshot_period_s).\n",
+     &Console::cmdSnapshot},
+    {"foxglove", "foxglove", "the Foxglove bridge: clients, subscriptions, send queues, drops",
+     "  One line per connected Foxglove/Lichtblick client (its operator session, how long it has\n"
+     "  been connected, subscriptions, queued messages and bytes, messages sent, data and video\n"
+     "  messages dropped for a slow reader, its messages refused), then the topics it subscribed\n"
+     "  to and publishes on. docs/foxglove.md.\n",
+     &Console::cmdFoxglove},
+  };
+}
+
+// Commands of gas inspection and alarms (docs/gas.md).
+std::vector<Console::CommandDef> Console::gasCommands() {
+  return {
+    {"inspect", "inspect <route> [speed_m_s]", "run a gas inspection route as a recorded run",
+     "  <route> is a file or a name in config/routes/ (config/routes/<name>.yaml). The route's\n"
+     "  points may carry dwell_s (the robot stops there), a camera preset (ptz: {pan_deg,\n"
+     "  tilt_deg} or {home: true}) and a label; `map` names the site's world file, which the\n"
+     "  run's report draws the concentration maps on. The robot navigates with the behaviour\n"
+     "  strategy (people get right of way, Eq 9) and reacts to a gas HIGH alarm as configured\n"
+     "  (client.yaml safety.gas_reaction: continue, stop = hold until resume, retreat). The run\n"
+     "  is recorded (named 'inspection <name>') and ends with the route. Then: report <run-id>.\n"
+     "  example: inspect gas_lab_inspection\n",
+     &Console::cmdInspect},
+    {"alarms", "alarms [all]", "gas alarms and gas sensor faults: active and unacknowledged ones, or all",
+     "  One line per alarm: #number, robot, gas, level (LOW = A1, HIGH = A2, SENSOR_FAULT with\n"
+     "  stuck, out_of_range or no_data), the reading and threshold, the worst reading, where the\n"
+     "  robot was, how long ago it was raised, whether it is still active and acknowledged.\n"
+     "  The robot raises and clears alarms (thresholds with hysteresis, minimum duration); the\n"
+     "  operator acknowledges them with ack. Raised alarms print at once, in red with a bell on a\n"
+     "  terminal, and the status line shows '| ALARM ...' while they are active.\n",
+     &Console::cmdAlarms},
+    {"ack", "ack <number>|all", "acknowledge a gas alarm (alarms lists the numbers)",
+     "  Acknowledging does not clear an alarm (the robot does, when the gas is gone); it records\n"
+     "  that the operator has seen it (catalog and run).\n"
+     "  example: ack 3\n",
+     &Console::cmdAck},
+  };
+}
+
+// Commands of the tuning host (docs/tuning.md).
+std::vector<Console::CommandDef> Console::tuningCommands() {
+  return {
+    {"identify", "identify <run-id>|last", "fit the hub-motor model to a recorded run (for tune)",
+     "  Fits each wheel's gain, time constant, dead time and saturation to the commanded and\n"
+     "  measured wheel speeds of the run's telemetry (an output-error fit), prints the model and\n"
+     "  its fit (100 % = perfect), saves <run>/plant.yaml and makes it the plant tune uses.\n"
+     "  'last' = the newest identification run. Record one with `route identification`.\n"
+     "  example: identify last\n",
+     &Console::cmdIdentify},
+    {"tune", "tune [key=value ...] | tune list", "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
+     "  Closed-loop simulations of the robot's own tracker on the plant (nominal, or the last\n"
+     "  `identify`), each candidate over plant variations x noise seeds; cost = weighted max/RMS\n"
+     "  position and angle error, convergence time, effort and saturation (docs/tuning.md).\n"
+     "  Options: ref=circle|line|waypoints radius=3.5 speed=0.5 laps=1 length=10\n"
+     "           params=kp,ki,kd,ke,kec,k1,k2,k3 (or all, adds a1,a2,a3) evals=1000\n"
+     "           plant=current|nominal|<run-id>|<plant.yaml> variations=4 seeds=2 threads=0 seed=1\n"
+     "           start=working|paper|tuned\n"
+     "  Shows a progress bar and the best cost; Ctrl-C stops and keeps the best so far. Then\n"
+     "  prints PID vs fuzzy-PID (paper gains) vs tuned, writes plots and summary.md into\n"
+     "  runs/tuning/<session>/, books the session in the catalog and makes the tuned set the\n"
+     "  working set (gains push sends it). `tune list`: the sessions in the catalog.\n"
+     "  example: tune evals=300 speed=0.5\n",
+     &Console::cmdTune},
+    {"gains", "gains show [robot] | gains set <name>=<value>...|paper|tuned|robot | gains push [robot] | "
+              "gains revert [robot] | gains export <file.yaml> | gains import <file.yaml>",
+     "the tracking gains: working set, push to a robot, revert, files",
+     "  show: working set, the robot's set in force (with its version), the paper's, the tuned.\n"
+     "  set: edit the working set (kp ki kd ke kec k1 k2 k3 a1 a2 a3; bounds are checked).\n"
+     "  push: send the working set; the robot checks it, applies it at its next control tick\n"
+     "    (also to a path being tracked) and answers with the version now in force, or why not.\n"
+     "  revert: push the set the robot had in force before its current one.\n"
+     "  export/import: a YAML file of the gains plus the .fis fuzzy system beside it; an\n"
+     "    imported .fis that differs from the loaded one is pushed with the gains.\n"
+     "  example: gains set kp=12 ki=3\n  example: gains push\n",
+     &Console::cmdGains},
+  };
+}
+
+// Commands of recorded runs (docs/recording.md).
+std::vector<Console::CommandDef> Console::runCommands() {
+  return {
+    {"record", "record start [name] | record stop", "record a run of the selected robot",
+     "  A run is written to <recording.dir>/<run-id>/: run.mcap (telemetry, commands, acks, events,\n"
+     "  camera frames; Foxglove opens it) and video.mp4, and listed in catalog.sqlite with its\n"
+     "  summary. track, goto and route start one by themselves (recording.auto_start) and end it\n"
+     "  when they complete or fail; record stop ends it ('stopped'). The status line shows REC.\n"
+     "  example: record start night round B\n",
+     &Console::cmdRecord},
+    {"runs", "runs [robot|outcome|text] [limit]", "list recorded runs, newest first",
+     "  A filter word is a robot id, an outcome (completed, stopped, failed, incomplete,\n"
+     "  running) or text in the run's name. Default limit 20.\n"
+     "  example: runs robot1\n",
+     &Console::cmdRuns},
+    {"run", "run show <run-id>", "a recorded run's summary, files and counts",
+     "  example: run show 20261122-083015-robot1\n", &Console::cmdRun},
+    {"report", "report <run-id>", "write a run's report: PNG plots and summary.md in <run>/report/",
+     "  Plots: trajectory (with the tracking reference), speed and nearest person with the proxemic\n"
+     "  zones, tracking errors, gas concentrations; summary.md links them and the run's files.\n"
+     "  example: report 20261122-083015-robot1\n",
+     &Console::cmdReport},
+    {"export", "export <run-id> csv [dir]", "one CSV per channel of a run's MCAP file (default <run>/csv/)",
+     "  Columns: log_time_s, publish_time_s, then every field, nested ones dotted (pose.x_m).\n",
+     &Console::cmdExport},
+    {"replay", "replay <run-id> [speed]", "play a run's telemetry back as status lines (speed 0.1-100, default 1)",
+     "  One status line per second of run time, and the run's events as they came.\n"
+     "  example: replay 1 10\n",
+     &Console::cmdReplay},
+  };
+}
+
+// Commands of scripts: waits, checks, output, leaving.
+std::vector<Console::CommandDef> Console::scriptCommands() {
+  return {
+    {"wait", "wait <seconds>", "pause the console (events still print)",
+     "  example: wait 2.5\n", &Console::cmdWait},
+    {"expect", "expect <field> <op> <value> [<tol>] [within <seconds>]", "check a value (scripts, tests)",
+     "  ops: == != < <= > >= ~   ('~' needs a tolerance: |field - value| <= tol; '+-' before it is optional)\n"
+     "  within: poll every 20 ms until true or the time runs out (default: check once).\n"
+     "  fields of the selected robot: x y theta v w cmd_v cmd_w wheel_l wheel_r mode faults mcu_faults\n"
+     "    connected telemetry_hz telemetry_age sensor_hz battery serial_bad_crc serial_frames_ok\n"
+     "    tracking: pos_err ang_err max_pos_err max_ang_err progress ref_x ref_y kp ki kd\n"
+     "    people: pattern (0 none, 1 crossing, 2 encountering, 3 leading, 4 confronting) person_m\n"
+     "      speed_factor people\n"
+     "    navigation: nav_mode goal_dist goal_index goal_count nav_switches dwell\n"
+     "    gas: gas0 gas1 gas2 gas3 (channel values) alarms alarms_high (active on the robot)\n"
+     "    tuning: gains_version wheel_test_progress\n"
+     "  and: robots (number of connected robots).\n"
+     "  mode takes IDLE, TELEOP, TRACKING, ESTOP, FAILSAFE, NAVIGATING, WHEEL_TEST; nav_mode takes NONE,\n"
+     "  GO_TO_GOAL, AVOID, FOLLOW_CW, FOLLOW_CCW, AT_GOAL; integer fields take 0x.. too.\n"
+     "  a field the robot left out reads 'unknown' and fails every comparison; '== unknown' checks that.\n"
+     "  examples: expect robots >= 1 within 5\n"
+     "            expect x ~ 2.0 0.05 within 10\n"
+     "            expect mode == ESTOP within 1\n"
+     "            expect nav_mode == FOLLOW_CW within 20\n",
+     &Console::cmdExpect},
+    {"echo", "echo <text>", "print text (to label script output)", "  example: echo --- leg 2 ---\n",
+     &Console::cmdEcho},
+    {"quit", "quit", "leave the console and shut the server down ('exit' too)", "", &Console::cmdQuit},
+    {"exit", "exit", "same as quit", "", &Console::cmdQuit},
+  };
+}
+
+const std::vector<Console::CommandDef>& Console::commands() {
+  static const std::vector<CommandDef> kCommands = [] {
+    std::vector<CommandDef> all;
+    for (auto family : {sessionCommands, motionCommands, gasCommands, tuningCommands, runCommands, scriptCommands})
+      for (auto& c : family()) all.push_back(c);
+    return all;
+  }();
   return kCommands;
 }
 
