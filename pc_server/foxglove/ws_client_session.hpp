@@ -54,6 +54,11 @@ class ClientSession : public std::enable_shared_from_this<ClientSession> {
  protected:
   virtual void kick() = 0;  // writes the queue if no write is under way (on the strand)
 
+  /// For the transports (ws_server.cpp): a connection refused before its
+  /// upgrade, and a served client gone.
+  void noteRefused() { server_.noteRefused(); }
+  void detachFromServer() { server_.detach(id_); }
+
   void pushControl(OutMessage m);
   std::optional<OutMessage> nextOut();
 

@@ -49,7 +49,7 @@ class Session final : public ClientSession {
                                        [self = self()](beast::error_code ec) {
                                          if (ec) {
                                            log::info(kTag, "client ", self->peer_, ": TLS handshake failed: ", ec.message());
-                                           self->server_.noteRefused();
+                                           self->noteRefused();
                                            self->endHandshake();
                                            return;
                                          }
@@ -84,7 +84,7 @@ class Session final : public ClientSession {
     http::async_read(ws_.next_layer(), buffer_, *parser_, [self = self()](beast::error_code ec, std::size_t) {
       if (ec) {
         log::info(kTag, "client ", self->peer_, ": no WebSocket upgrade: ", ec.message());
-        self->server_.noteRefused();
+        self->noteRefused();
         self->endHandshake();
         return;
       }
@@ -97,7 +97,7 @@ class Session final : public ClientSession {
     const UpgradeVerdict verdict = vetUpgrade(req, o.token, o.allowed_origins);
     if (!verdict.accepted()) {
       log::warn(kTag, "client ", peer_, " refused: ", verdict.reason);
-      server_.noteRefused();
+      noteRefused();
       endHandshake();
       auto res = std::make_shared<http::response<http::string_body>>(verdict.status, req.version());
       res->set(http::field::content_type, "text/plain");
@@ -181,7 +181,7 @@ class Session final : public ClientSession {
     beast::get_lowest_layer(ws_).socket().close(ignored);
     if (open_) {
       open_ = false;
-      server_.detach(id_);
+      detachFromServer();
     }
   }
 

@@ -108,7 +108,9 @@ class WsServer {
   uint64_t refusedConnections() const { return refused_connections_.load(); }
   const Options& options() const { return options_; }
 
-  // Used by the sessions (ws_server.cpp).
+ private:
+  // What the client sessions use (ClientSession is a friend; nothing else calls these).
+  friend class ClientSession;
   struct ChannelEntry {
     Channel channel;
     Kind kind = Kind::kData;
@@ -126,7 +128,6 @@ class WsServer {
   void handshakeEnded() { --handshaking_; }
   uint64_t nextClientId() { return next_client_.fetch_add(1); }
 
- private:
   void doAccept();
   std::shared_ptr<ClientSession> find(uint64_t client) const;
 
