@@ -133,34 +133,26 @@ void FoxgloveBridge::onEnvelope(const std::string& robot, const v1::Envelope& en
   if (stopped_) return;
   auto [it, fresh] = robots_.try_emplace(robot);
   RobotState& r = it->second;
-  if (!r.scene) r.scene = std::make_unique<scene::RobotScene>(robot, geometry_);
+  if (!r.feed) r.feed = std::make_unique<scene::SceneFeed>(robot, geometry_);
   if (!r.connected) {
     // A (re)connected robot: its Hello (gas channels, inlet) as the registry has it.
-    if (const auto snap = registry_.snapshot(robot, monoNowNs())) r.scene->onHello(snap->hello);
+    if (const auto snap = registry_.snapshot(robot, monoNowNs())) r.feed->onHello(snap->hello);
     advertiseRobot(robot, r);
   }
-  if (!inbound) {
-    if (env.has_command()) r.scene->onCommand(env.command());
-    return;
-  }
+  r.feed->onEnvelope(env, inbound);
+  if (!inbound) return;
   switch (env.body_case()) {
-    case v1::Envelope::kHello: r.scene->onHello(env.hello()); break;
     case v1::Envelope::kTelemetry: {
       const auto& t = env.telemetry();
-      r.scene->onTelemetry(t);
       publishMessage(r.ch.telemetry, ns, t);
       const int64_t link_offset_us = static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us());
-      if (const auto capture_ns = r.people_clock.fresh(t, link_offset_us, monoUsToWallNs);
-          capture_ns && server_.subscribed(r.ch.camera_people)) {
-        publishMessage(r.ch.camera_people, *capture_ns,
-                       scene::cameraPeople(t.perception(), t.video().width(), t.video().height(), *capture_ns));
-      }
-      if (server_.subscribed(r.ch.tf)) publishMessage(r.ch.tf, ns, r.scene->transforms(ns));
+      if (const auto people = r.feed->cameraPeople(t, link_offset_us); people && server_.subscribed(r.ch.camera_people))
+        publishMessage(r.ch.camera_people, people->first, people->second);
+      if (server_.subscribed(r.ch.tf)) publishMessage(r.ch.tf, ns, r.feed->scene().transforms(ns));
       break;
     }
     case v1::Envelope::kEvent: {
       const auto& e = env.event();
-      r.scene->onEvent(e);
       publishMessage(r.ch.events, ns, e);
       if (server_.subscribed(r.ch.log)) publishMessage(r.ch.log, ns, scene::RobotScene::log(robot, e, ns));
       if (e.has_gas_alarm()) publishMessage(r.ch.alarms, ns, e.gas_alarm());
@@ -178,7 +170,7 @@ void FoxgloveBridge::onAccessUnit(const std::string& robot, const video::Frame& 
     std::lock_guard lk(mu_);
     const auto it = robots_.find(robot);
     if (it == robots_.end() || !it->second.connected) return;
-    it->second.people_clock.onAccessUnit(frame, capture_us, ns);
+    if (it->second.feed) it->second.feed->onAccessUnit(frame, capture_us, ns);
     channel = it->second.ch.camera;
   }
   if (!server_.subscribed(channel)) return;
@@ -201,26 +193,22 @@ void FoxgloveBridge::tick() {
       }
     }
     for (auto& [robot, r] : robots_) {
-      if (!r.connected || !r.scene) continue;
-      const auto m = maps_.get(robot);
-      if (m.version != r.map_version) {
-        r.map_version = m.version;
-        r.scene->setMap(m.map ? std::optional<scene::SiteMap>(*m.map) : std::nullopt);
-      }
-      if (server_.subscribed(r.ch.scene)) publishMessage(r.ch.scene, ns, r.scene->scene(ns));
+      if (!r.connected || !r.feed) continue;
+      r.feed->followMap(maps_, robot);
+      if (server_.subscribed(r.ch.scene)) publishMessage(r.ch.scene, ns, r.feed->scene().scene(ns));
       if (server_.subscribed(r.ch.video_stats) && now - r.last_video_stats >= std::chrono::seconds(1)) {
         r.last_video_stats = now;
         publishMessage(r.ch.video_stats, ns, videoStats(robot));
       }
       if (now - r.last_grid >= steadyDuration(1.0 / options_.grid_hz)) {
         r.last_grid = now;
-        for (const auto& name : r.scene->gridChannels()) {
+        for (const auto& name : r.feed->scene().gridChannels()) {
           auto& id = r.ch.grids[name];
           if (id == 0)
             id = addChannel(scene::topicName(robot, scene::TopicKind::kGasGrid, name), ::foxglove::Grid::descriptor(),
                             WsServer::Kind::kData);
           if (server_.subscribed(id))
-            if (const auto g = r.scene->grid(name, ns)) publishMessage(id, ns, *g);
+            if (const auto g = r.feed->scene().grid(name, ns)) publishMessage(id, ns, *g);
         }
       }
     }

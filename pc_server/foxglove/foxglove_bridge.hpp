@@ -23,6 +23,7 @@
 #include "pc_server/foxglove/ws_server.hpp"
 #include "pc_server/scene/camera_people.hpp"
 #include "pc_server/scene/robot_scene.hpp"
+#include "pc_server/scene/scene_feed.hpp"
 #include "pc_server/scene/site_maps.hpp"
 #include "shared/video/rtp_h264.hpp"
 
@@ -82,10 +83,8 @@ class FoxgloveBridge : public WsServer::Handler {
     std::vector<uint32_t> all() const;
   };
   struct RobotState {
-    std::unique_ptr<scene::RobotScene> scene;
-    scene::CameraPeopleClock people_clock;  // detected pictures on the camera channel's clock
+    std::unique_ptr<scene::SceneFeed> feed;  // the scene, its map, the camera's people
     RobotChannels ch;
-    uint64_t map_version = 0;
     bool connected = false;
     std::chrono::steady_clock::time_point last_grid{};
     std::chrono::steady_clock::time_point last_video_stats{};

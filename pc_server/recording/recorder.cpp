@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "foxglove/CompressedVideo.pb.h"
-#include "pc_server/scene/camera_people.hpp"
+#include "pc_server/scene/scene_feed.hpp"
 #include "pc_server/scene/topics.hpp"
 #include "shared/record/mcap_writer.hpp"
 #include "shared/util/clock.hpp"
@@ -60,12 +60,11 @@ struct Recorder::Run {
   catalog::RunInfo info;
   record::McapWriter mcap;
   uint16_t ch_telemetry = 0, ch_command = 0, ch_ack = 0, ch_event = 0, ch_server = 0, ch_camera = 0, ch_info = 0;
-  // The 3-D scene (the live bridge's, so that the run replays the same view).
-  std::unique_ptr<scene::RobotScene> scene;
+  // The 3-D scene: the live bridge's SceneFeed, so that the run replays the same view.
+  std::unique_ptr<scene::SceneFeed> feed;
   uint16_t ch_tf = 0, ch_scene = 0, ch_log = 0, ch_camera_people = 0;
-  scene::CameraPeopleClock people_clock;  // detected pictures on the camera channel's clock
   std::map<std::string, uint16_t> ch_grid;
-  uint64_t last_tf_ns = 0, last_scene_ns = 0, last_grid_ns = 0, map_version = 0;
+  uint64_t last_tf_ns = 0, last_scene_ns = 0, last_grid_ns = 0;
   std::unique_ptr<video::Mp4Writer> mp4;
   std::string mp4_error;
   RunStats stats;
@@ -220,7 +219,7 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
     run->ch_tf = add(TopicKind::kTf);
     run->ch_scene = add(TopicKind::kScene);
     run->ch_log = add(TopicKind::kLog);
-    run->scene = std::make_unique<scene::RobotScene>(robot, geometry_);
+    run->feed = std::make_unique<scene::SceneFeed>(robot, geometry_);
     video::Mp4Settings ms;
     ms.max_fragment_s = config_.max_fragment_s;
     run->mp4 = std::make_unique<video::Mp4Writer>(run->info.dir + "/video.mp4", ms);
@@ -245,7 +244,7 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
       const uint64_t now = wallNowNs();
       run->mcap.write(run->ch_info, now, now, *h);
       hello_[robot] = *h;
-      run->scene->onHello(*h);
+      run->feed->onHello(*h);
     }
   }
   runs_[robot] = std::move(run);
@@ -363,19 +362,18 @@ void Recorder::recordTelemetryLocked(Run& r, const std::string& robot, const v1:
     r.gains_known = true;
   }
   r.mcap.write(r.ch_telemetry, log_ns, env.send_time_us() * 1000, t);
-  r.scene->onTelemetry(t);
-  if (const auto capture_ns = r.people_clock.fresh(
-          t, static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us()), monoUsToWallNs)) {
-    r.mcap.write(r.ch_camera_people, log_ns, *capture_ns,
-                 scene::cameraPeople(t.perception(), t.video().width(), t.video().height(), *capture_ns));
-  }
+  r.feed->onEnvelope(env, true);
+  if (const auto people =
+          r.feed->cameraPeople(t, static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us())))
+    r.mcap.write(r.ch_camera_people, log_ns, people->first, people->second);
   writeScene(r, robot, log_ns, true);
 }
 
-void Recorder::recordEventLocked(Run& r, const std::string& robot, const v1::Event& e, uint64_t publish_ns,
+void Recorder::recordEventLocked(Run& r, const std::string& robot, const v1::Envelope& env, uint64_t publish_ns,
                                  uint64_t log_ns, catalog::Time when) {
+  const v1::Event& e = env.event();
   r.mcap.write(r.ch_event, log_ns, publish_ns, e);
-  r.scene->onEvent(e);
+  r.feed->onEnvelope(env, true);
   r.mcap.write(r.ch_log, log_ns, log_ns, scene::RobotScene::log(robot, e, log_ns));
   if (e.kind() == v1::Event::GAINS_APPLIED && e.has_gains()) {
     // New gains during the run: the catalog keeps the latest set and counts the changes.
@@ -431,10 +429,10 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
       case v1::Envelope::kTelemetry: recordTelemetryLocked(r, robot, env, time_us, log_ns); break;
       case v1::Envelope::kCommand:
         r.mcap.write(r.ch_command, log_ns, publish_ns, env.command());
-        r.scene->onCommand(env.command());
+        r.feed->onEnvelope(env, false);
         break;
       case v1::Envelope::kAck: r.mcap.write(r.ch_ack, log_ns, publish_ns, env.ack()); break;
-      case v1::Envelope::kEvent: recordEventLocked(r, robot, env.event(), publish_ns, log_ns, when); break;
+      case v1::Envelope::kEvent: recordEventLocked(r, robot, env, publish_ns, log_ns, when); break;
       default: break;
     }
   } catch (const std::exception& e) {
@@ -473,7 +471,7 @@ void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame,
   Run& r = *it->second;
   ++r.video_frames;
   const uint64_t capture_wall_ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
-  r.people_clock.onAccessUnit(frame, capture_us, capture_wall_ns);
+  r.feed->onAccessUnit(frame, capture_us, capture_wall_ns);
   const auto v = scene::RobotScene::cameraFrame(robot, frame, capture_wall_ns);
   try {
     r.mcap.write(r.ch_camera, wallNowNs(), capture_wall_ns, v);
@@ -497,27 +495,21 @@ void Recorder::writeScene(Run& r, const std::string& robot, uint64_t ns, bool te
   constexpr uint64_t kTfNs = 100'000'000, kSceneNs = 200'000'000, kGridNs = 1'000'000'000;
   if (telemetry && ns - r.last_tf_ns >= kTfNs) {
     r.last_tf_ns = ns;
-    r.mcap.write(r.ch_tf, ns, ns, r.scene->transforms(ns));
+    r.mcap.write(r.ch_tf, ns, ns, r.feed->scene().transforms(ns));
   }
   if (ns - r.last_scene_ns >= kSceneNs) {
     r.last_scene_ns = ns;
-    if (site_maps_) {
-      const auto m = site_maps_->get(robot);
-      if (m.version != r.map_version) {
-        r.map_version = m.version;
-        r.scene->setMap(m.map ? std::optional<scene::SiteMap>(*m.map) : std::nullopt);
-      }
-    }
-    r.mcap.write(r.ch_scene, ns, ns, r.scene->scene(ns));
+    if (site_maps_) r.feed->followMap(*site_maps_, robot);
+    r.mcap.write(r.ch_scene, ns, ns, r.feed->scene().scene(ns));
   }
   if (ns - r.last_grid_ns >= kGridNs) {
     r.last_grid_ns = ns;
-    for (const auto& name : r.scene->gridChannels()) {
+    for (const auto& name : r.feed->scene().gridChannels()) {
       auto& ch = r.ch_grid[name];
       if (ch == 0)
         ch = r.mcap.addProtobufChannel(::foxglove::Grid::descriptor(),
                                        scene::topicName(r.info.robot, scene::TopicKind::kGasGrid, name));
-      if (const auto g = r.scene->grid(name, ns)) r.mcap.write(ch, ns, ns, *g);
+      if (const auto g = r.feed->scene().grid(name, ns)) r.mcap.write(ch, ns, ns, *g);
     }
   }
 }

@@ -100,8 +100,8 @@ class Recorder {
                                const std::string& run_id, catalog::Time when);
   void recordTelemetryLocked(Run& r, const std::string& robot, const v1::Envelope& env, uint64_t time_us,
                              uint64_t log_ns);
-  void recordEventLocked(Run& r, const std::string& robot, const v1::Event& e, uint64_t publish_ns, uint64_t log_ns,
-                         catalog::Time when);
+  void recordEventLocked(Run& r, const std::string& robot, const v1::Envelope& env, uint64_t publish_ns,
+                         uint64_t log_ns, catalog::Time when);
   /// A stored event or ack the robot sent late (store-and-forward).
   static bool isLate(const v1::Envelope& env);
   /// The id of the robot's run recording at `t` (catalog), "" = none.
