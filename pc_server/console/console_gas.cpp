@@ -57,9 +57,10 @@ bool Console::cmdInspect(const Args& args, const std::string&, int) {
   const auto robot = connectedRobot("inspect");
   if (!robot) return false;
   if (!recorder_) out_ << "inspect: note: the server records nothing (--no-record): no run, no report\n";
-  if (speed) r.speed_m_s = *speed;
-  out_ << routeSummary(r, true) << "\n";
-  return report(service_->inspect(session_, *robot, r, speed, clock_->nowNs()), true);
+  std::string summary;
+  const Issued issued = service_->inspect(session_, *robot, r, speed, clock_->nowNs(), &summary);
+  if (!summary.empty()) out_ << summary << "\n";
+  return report(issued, true);
 }
 
 bool Console::cmdAlarms(const Args& args, const std::string&, int) {

@@ -48,14 +48,7 @@ bool Console::cmdDrive(const Args& args, const std::string&, int) {
   return true;
 }
 
-void Console::operatorPresent() {
-  if (!(options_.drive_lease_s > 0) || drive_robot_.empty()) return;
-  if (control_) {
-    const auto h = control_->holder(drive_robot_);
-    if (!h || h->session != session_) return;  // taken over or released: not ours to keep moving
-  }
-  sink_.renewTeleop(drive_robot_, options_.drive_lease_s);
-}
+void Console::operatorPresent() { service_->renewTeleop(session_, drive_robot_, options_.drive_lease_s); }
 
 bool Console::cmdTeleop(const Args& args, const std::string&, int) {
   if (args.size() > 1) return fail("teleop", "takes at most one mode: teleop [step|hold]");
@@ -133,8 +126,10 @@ bool Console::cmdRoute(const Args& args, const std::string&, int) {
   } catch (const config::ConfigError& e) {
     return fail("route", e.what());
   }
-  out_ << routeSummary(r, false) << "\n";
-  return report(service_->route(session_, selected_, r, clock_->nowNs()), true);
+  std::string summary;
+  const Issued issued = service_->route(session_, selected_, r, clock_->nowNs(), &summary);
+  out_ << summary << "\n";
+  return report(issued, true);
 }
 
 bool Console::cmdStop(const Args& args, const std::string&, int) {

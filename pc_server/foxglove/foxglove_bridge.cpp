@@ -7,7 +7,6 @@
 #include <nlohmann/json.hpp>
 
 #include "pc_server/foxglove/bridge_services.hpp"
-#include "pc_server/operator/command_limits.hpp"
 #include "pc_server/operator/route_file.hpp"
 #include "pc_server/scene/topics.hpp"
 #include "shared/config/config_node.hpp"
@@ -450,9 +449,11 @@ Issued FoxgloveBridge::issue(const ServiceRequest& req, uint64_t session, const 
         bad.reason = e.what();
         return bad;
       }
-      if (inspection && req.speed_m_s && commandSpeedOk(*req.speed_m_s)) r.speed_m_s = *req.speed_m_s;
-      preface = routeSummary(r, inspection) + "\n";
-      return inspection ? service_.inspect(session, robot, r, req.speed_m_s, now) : service_.route(session, robot, r, now);
+      std::string summary;
+      Issued issued = inspection ? service_.inspect(session, robot, r, req.speed_m_s, now, &summary)
+                                 : service_.route(session, robot, r, now, &summary);
+      if (!summary.empty()) preface = summary + "\n";
+      return issued;
     }
     case Call::kRecordStart: return service_.recordStart(session, robot, req.name);
     case Call::kRecordStop: return service_.recordStop(session, robot);

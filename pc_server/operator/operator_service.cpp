@@ -257,12 +257,23 @@ CallResult OperatorService::releaseControl(uint64_t session, const std::string& 
   return r;
 }
 
+void OperatorService::renewTeleop(uint64_t session, const std::string& robot, double lease_s) {
+  if (robot.empty() || !(lease_s > 0)) return;
+  if (control_) {
+    const auto h = control_->holder(robot);
+    if (!h || h->session != session) return;  // taken over or released: not this session's to keep moving
+  }
+  sink_.renewTeleop(robot, lease_s);
+}
+
 void OperatorService::setRunContext(Recorder* recorder, scene::SiteMaps* site_maps) {
   recorder_ = recorder;
   site_maps_ = site_maps;
 }
 
-Issued OperatorService::route(uint64_t session, const std::string& robot, const Route& r, int64_t now_ns) {
+Issued OperatorService::route(uint64_t session, const std::string& robot, const Route& r, int64_t now_ns,
+                              std::string* summary) {
+  if (summary) *summary = routeSummary(r, false);
   v1::Command c;
   if (r.isWheelTest())
     *c.mutable_wheel_test() = wheelTestOf(r);
@@ -274,7 +285,7 @@ Issued OperatorService::route(uint64_t session, const std::string& robot, const 
 }
 
 Issued OperatorService::inspect(uint64_t session, const std::string& robot, Route r, std::optional<double> speed_m_s,
-                                int64_t now_ns) {
+                                int64_t now_ns, std::string* summary) {
   if (speed_m_s) {
     if (!commandSpeedOk(*speed_m_s))
       return invalid("inspect", robot,
@@ -283,6 +294,7 @@ Issued OperatorService::inspect(uint64_t session, const std::string& robot, Rout
     r.speed_m_s = *speed_m_s;
   }
   if (r.isWheelTest()) return invalid("inspect", robot, "'" + r.name + "' is a wheel test, not an inspection route");
+  if (summary) *summary = routeSummary(r, true);
   if (auto bad = checkConnected("inspect", robot, now_ns)) return *bad;
   // The map goes to the run before the command: the robot's Ack starts the run.
   const bool run_map = recorder_ && !r.map.empty();

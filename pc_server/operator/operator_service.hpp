@@ -150,13 +150,20 @@ class OperatorService {
 
   /// `route`: a route's points (GoTo) or its wheel test; the route's site
   /// map is drawn for the robot once the command is sent. Needs control.
-  Issued route(uint64_t session, const std::string& robot, const Route& r, int64_t now_ns);
+  /// `summary` (when given) gets the operator's line about the route
+  /// (routeSummary), to print before the result.
+  Issued route(uint64_t session, const std::string& robot, const Route& r, int64_t now_ns,
+               std::string* summary = nullptr);
   /// `inspect`: a recorded gas inspection round (docs/gas.md): the route with
   /// the gas reaction and dwells, its map attached to the run the robot's
   /// Ack starts (forgotten again when the robot does not take it). speed_m_s
   /// overrides the route's, within (0, kMaxCommandSpeed_m_s]. Needs control.
+  /// `summary` as for route(), at the speed it runs (empty when the speed or route is refused).
   Issued inspect(uint64_t session, const std::string& robot, Route r, std::optional<double> speed_m_s,
-                 int64_t now_ns);
+                 int64_t now_ns, std::string* summary = nullptr);
+  /// Renews the lease of `session`'s leased teleop set-point on `robot`
+  /// (the operator is still there), only while that session holds the robot.
+  void renewTeleop(uint64_t session, const std::string& robot, double lease_s);
   /// `record start [name]` / `record stop`: a run of the robot's messages
   /// (no control needed: recording moves nothing). kCompleted with reason
   /// "recording run <id>" / "run <id> stopped"; kInvalid when the server
