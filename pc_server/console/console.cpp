@@ -86,9 +86,11 @@ bool Console::execute(const std::string& raw_line, int line_no) {
     return false;
   }
   const std::size_t at = line.find_first_of(" \t", 0);
-  const std::string rest = at == std::string::npos ? "" : trim(line.substr(at));
-  const Args args(words.begin() + 1, words.end());
-  const bool ok = (this->*(c->run))(args, rest, line_no);
+  auto parsed = parseCommandArgs(c->name, c->forms, at == std::string::npos ? "" : line.substr(at));
+  if (auto* why = std::get_if<std::string>(&parsed)) return fail(c->name, *why);
+  auto& args = std::get<CommandArgs>(parsed);
+  args.line_no = line_no;
+  const bool ok = (this->*(c->run))(args);
   out_.flush();
   return ok;
 }
@@ -155,9 +157,9 @@ bool Console::mayMove(const std::string& robot, const std::string& cmd) {
   return false;
 }
 
-bool Console::cmdControl(const Args& args, const std::string&, int) {
+bool Console::cmdControl(const CommandArgs& a) {
   if (!control_) return fail("control", "this console has no sessions (no control arbiter)");
-  if (args.empty()) {
+  if (a.form == 0) {
     out_ << "this session: " << control_->sessionName(session_) << "\n";
     const auto holders = control_->holders();
     for (const auto& snap : registry_.snapshots(clock_->nowNs())) {
@@ -169,12 +171,8 @@ bool Console::cmdControl(const Args& args, const std::string&, int) {
     }
     return true;
   }
-  const bool take = args[0] == "take", release = args[0] == "release";
-  const bool force = take && args.size() == 2 && args[1] == "force";
-  if ((!take && !release) || (release && args.size() != 1) || (take && args.size() > 1 && !force))
-    return fail("control", "syntax: control | control take [force] | control release");
-  const auto r = release ? service_->releaseControl(session_, selected_)
-                         : service_->takeControl(session_, selected_, force, clock_->nowNs());
+  const auto r = a.has("release") ? service_->releaseControl(session_, selected_)
+                                  : service_->takeControl(session_, selected_, a.has("force"), clock_->nowNs());
   if (!r.ok()) return fail("control", r.reason);
   out_ << r.robot << ": " << r.reason << "\n";
   return true;
@@ -232,20 +230,18 @@ bool Console::report(const Issued& issued, bool runs) {
   return true;
 }
 
-bool Console::cmdHelp(const Args& args, const std::string&, int) {
-  if (args.size() > 1) return fail("help", "takes at most one command name");
-  if (args.empty()) {
+bool Console::cmdHelp(const CommandArgs& a) {
+  if (!a.has("command")) {
     out_ << helpText();
     return true;
   }
-  const std::string text = helpText(args[0]);
-  if (text.empty()) return fail("help", "unknown command '" + args[0] + "'");
+  const std::string text = helpText(a.text("command"));
+  if (text.empty()) return fail("help", "unknown command '" + a.text("command") + "'");
   out_ << text;
   return true;
 }
 
-bool Console::cmdRobots(const Args& args, const std::string&, int) {
-  if (!args.empty()) return fail("robots", "takes no arguments");
+bool Console::cmdRobots(const CommandArgs&) {
   const auto all = registry_.snapshots(clock_->nowNs());
   if (all.empty()) {
     out_ << "no robot has connected yet\n";
@@ -263,18 +259,17 @@ bool Console::cmdRobots(const Args& args, const std::string&, int) {
   return true;
 }
 
-bool Console::cmdSelect(const Args& args, const std::string&, int) {
-  if (args.size() != 1) return fail("select", "needs one robot id: select <robot>");
-  if (!net::validRobotId(args[0])) return fail("select", "'" + args[0] + "' is not a valid robot id ([A-Za-z0-9_-]{1,64})");
-  selected_ = args[0];
+bool Console::cmdSelect(const CommandArgs& a) {
+  const std::string& robot = a.text("robot");
+  if (!net::validRobotId(robot)) return fail("select", "'" + robot + "' is not a valid robot id ([A-Za-z0-9_-]{1,64})");
+  selected_ = robot;
   const auto snap = registry_.snapshot(selected_, clock_->nowNs());
   out_ << "selected " << selected_ << (snap && snap->connected ? "" : " (not connected yet)") << "\n";
   return true;
 }
 
-bool Console::cmdStatus(const Args& args, const std::string&, int) {
-  if (args.size() > 1) return fail("status", "takes at most one robot id");
-  const std::string robot = args.empty() ? selected_ : args[0];
+bool Console::cmdStatus(const CommandArgs& a) {
+  const std::string robot = a.has("robot") ? a.text("robot") : selected_;
   if (robot.empty()) return fail("status", "no robot selected");
   out_ << statusText(robot) << "\n";
   return true;
@@ -287,29 +282,20 @@ std::string Console::statusText(const std::string& robot) const {
   return s;
 }
 
-bool Console::cmdRecord(const Args& args, const std::string& rest, int) {
+bool Console::cmdRecord(const CommandArgs& a) {
   if (!recorder_) return fail("record", "the server records nothing (recording.enabled: false or --no-record)");
-  if (args.empty() || (args[0] != "start" && args[0] != "stop") || (args[0] == "stop" && args.size() > 1))
-    return fail("record", "syntax: record start [name] | record stop");
-  CallResult r;
-  if (args[0] == "stop") {
-    r = service_->recordStop(session_, selected_);
-  } else {
-    const auto sp = rest.find("start");
-    std::string name = sp == std::string::npos ? "" : rest.substr(sp + 5);
-    name.erase(0, name.find_first_not_of(" \t"));
-    r = service_->recordStart(session_, selected_, name);
-  }
+  const CallResult r = a.has("stop") ? service_->recordStop(session_, selected_)
+                                     : service_->recordStart(session_, selected_, a.text("name"));
   if (!r.ok()) return fail("record", r.reason);
   out_ << r.robot << ": " << r.reason << "\n";
   return true;
 }
 
-bool Console::cmdRuns(const Args& args, const std::string&, int) {
+bool Console::cmdRuns(const CommandArgs& words) {
   if (!recorder_) return fail("runs", "the server records nothing (recording.enabled: false or --no-record)");
   catalog::RunFilter f;
   f.limit = 20;
-  for (const auto& a : args) {
+  for (const auto& a : words.words) {
     if (const auto n = parseInteger(a); n && *n > 0) {
       f.limit = static_cast<int>(*n);
     } else if (a == "completed" || a == "stopped" || a == "failed" || a == "incomplete" || a == "running") {
@@ -330,11 +316,10 @@ bool Console::cmdRuns(const Args& args, const std::string&, int) {
   return true;
 }
 
-bool Console::cmdRun(const Args& args, const std::string&, int) {
+bool Console::cmdRun(const CommandArgs& a) {
   if (!recorder_) return fail("run", "the server records nothing (recording.enabled: false or --no-record)");
-  if (args.size() != 2 || args[0] != "show") return fail("run", "syntax: run show <run-id>");
-  const auto d = recorder_->catalog().run(args[1]);
-  if (!d) return fail("run", "no run '" + args[1] + "' in the catalog (see runs)");
+  const auto d = recorder_->catalog().run(a.text("run-id"));
+  if (!d) return fail("run", "no run '" + a.text("run-id") + "' in the catalog (see runs)");
   const auto& i = d->info;
   out_ << "run " << i.id << " (" << i.robot << ")" << (i.name.empty() ? "" : ": " + i.name) << "\n";
   out_ << "  started " << catalog::formatIsoUtc(i.start)
@@ -359,17 +344,14 @@ bool Console::cmdRun(const Args& args, const std::string&, int) {
   return true;
 }
 
-bool Console::cmdWait(const Args& args, const std::string&, int) {
-  if (args.size() != 1) return fail("wait", "needs one number of seconds: wait <seconds>");
-  const auto s = parseNumber(args[0]);
-  if (!s) return fail("wait", "'" + args[0] + "' is not a number");
-  if (*s < 0 || *s > 3600) return fail("wait", args[0] + " s is outside [0, 3600]");
-  if (!sleepPumping(*s)) return fail("wait", "interrupted (server stopping)");
+bool Console::cmdWait(const CommandArgs& a) {
+  if (!sleepPumping(*a.number("seconds"))) return fail("wait", "interrupted (server stopping)");
   return true;
 }
 
-bool Console::cmdExpect(const Args& args, const std::string&, int line_no) {
-  const auto parsed = parseExpect(args);
+bool Console::cmdExpect(const CommandArgs& a) {
+  const int line_no = a.line_no;
+  const auto parsed = parseExpect(a.words);
   if (const auto* err = std::get_if<std::string>(&parsed)) {
     out_ << "EXPECT FAILED (line " << line_no << "): " << *err << "\n";
     ++tally_.expects_failed;
@@ -401,13 +383,12 @@ bool Console::cmdExpect(const Args& args, const std::string&, int line_no) {
   return false;
 }
 
-bool Console::cmdEcho(const Args&, const std::string& rest, int) {
-  out_ << rest << "\n";
+bool Console::cmdEcho(const CommandArgs& a) {
+  out_ << a.rest << "\n";
   return true;
 }
 
-bool Console::cmdQuit(const Args& args, const std::string&, int) {
-  if (!args.empty()) return fail("quit", "takes no arguments");
+bool Console::cmdQuit(const CommandArgs&) {
   quit_ = true;
   return true;
 }

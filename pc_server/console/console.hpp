@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "pc_server/link/command_sink.hpp"
+#include "pc_server/console/command_args.hpp"
 #include "pc_server/console/console_clock.hpp"
 #include "pc_server/operator/control_arbiter.hpp"
 #include "pc_server/operator/operator_service.hpp"
@@ -138,13 +139,19 @@ class Console {
 
   /// The text of `help` (all commands) or `help <command>`; empty for an unknown command.
   static std::string helpText(const std::string& command = "");
+  /// The words that may complete the last word of `partial_line` (a command
+  /// name, a keyword, a choice, a robot id), from the command table; sorted.
+  std::vector<std::string> completions(const std::string& partial_line) const;
+  /// What is wrong with the command table's forms, one line each ("" = nothing).
+  static std::string tableProblems();
 
  private:
-  using Args = std::vector<std::string>;
-  using Handler = bool (Console::*)(const Args& args, const std::string& rest, int line_no);
+  using Handler = bool (Console::*)(const CommandArgs& a);
+  /// A command: its forms of typed arguments (command_args.hpp: the syntax,
+  /// the argument errors and completion come from them), its help, its handler.
   struct CommandDef {
     const char* name;
-    const char* syntax;
+    std::vector<CommandForm> forms;
     const char* summary;
     const char* details;
     Handler run;
@@ -159,39 +166,39 @@ class Console {
   static std::vector<CommandDef> scriptCommands();
   static const CommandDef* findCommand(const std::string& name);
 
-  bool cmdHelp(const Args& args, const std::string& rest, int line_no);
-  bool cmdRobots(const Args& args, const std::string& rest, int line_no);
-  bool cmdSelect(const Args& args, const std::string& rest, int line_no);
-  bool cmdStatus(const Args& args, const std::string& rest, int line_no);
-  bool cmdDrive(const Args& args, const std::string& rest, int line_no);
-  bool cmdTeleop(const Args& args, const std::string& rest, int line_no);
-  bool cmdTrack(const Args& args, const std::string& rest, int line_no);
-  bool cmdGoto(const Args& args, const std::string& rest, int line_no);
-  bool cmdRoute(const Args& args, const std::string& rest, int line_no);
-  bool cmdStop(const Args& args, const std::string& rest, int line_no);
-  bool cmdEstop(const Args& args, const std::string& rest, int line_no);
-  bool cmdResume(const Args& args, const std::string& rest, int line_no);
-  bool cmdVideo(const Args& args, const std::string& rest, int line_no);
-  bool cmdPtz(const Args& args, const std::string& rest, int line_no);
-  bool cmdSnapshot(const Args& args, const std::string& rest, int line_no);
-  bool cmdFoxglove(const Args& args, const std::string& rest, int line_no);
-  bool cmdRecord(const Args& args, const std::string& rest, int line_no);
-  bool cmdRuns(const Args& args, const std::string& rest, int line_no);
-  bool cmdRun(const Args& args, const std::string& rest, int line_no);
-  bool cmdReport(const Args& args, const std::string& rest, int line_no);
-  bool cmdExport(const Args& args, const std::string& rest, int line_no);
-  bool cmdReplay(const Args& args, const std::string& rest, int line_no);
-  bool cmdInspect(const Args& args, const std::string& rest, int line_no);
-  bool cmdAlarms(const Args& args, const std::string& rest, int line_no);
-  bool cmdAck(const Args& args, const std::string& rest, int line_no);
-  bool cmdIdentify(const Args& args, const std::string& rest, int line_no);
-  bool cmdTune(const Args& args, const std::string& rest, int line_no);
-  bool cmdGains(const Args& args, const std::string& rest, int line_no);
+  bool cmdHelp(const CommandArgs& a);
+  bool cmdRobots(const CommandArgs& a);
+  bool cmdSelect(const CommandArgs& a);
+  bool cmdStatus(const CommandArgs& a);
+  bool cmdDrive(const CommandArgs& a);
+  bool cmdTeleop(const CommandArgs& a);
+  bool cmdTrack(const CommandArgs& a);
+  bool cmdGoto(const CommandArgs& a);
+  bool cmdRoute(const CommandArgs& a);
+  bool cmdStop(const CommandArgs& a);
+  bool cmdEstop(const CommandArgs& a);
+  bool cmdResume(const CommandArgs& a);
+  bool cmdVideo(const CommandArgs& a);
+  bool cmdPtz(const CommandArgs& a);
+  bool cmdSnapshot(const CommandArgs& a);
+  bool cmdFoxglove(const CommandArgs& a);
+  bool cmdRecord(const CommandArgs& a);
+  bool cmdRuns(const CommandArgs& a);
+  bool cmdRun(const CommandArgs& a);
+  bool cmdReport(const CommandArgs& a);
+  bool cmdExport(const CommandArgs& a);
+  bool cmdReplay(const CommandArgs& a);
+  bool cmdInspect(const CommandArgs& a);
+  bool cmdAlarms(const CommandArgs& a);
+  bool cmdAck(const CommandArgs& a);
+  bool cmdIdentify(const CommandArgs& a);
+  bool cmdTune(const CommandArgs& a);
+  bool cmdGains(const CommandArgs& a);
   struct TuningState;
   /// `gains show [robot]`: working, the robot's, the paper's and the tuned set side by side.
-  bool gainsShow(const Args& args, TuningState& ts);
+  bool gainsShow(const CommandArgs& a, TuningState& ts);
   /// `gains set name=value ... | paper | tuned | robot`: the working set, checked.
-  bool gainsSet(const Args& args, TuningState& ts);
+  bool gainsSet(const CommandArgs& a, TuningState& ts);
   /// `tune list`: the tuning sessions in the catalog, newest first.
   bool cmdTuneList();
   /// tune's key=value options, each setting its part of `s`, the plant's
@@ -212,10 +219,10 @@ class Console {
                  const std::string& session);
   /// A run of the catalog and its directory; prints why not (as `cmd`) when there is none.
   std::optional<std::pair<catalog::RunDetail, std::string>> findRun(const std::string& cmd, const std::string& id);
-  bool cmdWait(const Args& args, const std::string& rest, int line_no);
-  bool cmdExpect(const Args& args, const std::string& rest, int line_no);
-  bool cmdEcho(const Args& args, const std::string& rest, int line_no);
-  bool cmdQuit(const Args& args, const std::string& rest, int line_no);
+  bool cmdWait(const CommandArgs& a);
+  bool cmdExpect(const CommandArgs& a);
+  bool cmdEcho(const CommandArgs& a);
+  bool cmdQuit(const CommandArgs& a);
 
   /// Prints "<cmd>: <message>" and returns false.
   bool fail(const std::string& cmd, const std::string& message);
@@ -223,9 +230,9 @@ class Console {
   std::optional<std::string> connectedRobot(const std::string& cmd);
   /// Whether this session may move `robot` (see setSession); prints why not.
   bool mayMove(const std::string& robot, const std::string& cmd);
-  bool cmdControl(const Args& args, const std::string& rest, int line_no);
+  bool cmdControl(const CommandArgs& a);
   /// Sends a Stop/EStop/Resume and reports its Ack.
-  bool simpleCommand(const std::string& name, const Args& args, v1::Command cmd);
+  bool simpleCommand(const std::string& name, v1::Command cmd);
   /// Sends `cmd` to the selected robot through the service, waits for its Ack and prints the answer.
   bool sendAndReport(const std::string& name, v1::Command cmd, bool runs = false);
   /// A service call's result, waited for when pending, printed. With `runs` (track, goto,

@@ -2,9 +2,11 @@
 // text (docs/console.md), and the help built from it.
 #include "pc_server/console/console.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
+#include "pc_server/operator/command_limits.hpp"
 #include "pc_server/operator/route_file.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "pc_server/recording/recorder.hpp"
@@ -14,27 +16,41 @@
 
 namespace inspect::server {
 
+using namespace args;
+using Source = ArgSpec::Source;
+
+namespace {
+/// track's last argument: the tracking controller (default: the robot's config).
+ArgSpec controller() {
+  ArgSpec a = choice("controller", {"fuzzy_pid", "pid", "direct"}, "controller");
+  a.shown = "<controller>";
+  return a;
+}
+/// A command that takes no arguments: one empty form.
+std::vector<CommandForm> noArguments() { return {CommandForm{}}; }
+}  // namespace
+
 // Commands of the session: help, robots, selection, status, control.
 std::vector<Console::CommandDef> Console::sessionCommands() {
   return {
-    {"help", "help [command]", "list the commands, or explain one",
+    {"help", {{opt(completing(word("command", "command name"), Source::kCommands))}}, "list the commands, or explain one",
      "  help          lists every command\n"
      "  help drive    explains one command\n",
      &Console::cmdHelp},
-    {"robots", "robots", "table of robots: id, connected, address, telemetry Hz, mode, telemetry age",
+    {"robots", noArguments(), "table of robots: id, connected, address, telemetry Hz, mode, telemetry age",
      "  Lists every robot that connected since the server started; '*' marks the selected one.\n",
      &Console::cmdRobots},
-    {"select", "select <robot>", "choose the robot that drive/stop/estop/resume/status/expect act on",
+    {"select", {{completing(word("robot", "robot id"), Source::kRobots)}}, "choose the robot that drive/stop/estop/resume/status/expect act on",
      "  The robot need not be connected yet. With no selection, the first robot to connect\n"
      "  is selected automatically.\n"
      "  example: select robot2\n",
      &Console::cmdSelect},
-    {"status", "status [robot]", "one status line of the selected (or named) robot",
+    {"status", {{opt(completing(word("robot", "robot id"), Source::kRobots))}}, "one status line of the selected (or named) robot",
      "  example: status\n"
      "  robot1 | TELEOP | v +0.30 w +0.00 | x 1.20 y 0.00 th +0.00 | us 1.23 2.01 -- 0.88 | faults none |"
      " tlm 50 Hz | serial ok\n",
      &Console::cmdStatus},
-    {"control", "control [take [force] | release]", "who controls each robot; take or release the selected robot",
+    {"control", {CommandForm{}, {subcommand("take"), opt(keyword("force"))}, {keyword("release")}}, "who controls each robot; take or release the selected robot",
      "  One session (console) at a time controls a robot: only its motion commands (drive, teleop,\n"
      "  track, goto, route, inspect, resume, ptz, gains push) reach the robot; the first such command\n"
      "  takes a free robot. Other sessions observe: status, events and runs; stop and estop always work.\n"
@@ -50,7 +66,7 @@ std::vector<Console::CommandDef> Console::sessionCommands() {
 // Commands of moving the robot and its camera.
 std::vector<Console::CommandDef> Console::motionCommands() {
   return {
-    {"drive", "drive <v_m_s> <w_rad_s>", "set the teleop set-point; re-sent at teleop_resend_hz until stop",
+    {"drive", {{number("v_m_s"), number("w_rad_s")}}, "set the teleop set-point; re-sent at teleop_resend_hz until stop",
      "  v in [-1, 1] m/s (forward positive), w in [-2, 2] rad/s (counter-clockwise positive).\n"
      "  The server re-sends the set-point (default 20 Hz) so the robot's 300 ms deadman stays\n"
      "  quiet while the console and link work; in an attached console (--attach) it lapses\n"
@@ -59,14 +75,16 @@ std::vector<Console::CommandDef> Console::motionCommands() {
      "  example: drive 0.3 0      (straight ahead at 0.3 m/s)\n"
      "  example: drive 0 0.5      (turn on the spot, 0.5 rad/s to the left)\n",
      &Console::cmdDrive},
-    {"teleop", "teleop [step|hold]", "keyboard teleop (interactive terminal only)",
+    {"teleop", {{opt(choice("mode", {"step", "hold"}, "mode"))}}, "keyboard teleop (interactive terminal only)",
      "  step (default): w/s or Up/Down step v by 0.05 m/s, a/d or Left/Right step w by 0.1 rad/s\n"
      "    (clamped to +-1.0 m/s, +-2.0 rad/s); the set-point stays until changed.\n"
      "  hold: hold w/s/a/d (or arrows) to drive at 0.3 m/s or 1.0 rad/s; releasing the key\n"
      "    zeroes the set-point (deadman: 300 ms before the first auto-repeat, 200 ms after).\n"
      "  Both: space (or x, 0) zeroes at once; q or Esc leaves teleop and sends stop.\n",
      &Console::cmdTeleop},
-    {"track", "track circle <radius_m> [speed_m_s] [laps] [controller] | track line <length_m> [speed_m_s] [controller]",
+    {"track",
+     {{subcommand("circle", "path"), number("radius_m"), opt(number("speed_m_s")), opt(number("laps")), opt(controller())},
+      {keyword("line"), number("length_m"), opt(number("speed_m_s")), opt(controller())}},
      "track a reference path from the robot's current pose (Eqs 10-15)",
      "  circle: radius > 0 turns left (counter-clockwise), < 0 right; speed default 0.5 m/s, laps 1.\n"
      "  line: straight ahead. controller: fuzzy_pid, pid or direct (default: the robot's config).\n"
@@ -75,7 +93,7 @@ std::vector<Console::CommandDef> Console::motionCommands() {
      "  example: track circle 3.5 0.5\n"
      "  example: track line 4 0.3 pid\n",
      &Console::cmdTrack},
-    {"goto", "goto <x_m> <y_m> [speed_m_s]", "navigate to a point, going round obstacles",
+    {"goto", {{number("x_m"), number("y_m"), opt(number("speed_m_s"))}}, "navigate to a point, going round obstacles",
      "  The robot's navigation automaton (go-to-goal, avoid, boundary following) drives to (x, y)\n"
      "  in its odometry frame (origin and x axis = its pose when robot_client started) at up to\n"
      "  speed_m_s (default: the robot's, 0.5 m/s; at most 1). People slow it down (Eq 9).\n"
@@ -85,7 +103,7 @@ std::vector<Console::CommandDef> Console::motionCommands() {
      "  example: goto 2 0\n"
      "  example: goto 3.5 -1 0.3\n",
      &Console::cmdGoto},
-    {"route", "route <file|name>", "navigate through the waypoints of a route file, or play its wheel test",
+    {"route", {{word("file|name", "route")}}, "navigate through the waypoints of a route file, or play its wheel test",
      "  The file is YAML (example: config/routes/warehouse_tour.yaml):\n"
      "    name: tour                          # optional, default: the file name\n"
      "    speed_m_s: 0.4                      # optional, default: the robot's (0.5 m/s)\n"
@@ -98,15 +116,19 @@ std::vector<Console::CommandDef> Console::motionCommands() {
      "  example: route config/routes/warehouse_tour.yaml\n"
      "  example: route identification\n",
      &Console::cmdRoute},
-    {"stop", "stop", "zero the set-point and stop re-sending (not latched)",
+    {"stop", noArguments(), "zero the set-point and stop re-sending (not latched)",
      "  Prints the robot's answer: 'robot1: stop accepted', '... rejected: <reason>' or\n"
      "  'robot1: no ack within 1 s' (the last two are errors).\n",
      &Console::cmdStop},
-    {"estop", "estop", "emergency stop, latched until resume",
+    {"estop", noArguments(), "emergency stop, latched until resume",
      "  Clears the set-point and sends EStop; waits up to 1 s for the Ack.\n", &Console::cmdEstop},
-    {"resume", "resume", "clear a latched e-stop or failsafe",
+    {"resume", noArguments(), "clear a latched e-stop or failsafe",
      "  Waits up to 1 s for the Ack; e.g. 'robot1: resume rejected: <reason>'.\n", &Console::cmdResume},
-    {"video", "video on|off|keyframe|stats | video res <W>x<H> | video fps <n> | video bitrate <kbit/s>",
+    {"video",
+     {{choice("what", {"on", "off", "keyframe", "stats"})},
+      {keyword("res"), wanting(size("size"), kVideoSizeWant)},
+      {keyword("fps"), wanting(number("n"), kVideoFpsWant)},
+      {keyword("bitrate"), wanting(integer("kbit/s"), kVideoBitrateWant)}},
      "control the selected robot's camera stream; show its figures",
      "  on/off start and stop streaming; keyframe asks for an IDR now (the server also asks by\n"
      "  itself, at most every 0.3 s, when it lost part of a picture).\n"
@@ -118,15 +140,15 @@ std::vector<Console::CommandDef> Console::motionCommands() {
      "    -flags low_delay video/robot1.sdp   (the server forwards the RTP to the SDP's port)\n"
      "  example: video res 1280x720\n",
      &Console::cmdVideo},
-    {"ptz", "ptz <pan_deg> <tilt_deg> | ptz home", "point the camera mount (sent to the MCU)",
+    {"ptz", {{number("pan_deg"), number("tilt_deg")}, {keyword("home")}}, "point the camera mount (sent to the MCU)",
      "  pan counter-clockwise positive, [-180, 180] degrees; tilt up positive, [-90, 90].\n"
      "  example: ptz 30 -10\n",
      &Console::cmdPtz},
-    {"snapshot", "snapshot [file.png]", "save the selected robot's latest decoded picture as PNG",
+    {"snapshot", {{opt(word("file.png"))}}, "save the selected robot's latest decoded picture as PNG",
      "  Default file: <video.dir>/<robot>_<n>.png. Without a display the server also keeps\n"
      "  <video.dir>/<robot>_latest.png fresh (video.snapshot_period_s).\n",
      &Console::cmdSnapshot},
-    {"foxglove", "foxglove", "the Foxglove bridge: clients, subscriptions, send queues, drops",
+    {"foxglove", noArguments(), "the Foxglove bridge: clients, subscriptions, send queues, drops",
      "  One line per connected Foxglove/Lichtblick client (its operator session, how long it has\n"
      "  been connected, subscriptions, queued messages and bytes, messages sent, data and video\n"
      "  messages dropped for a slow reader, its messages refused), then the topics it subscribed\n"
@@ -138,7 +160,7 @@ std::vector<Console::CommandDef> Console::motionCommands() {
 // Commands of gas inspection and alarms (docs/gas.md).
 std::vector<Console::CommandDef> Console::gasCommands() {
   return {
-    {"inspect", "inspect <route> [speed_m_s]", "run a gas inspection route as a recorded run",
+    {"inspect", {{word("route"), opt(number("speed_m_s"))}}, "run a gas inspection route as a recorded run",
      "  <route> is a file or a name in config/routes/ (config/routes/<name>.yaml). The route's\n"
      "  points may carry dwell_s (the robot stops there), a camera preset (ptz: {pan_deg,\n"
      "  tilt_deg} or {home: true}) and a label; `map` names the site's world file, which the\n"
@@ -148,7 +170,7 @@ std::vector<Console::CommandDef> Console::gasCommands() {
      "  is recorded (named 'inspection <name>') and ends with the route. Then: report <run-id>.\n"
      "  example: inspect gas_lab_inspection\n",
      &Console::cmdInspect},
-    {"alarms", "alarms [all]", "gas alarms and gas sensor faults: active and unacknowledged ones, or all",
+    {"alarms", {{opt(keyword("all"))}}, "gas alarms and gas sensor faults: active and unacknowledged ones, or all",
      "  One line per alarm: #number, robot, gas, level (LOW = A1, HIGH = A2, SENSOR_FAULT with\n"
      "  stuck, out_of_range or no_data), the reading and threshold, the worst reading, where the\n"
      "  robot was, how long ago it was raised, whether it is still active and acknowledged.\n"
@@ -156,7 +178,7 @@ std::vector<Console::CommandDef> Console::gasCommands() {
      "  operator acknowledges them with ack. Raised alarms print at once, in red with a bell on a\n"
      "  terminal, and the status line shows '| ALARM ...' while they are active.\n",
      &Console::cmdAlarms},
-    {"ack", "ack <number>|all", "acknowledge a gas alarm (alarms lists the numbers)",
+    {"ack", {{keyword("all")}, {word("number")}}, "acknowledge a gas alarm (alarms lists the numbers)",
      "  Acknowledging does not clear an alarm (the robot does, when the gas is gone); it records\n"
      "  that the operator has seen it (catalog and run).\n"
      "  example: ack 3\n",
@@ -167,14 +189,14 @@ std::vector<Console::CommandDef> Console::gasCommands() {
 // Commands of the tuning host (docs/tuning.md).
 std::vector<Console::CommandDef> Console::tuningCommands() {
   return {
-    {"identify", "identify <run-id>|last", "fit the hub-motor model to a recorded run (for tune)",
+    {"identify", {{word("run-id|last")}}, "fit the hub-motor model to a recorded run (for tune)",
      "  Fits each wheel's gain, time constant, dead time and saturation to the commanded and\n"
      "  measured wheel speeds of the run's telemetry (an output-error fit), prints the model and\n"
      "  its fit (100 % = perfect), saves <run>/plant.yaml and makes it the plant tune uses.\n"
      "  'last' = the newest identification run. Record one with `route identification`.\n"
      "  example: identify last\n",
      &Console::cmdIdentify},
-    {"tune", "tune [key=value ...] | tune list", "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
+    {"tune", {{subcommand("list")}, {opt(keyValues("options", "key=value ..."))}}, "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
      "  Closed-loop simulations of the robot's own tracker on the plant (nominal, or the last\n"
      "  `identify`), each candidate over plant variations x noise seeds; cost = weighted max/RMS\n"
      "  position and angle error, convergence time, effort and saturation (docs/tuning.md).\n"
@@ -188,8 +210,14 @@ std::vector<Console::CommandDef> Console::tuningCommands() {
      "  working set (gains push sends it). `tune list`: the sessions in the catalog.\n"
      "  example: tune evals=300 speed=0.5\n",
      &Console::cmdTune},
-    {"gains", "gains show [robot] | gains set <name>=<value>...|paper|tuned|robot | gains push [robot] | "
-              "gains revert [robot] | gains export <file.yaml> | gains import <file.yaml>",
+    {"gains",
+     {{subcommand("show"), opt(completing(word("robot"), Source::kRobots))},
+      {keyword("set"), choice("preset", {"paper", "tuned", "robot"})},
+      {keyword("set"), keyValues("gains", "<name>=<value>...")},
+      {keyword("push"), opt(completing(word("robot"), Source::kRobots))},
+      {keyword("revert"), opt(completing(word("robot"), Source::kRobots))},
+      {keyword("export"), word("file.yaml")},
+      {keyword("import"), word("file.yaml")}},
      "the tracking gains: working set, push to a robot, revert, files",
      "  show: working set, the robot's set in force (with its version), the paper's, the tuned.\n"
      "  set: edit the working set (kp ki kd ke kec k1 k2 k3 a1 a2 a3; bounds are checked).\n"
@@ -206,29 +234,29 @@ std::vector<Console::CommandDef> Console::tuningCommands() {
 // Commands of recorded runs (docs/recording.md).
 std::vector<Console::CommandDef> Console::runCommands() {
   return {
-    {"record", "record start [name] | record stop", "record a run of the selected robot",
+    {"record", {{subcommand("start"), opt(rest("name"))}, {keyword("stop")}}, "record a run of the selected robot",
      "  A run is written to <recording.dir>/<run-id>/: run.mcap (telemetry, commands, acks, events,\n"
      "  camera frames; Foxglove opens it) and video.mp4, and listed in catalog.sqlite with its\n"
      "  summary. track, goto and route start one by themselves (recording.auto_start) and end it\n"
      "  when they complete or fail; record stop ends it ('stopped'). The status line shows REC.\n"
      "  example: record start night round B\n",
      &Console::cmdRecord},
-    {"runs", "runs [robot|outcome|text] [limit]", "list recorded runs, newest first",
+    {"runs", {{words("[robot|outcome|text] [limit]")}}, "list recorded runs, newest first",
      "  A filter word is a robot id, an outcome (completed, stopped, failed, incomplete,\n"
      "  running) or text in the run's name. Default limit 20.\n"
      "  example: runs robot1\n",
      &Console::cmdRuns},
-    {"run", "run show <run-id>", "a recorded run's summary, files and counts",
+    {"run", {{subcommand("show"), word("run-id")}}, "a recorded run's summary, files and counts",
      "  example: run show 20261122-083015-robot1\n", &Console::cmdRun},
-    {"report", "report <run-id>", "write a run's report: PNG plots and summary.md in <run>/report/",
+    {"report", {{word("run-id")}}, "write a run's report: PNG plots and summary.md in <run>/report/",
      "  Plots: trajectory (with the tracking reference), speed and nearest person with the proxemic\n"
      "  zones, tracking errors, gas concentrations; summary.md links them and the run's files.\n"
      "  example: report 20261122-083015-robot1\n",
      &Console::cmdReport},
-    {"export", "export <run-id> csv [dir]", "one CSV per channel of a run's MCAP file (default <run>/csv/)",
+    {"export", {{word("run-id"), keyword("csv"), opt(word("dir"))}}, "one CSV per channel of a run's MCAP file (default <run>/csv/)",
      "  Columns: log_time_s, publish_time_s, then every field, nested ones dotted (pose.x_m).\n",
      &Console::cmdExport},
-    {"replay", "replay <run-id> [speed]", "play a run's telemetry back as status lines (speed 0.1-100, default 1)",
+    {"replay", {{word("run-id"), opt(within(number("speed"), 0.1, 100))}}, "play a run's telemetry back as status lines (speed 0.1-100, default 1)",
      "  One status line per second of run time, and the run's events as they came.\n"
      "  example: replay 1 10\n",
      &Console::cmdReplay},
@@ -238,9 +266,9 @@ std::vector<Console::CommandDef> Console::runCommands() {
 // Commands of scripts: waits, checks, output, leaving.
 std::vector<Console::CommandDef> Console::scriptCommands() {
   return {
-    {"wait", "wait <seconds>", "pause the console (events still print)",
+    {"wait", {{within(number("seconds"), 0, 3600, "s")}}, "pause the console (events still print)",
      "  example: wait 2.5\n", &Console::cmdWait},
-    {"expect", "expect <field> <op> <value> [<tol>] [within <seconds>]", "check a value (scripts, tests)",
+    {"expect", {{words("<field> <op> <value> [<tol>] [within <seconds>]")}}, "check a value (scripts, tests)",
      "  ops: == != < <= > >= ~   ('~' needs a tolerance: |field - value| <= tol; '+-' before it is optional)\n"
      "  within: poll every 20 ms until true or the time runs out (default: check once).\n"
      "  fields of the selected robot: x y theta v w cmd_v cmd_w wheel_l wheel_r mode faults mcu_faults\n"
@@ -260,10 +288,10 @@ std::vector<Console::CommandDef> Console::scriptCommands() {
      "            expect mode == ESTOP within 1\n"
      "            expect nav_mode == FOLLOW_CW within 20\n",
      &Console::cmdExpect},
-    {"echo", "echo <text>", "print text (to label script output)", "  example: echo --- leg 2 ---\n",
+    {"echo", {{opt(rest("text"))}}, "print text (to label script output)", "  example: echo --- leg 2 ---\n",
      &Console::cmdEcho},
-    {"quit", "quit", "leave the console and shut the server down ('exit' too)", "", &Console::cmdQuit},
-    {"exit", "exit", "same as quit", "", &Console::cmdQuit},
+    {"quit", noArguments(), "leave the console and shut the server down ('exit' too)", "", &Console::cmdQuit},
+    {"exit", noArguments(), "same as quit", "", &Console::cmdQuit},
   };
 }
 
@@ -288,7 +316,7 @@ std::string Console::helpText(const std::string& command) {
     std::string s = "commands:\n";
     for (const auto& c : commands()) {
       if (std::string(c.name) == "exit") continue;
-      const std::string syntax = c.syntax;
+      const std::string syntax = commandSyntax(c.name, c.forms);
       s += syntax.size() <= 30 ? "  " + padRight(syntax, 30) + " " + c.summary + "\n"
                                : "  " + syntax + "\n  " + std::string(31, ' ') + c.summary + "\n";
     }
@@ -298,7 +326,43 @@ std::string Console::helpText(const std::string& command) {
   }
   const CommandDef* c = findCommand(command);
   if (!c) return "";
-  return std::string(c->syntax) + "\n  " + c->summary + "\n" + c->details;
+  // One line per form: "ptz <pan_deg> <tilt_deg>", then "ptz home".
+  std::string s;
+  for (const auto& f : formSyntaxes(c->name, c->forms)) s += f + "\n";
+  return s + "  " + c->summary + "\n" + c->details;
+}
+
+std::string Console::tableProblems() {
+  std::string out;
+  for (const auto& c : commands())
+    if (std::string p = formProblems(c.name, c.forms); !p.empty()) out += p + "\n";
+  return out;
+}
+
+std::vector<std::string> Console::completions(const std::string& partial_line) const {
+  std::vector<std::string> done = splitWords(partial_line);
+  const bool at_blank = !partial_line.empty() && (partial_line.back() == ' ' || partial_line.back() == '\t');
+  const std::string partial = at_blank || done.empty() ? "" : done.back();
+  if (!at_blank && !done.empty()) done.pop_back();
+  const bool tried = !done.empty() && done.front() == "try";  // 'try <command>'
+  if (tried) done.erase(done.begin());
+  std::vector<std::string> names;
+  if (!tried) names.push_back("try");
+  for (const auto& c : commands()) names.push_back(c.name);
+  if (done.empty()) {
+    std::vector<std::string> out;
+    for (const auto& n : names)
+      if (n.compare(0, partial.size(), partial) == 0) out.push_back(n);
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  const CommandDef* c = findCommand(done.front() == "?" ? "help" : done.front());
+  if (!c) return {};
+  std::vector<std::string> robots;
+  for (const auto& r : registry_.snapshots(clock_->nowNs())) robots.push_back(r.id);
+  const std::map<ArgSpec::Source, std::vector<std::string>> dynamic{{Source::kCommands, names},
+                                                                    {Source::kRobots, robots}};
+  return completeArgs(c->forms, {done.begin() + 1, done.end()}, partial, dynamic);
 }
 
 }  // namespace inspect::server

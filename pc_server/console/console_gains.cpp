@@ -33,9 +33,8 @@
 
 namespace inspect::server {
 
-bool Console::gainsShow(const Args& args, TuningState& ts) {
-  if (args.size() > 2) return fail("gains", "syntax: gains show [robot]");
-  const std::string robot = args.size() == 2 ? args[1] : selected_;
+bool Console::gainsShow(const CommandArgs& a, TuningState& ts) {
+  const std::string robot = a.has("robot") ? a.text("robot") : selected_;
   std::optional<RobotSnapshot> snap;
   if (!robot.empty()) snap = registry_.snapshot(robot, clock_->nowNs());
   const bool have_robot = snap && snap->gains_known;
@@ -60,31 +59,31 @@ bool Console::gainsShow(const Args& args, TuningState& ts) {
   return true;
 }
 
-bool Console::gainsSet(const Args& args, TuningState& ts) {
-  if (args.size() < 2) return fail("gains", "syntax: gains set <name>=<value> ... | gains set paper|tuned|robot");
-  if (args.size() == 2 && (args[1] == "paper" || args[1] == "tuned" || args[1] == "robot")) {
-    if (args[1] == "paper") ts.working = ts.paper;
-    if (args[1] == "tuned") {
+bool Console::gainsSet(const CommandArgs& a, TuningState& ts) {
+  if (const std::string& set = a.text("preset"); !set.empty()) {
+    if (set == "paper") ts.working = ts.paper;
+    if (set == "tuned") {
       if (!ts.tuned) return fail("gains", "nothing tuned yet (tune)");
       ts.working = *ts.tuned;
     }
-    if (args[1] == "robot") {
+    if (set == "robot") {
       const auto snap = selected_.empty() ? std::optional<RobotSnapshot>() : registry_.snapshot(selected_, clock_->nowNs());
       if (!snap || !snap->gains_known) return fail("gains", "the selected robot has not announced its gains");
       ts.working = net::fromProto(snap->gains);
     }
-    out_ << "gains: working set = " << args[1] << ": " << gainsText(ts.working) << "\n";
+    out_ << "gains: working set = " << set << ": " << gainsText(ts.working) << "\n";
     return true;
   }
+  const auto& args = a.list("gains");
   control::GainSet next = ts.working;
-  for (std::size_t i = 1; i < args.size(); ++i) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
     std::string k, v;
     if (!splitKeyValue(args[i], k, v)) {
       // "gains set kp 12" form
-      if (args.size() == 3 && i == 1) {
-        k = args[1];
-        v = args[2];
-        i = 2;
+      if (args.size() == 2 && i == 0) {
+        k = args[0];
+        v = args[1];
+        i = 1;
       } else {
         return fail("gains", "'" + args[i] + "' is not name=value");
       }
@@ -101,18 +100,16 @@ bool Console::gainsSet(const Args& args, TuningState& ts) {
   return true;
 }
 
-bool Console::cmdGains(const Args& args, const std::string&, int) {
-  if (args.empty()) return fail("gains", "syntax: gains show|set|push|revert|export|import ... (help gains)");
+bool Console::cmdGains(const CommandArgs& a) {
   TuningState* ts = tuning("gains");
   if (!ts) return false;
-  const std::string& sub = args[0];
-  if (sub == "show") return gainsShow(args, *ts);
-  if (sub == "set") return gainsSet(args, *ts);
+  const std::string& sub = a.words.front();  // the form's keyword
+  if (sub == "show") return gainsShow(a, *ts);
+  if (sub == "set") return gainsSet(a, *ts);
   if (sub == "push") {
-    if (args.size() > 2) return fail("gains", "syntax: gains push [robot]");
     std::string robot;
-    if (args.size() == 2) {
-      robot = args[1];
+    if (a.has("robot")) {
+      robot = a.text("robot");
       const auto snap = registry_.snapshot(robot, clock_->nowNs());
       if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
     } else {
@@ -125,8 +122,7 @@ bool Console::cmdGains(const Args& args, const std::string&, int) {
                      tuned ? ts->tuned_session : "");
   }
   if (sub == "revert") {
-    if (args.size() > 2) return fail("gains", "syntax: gains revert [robot]");
-    const std::string robot = args.size() == 2 ? args[1] : selected_;
+    const std::string robot = a.has("robot") ? a.text("robot") : selected_;
     if (robot.empty()) return fail("gains", "no robot selected");
     const auto snap = registry_.snapshot(robot, clock_->nowNs());
     if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
@@ -136,22 +132,21 @@ bool Console::cmdGains(const Args& args, const std::string&, int) {
     if (!pushGains(robot, net::fromProto(prev), "revert to v" + std::to_string(version), "")) return false;
     return true;
   }
+  const std::string& file = a.text("file.yaml");
   if (sub == "export") {
-    if (args.size() != 2) return fail("gains", "syntax: gains export <file.yaml>");
     try {
-      config::exportGains(ts->working, ts->fis, args[1], "exported from the pc_server console");
+      config::exportGains(ts->working, ts->fis, file, "exported from the pc_server console");
     } catch (const std::exception& e) {
       return fail("gains", e.what());
     }
-    out_ << "gains: working set written to " << args[1] << " with its fuzzy system beside it\n";
+    out_ << "gains: working set written to " << file << " with its fuzzy system beside it\n";
     return true;
   }
   if (sub == "import") {
-    if (args.size() != 2) return fail("gains", "syntax: gains import <file.yaml>");
     fuzzy::Fis fis;
     config::GainsFile f;
     try {
-      f = config::importGains(args[1], ts->working, &fis);
+      f = config::importGains(file, ts->working, &fis);
     } catch (const std::exception& e) {
       return fail("gains", e.what());
     }
@@ -160,11 +155,11 @@ bool Console::cmdGains(const Args& args, const std::string&, int) {
       ts->fis_imported = fuzzy::formatFis(fis) != fuzzy::formatFis(ts->fis) || ts->fis_imported;
       ts->fis = fis;
     }
-    out_ << "gains: working set from " << args[1] << ": " << gainsText(ts->working) << "\n";
+    out_ << "gains: working set from " << file << ": " << gainsText(ts->working) << "\n";
     if (ts->fis_imported) out_ << "gains: fuzzy system '" << ts->fis.name << "' goes with the next push\n";
     return true;
   }
-  return fail("gains", "unknown subcommand '" + sub + "' (show, set, push, revert, export, import)");
+  return fail("gains", "unknown subcommand '" + sub + "'");  // a form without its handler
 }
 
 }  // namespace inspect::server

@@ -39,21 +39,17 @@ std::string alarmLine(const AlarmRecord& r, int64_t now_ns) {
 
 }  // namespace
 
-bool Console::cmdInspect(const Args& args, const std::string&, int) {
-  if (args.empty() || args.size() > 2) return fail("inspect", "syntax: inspect <route> [speed_m_s]");
+bool Console::cmdInspect(const CommandArgs& a) {
   Route r;
   try {
-    r = openRoute(args[0]);
+    r = openRoute(a.text("route"));
   } catch (const config::ConfigError& e) {
     return fail("inspect", e.what());
   }
-  std::optional<double> speed;
-  if (args.size() == 2) {
-    speed = parseNumber(args[1]);
-    if (!speed || !commandSpeedOk(*speed))
-      return fail("inspect", "speed_m_s '" + args[1] + "' must be a number in (0, " + fmtShort(kMaxCommandSpeed_m_s) +
-                                 "] m/s");
-  }
+  const std::optional<double> speed = a.number("speed_m_s");
+  if (speed && !commandSpeedOk(*speed))
+    return fail("inspect", "speed_m_s '" + a.text("speed_m_s") + "' must be a number in (0, " +
+                               fmtShort(kMaxCommandSpeed_m_s) + "] m/s");
   const auto robot = connectedRobot("inspect");
   if (!robot) return false;
   if (!recorder_) out_ << "inspect: note: the server records nothing (--no-record): no run, no report\n";
@@ -63,9 +59,8 @@ bool Console::cmdInspect(const Args& args, const std::string&, int) {
   return report(issued, true);
 }
 
-bool Console::cmdAlarms(const Args& args, const std::string&, int) {
-  if (args.size() > 1 || (args.size() == 1 && args[0] != "all")) return fail("alarms", "syntax: alarms [all]");
-  const bool all = args.size() == 1;
+bool Console::cmdAlarms(const CommandArgs& a) {
+  const bool all = a.has("all");
   const auto list = registry_.alarms(all);
   if (list.empty()) {
     out_ << (all ? "no gas alarms so far\n" : "no active or unacknowledged gas alarms\n");
@@ -76,16 +71,15 @@ bool Console::cmdAlarms(const Args& args, const std::string&, int) {
   return true;
 }
 
-bool Console::cmdAck(const Args& args, const std::string&, int) {
-  if (args.size() != 1) return fail("ack", "syntax: ack <number>|all (alarms lists the numbers)");
+bool Console::cmdAck(const CommandArgs& a) {
   std::optional<int> number;
-  if (args[0] != "all") {
-    std::string n = args[0];
+  if (!a.has("all")) {
+    std::string n = a.text("number");
     if (!n.empty() && n[0] == '#') n.erase(0, 1);
     const auto pv = parseNumber(n);
     const double v = pv ? *pv : 0.0;
     if (!pv || v < 1 || v != std::floor(v) || v > 1e9)
-      return fail("ack", "'" + args[0] + "' is not an alarm number (alarms lists them)");
+      return fail("ack", "'" + a.text("number") + "' is not an alarm number (alarms lists them)");
     number = static_cast<int>(v);
   }
   const auto acks = service_->acknowledgeAlarms(session_, number, clock_->nowNs());

@@ -85,9 +85,8 @@ std::optional<std::pair<catalog::RunDetail, std::string>> Console::findRun(const
   return std::make_pair(std::move(*d), std::move(dir));
 }
 
-bool Console::cmdReport(const Args& args, const std::string&, int) {
-  if (args.size() != 1) return fail("report", "syntax: report <run-id>");
-  const auto run = findRun("report", args[0]);
+bool Console::cmdReport(const CommandArgs& a) {
+  const auto run = findRun("report", a.text("run-id"));
   if (!run) return false;
   const auto& [d, dir] = *run;
   try {
@@ -144,12 +143,11 @@ bool Console::cmdReport(const Args& args, const std::string&, int) {
   }
 }
 
-bool Console::cmdExport(const Args& args, const std::string&, int) {
-  if (args.size() < 2 || args.size() > 3 || args[1] != "csv") return fail("export", "syntax: export <run-id> csv [dir]");
-  const auto run = findRun("export", args[0]);
+bool Console::cmdExport(const CommandArgs& a) {
+  const auto run = findRun("export", a.text("run-id"));
   if (!run) return false;
   const auto& [d, dir] = *run;
-  const std::string out_dir = args.size() == 3 ? args[2] : dir + "/csv";
+  const std::string out_dir = a.has("dir") ? a.text("dir") : dir + "/csv";
   try {
     const auto r = record::exportCsv(dir + "/run.mcap", out_dir, false, "/" + d.info.robot + "/");
     out_ << d.info.id << ": exported " << r.files.size() << " CSV files to " << out_dir << "\n";
@@ -161,15 +159,9 @@ bool Console::cmdExport(const Args& args, const std::string&, int) {
   }
 }
 
-bool Console::cmdReplay(const Args& args, const std::string&, int) {
-  if (args.empty() || args.size() > 2) return fail("replay", "syntax: replay <run-id> [speed]");
-  double speed = 1.0;
-  if (args.size() == 2) {
-    const auto v = parseNumber(args[1]);
-    if (!v || !(*v >= 0.1 && *v <= 100)) return fail("replay", "speed '" + args[1] + "': want 0.1 to 100");
-    speed = *v;
-  }
-  const auto run = findRun("replay", args[0]);
+bool Console::cmdReplay(const CommandArgs& a) {
+  const double speed = a.number("speed", 1.0);
+  const auto run = findRun("replay", a.text("run-id"));
   if (!run) return false;
   const auto& [d, dir] = *run;
   RunLog log;

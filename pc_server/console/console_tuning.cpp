@@ -87,12 +87,11 @@ Console::TuningState* Console::tuning(const std::string& cmd) {
 
 // ------------------------------------------------------------------ identify
 
-bool Console::cmdIdentify(const Args& args, const std::string&, int) {
-  if (args.size() != 1) return fail("identify", "syntax: identify <run-id>|last");
+bool Console::cmdIdentify(const CommandArgs& a) {
   TuningState* ts = tuning("identify");
   if (!ts) return false;
   if (!recorder_) return fail("identify", "the server records nothing (--no-record): there are no runs");
-  std::string id = args[0];
+  std::string id = a.text("run-id|last");
   if (id == "last") {
     // The newest run that played a wheel test (an identification route).
     catalog::RunFilter f;
@@ -331,8 +330,8 @@ std::optional<std::string> Console::saveTuneSession(const tuning::TuneSetup& set
   return session;
 }
 
-bool Console::cmdTune(const Args& args, const std::string&, int) {
-  if (args.size() == 1 && args[0] == "list") return cmdTuneList();
+bool Console::cmdTune(const CommandArgs& a) {
+  if (a.has("list")) return cmdTuneList();
   TuningState* ts = tuning("tune");
   if (!ts) return false;
   tuning::TuneSetup s;
@@ -342,7 +341,8 @@ bool Console::cmdTune(const Args& args, const std::string&, int) {
   s.plant = ts->plant;
   std::string plant_source = ts->plant_source;
   std::string start = "working";
-  if (const std::string why = applyKeyValues(args, tuneOptions(*ts, s, plant_source, start), "tune"); !why.empty())
+  if (const std::string why = applyKeyValues(a.list("options"), tuneOptions(*ts, s, plant_source, start), "tune");
+      !why.empty())
     return fail("tune", why);
   const control::GainSet start_gains = start == "paper" ? ts->paper : start == "tuned" ? *ts->tuned : ts->working;
   // Each run's samples are held in memory: a reference longer than 5 minutes

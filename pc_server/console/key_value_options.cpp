@@ -7,18 +7,6 @@
 
 namespace inspect::server {
 
-namespace {
-
-/// "a, b or c".
-std::string alternatives(const std::vector<std::string>& words) {
-  std::string out;
-  for (std::size_t i = 0; i < words.size(); ++i)
-    out += (i == 0 ? "" : i + 1 == words.size() ? " or " : ", ") + words[i];
-  return out;
-}
-
-}  // namespace
-
 std::string applyKeyValues(const std::vector<std::string>& args, const std::vector<KeyValueOption>& table,
                            const std::string& command) {
   for (const auto& a : args) {
@@ -35,7 +23,7 @@ std::string applyKeyValues(const std::vector<std::string>& args, const std::vect
         return k + "=" + v + ": expected a number in [" + util::fmtShort(opt->lo) + ", " + util::fmtShort(opt->hi) + "]";
       number = *n;
     } else if (!opt->words.empty() && std::find(opt->words.begin(), opt->words.end(), v) == opt->words.end()) {
-      return k + "=" + v + ": expected " + alternatives(opt->words);
+      return k + "=" + v + ": expected " + util::alternatives(opt->words);
     }
     if (std::string why = opt->apply(number, v); !why.empty()) return why;
   }

@@ -166,22 +166,23 @@ Issued OperatorService::video(uint64_t session, const std::string& robot, const 
       what = "keyframe";
       break;
     case W::kRes:
-      if (r.width < 64 || r.height < 64 || r.width > 4096 || r.height > 4096 || r.width % 2 || r.height % 2)
+      if (r.width < kVideoMinSide || r.height < kVideoMinSide || r.width > kVideoMaxSide ||
+          r.height > kVideoMaxSide || r.width % 2 || r.height % 2)
         return invalid("video", robot,
-                       "res '" + std::to_string(r.width) + "x" + std::to_string(r.height) +
-                           "': want <W>x<H>, even, 64 to 4096 (e.g. 1280x720)");
+                       "res '" + std::to_string(r.width) + "x" + std::to_string(r.height) + "': want " + kVideoSizeWant);
       v->set_width(static_cast<uint32_t>(r.width));
       v->set_height(static_cast<uint32_t>(r.height));
       what = "res";
       break;
     case W::kFps:
-      if (!(r.fps >= 1 && r.fps <= 120)) return invalid("video", robot, "fps '" + fmtShort(r.fps) + "': want 1 to 120");
+      if (!(r.fps >= kVideoMinFps && r.fps <= kVideoMaxFps))
+        return invalid("video", robot, "fps '" + fmtShort(r.fps) + "': want " + kVideoFpsWant);
       v->set_fps(r.fps);
       what = "fps";
       break;
     case W::kBitrate:
-      if (r.bitrate_kbps < 50 || r.bitrate_kbps > 50000)
-        return invalid("video", robot, "bitrate '" + std::to_string(r.bitrate_kbps) + "': want 50 to 50000 kbit/s");
+      if (r.bitrate_kbps < kVideoMinBitrate_kbps || r.bitrate_kbps > kVideoMaxBitrate_kbps)
+        return invalid("video", robot, "bitrate '" + std::to_string(r.bitrate_kbps) + "': want " + kVideoBitrateWant);
       v->set_bitrate_kbps(static_cast<uint32_t>(r.bitrate_kbps));
       what = "bitrate";
       break;

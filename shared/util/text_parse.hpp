@@ -17,6 +17,8 @@ std::optional<long long> parseInteger(std::string_view text);
 std::vector<std::string> splitWords(std::string_view text);
 /// Removes leading and trailing blanks (and a trailing '\r').
 std::string trim(std::string_view text);
+/// The words as a list for a message: "a, b or c" ("a" alone, "a or b").
+std::string alternatives(const std::vector<std::string>& words);
 /// "key=value" into its two halves (neither empty); false otherwise.
 bool splitKeyValue(const std::string& a, std::string& k, std::string& v);
 

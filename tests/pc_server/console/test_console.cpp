@@ -152,6 +152,27 @@ TEST_F(ConsoleTest, HelpListsEveryCommandAndExplainsOne) {
   EXPECT_HAS(out, "unknown command 'nope'");
 }
 
+TEST_F(ConsoleTest, TheCommandTableParsesUnambiguously) { EXPECT_EQ(Console::tableProblems(), ""); }
+
+TEST_F(ConsoleTest, CompletionComesFromTheCommandTable) {
+  connectRobot();
+  using V = std::vector<std::string>;
+  EXPECT_EQ(console_.completions("tr"), (V{"track", "try"}));
+  EXPECT_EQ(console_.completions("try tr"), (V{"track"}));
+  EXPECT_EQ(console_.completions("dr"), (V{"drive"}));
+  EXPECT_EQ(console_.completions("video "), (V{"bitrate", "fps", "keyframe", "off", "on", "res", "stats"}));
+  EXPECT_EQ(console_.completions("gains push r"), (V{"robot1"}));
+  EXPECT_EQ(console_.completions("help dri"), (V{"drive"}));
+  EXPECT_EQ(console_.completions("control take f"), (V{"force"}));
+  EXPECT_TRUE(console_.completions("drive 0.1 ").empty());
+  EXPECT_TRUE(console_.completions("nonsense ").empty());
+  // Help shows the same syntax the errors quote.
+  EXPECT_EQ(Console::helpText("control").rfind("control\ncontrol take [force]\ncontrol release\n", 0), 0u);
+  const auto [ok, out] = run("control take forse");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "syntax: control | control take [force] | control release");
+}
+
 struct BadArgsCase {
   const char* line;
   const char* message;
