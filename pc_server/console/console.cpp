@@ -291,11 +291,11 @@ bool Console::cmdRecord(const CommandArgs& a) {
   return true;
 }
 
-bool Console::cmdRuns(const CommandArgs& words) {
+bool Console::cmdRuns(const CommandArgs& args) {
   if (!recorder_) return fail("runs", "the server records nothing (recording.enabled: false or --no-record)");
   catalog::RunFilter f;
   f.limit = 20;
-  for (const auto& a : words.words) {
+  for (const auto& a : args.words) {
     if (const auto n = parseInteger(a); n && *n > 0) {
       f.limit = static_cast<int>(*n);
     } else if (a == "completed" || a == "stopped" || a == "failed" || a == "incomplete" || a == "running") {

@@ -231,8 +231,6 @@ class Console {
   /// Whether this session may move `robot` (see setSession); prints why not.
   bool mayMove(const std::string& robot, const std::string& cmd);
   bool cmdControl(const CommandArgs& a);
-  /// Sends a Stop/EStop/Resume and reports its Ack.
-  bool simpleCommand(const std::string& name, v1::Command cmd);
   /// Sends `cmd` to the selected robot through the service, waits for its Ack and prints the answer.
   bool sendAndReport(const std::string& name, v1::Command cmd, bool runs = false);
   /// A service call's result, waited for when pending, printed. With `runs` (track, goto,

