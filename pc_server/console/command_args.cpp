@@ -82,11 +82,12 @@ ArgSpec rest(const std::string& name, const std::string& shown) {
   return a;
 }
 
-ArgSpec keyValues(const std::string& name, const std::string& shown) {
+ArgSpec keyValues(const std::string& name, const std::string& shown, std::vector<ArgSpec> keys) {
   ArgSpec a;
   a.kind = ArgSpec::Kind::kKeyValues;
   a.name = name;
   a.shown = shown;
+  a.keys = std::move(keys);
   return a;
 }
 
@@ -208,6 +209,37 @@ std::string valueError(const ArgSpec& a, const std::string& w) {
   return "";
 }
 
+const ArgSpec* keyOf(const ArgSpec& a, const std::string& key) {
+  for (const auto& k : a.keys)
+    if (k.name == key) return &k;
+  return nullptr;
+}
+
+/// Why the word is not one of `a`'s key=value pairs ("" when it is):
+/// "'frob' is not key=value", "unknown option 'colour' (ref, radius ... or start)",
+/// "evals=5: expected a number in [10, 100000]", "ref=spiral: expected circle, line or waypoints".
+std::string keyValueError(const ArgSpec& a, const std::string& w) {
+  std::string k, v;
+  if (!util::splitKeyValue(w, k, v)) return "'" + w + "' is not key=value";
+  const ArgSpec* key = keyOf(a, k);
+  if (!key) {
+    std::vector<std::string> names;
+    for (const auto& o : a.keys) names.push_back(o.name);
+    return "unknown option '" + k + "' (" + util::alternatives(names) + ")";
+  }
+  if (valueError(*key, v).empty()) return "";
+  const bool fraction = key->kind == Kind::kInteger && util::parseNumber(v) && !util::parseInteger(v);
+  const std::string what = fraction ? "a whole number" : "a number";
+  switch (key->kind) {
+    case Kind::kNumber:
+    case Kind::kInteger:
+      return w + ": expected " + what +
+             (key->ranged ? " in [" + util::fmtShort(key->lo) + ", " + util::fmtShort(key->hi) + "]" : "");
+    case Kind::kChoice: return w + ": expected " + util::alternatives(key->words);
+    default: return w + ": expected " + key->shown;
+  }
+}
+
 /// How a form's syntax shows the argument.
 std::string shownInSyntax(const ArgSpec& a) {
   if (!a.optional || a.kind == Kind::kWords) return a.shown;
@@ -243,6 +275,7 @@ std::string countError(const std::string& command, const CommandForm& f) {
 struct Attempt {
   std::optional<CommandArgs> args;
   bool count_error = false;     // too few or too many words
+  bool in_key_values = false;   // value_error is about one of a kKeyValues' pairs
   std::string value_error;      // a word of the wrong type or out of range
   const ArgSpec* failed = nullptr;
   std::string failed_word;
@@ -262,7 +295,24 @@ Attempt tryForm(const CommandForm& f, const std::vector<Word>& words, const std:
         return r;
       }
       out.setText(a.name, line.substr(words[j].at));
-      for (; j < words.size(); ++j) out.addWord(a.name, words[j].text);
+      for (; j < words.size(); ++j) {
+        const std::string& w = words[j].text;
+        if (a.kind == Kind::kKeyValues && !a.keys.empty()) {
+          if (std::string why = keyValueError(a, w); !why.empty()) {
+            r.failed = &a;
+            r.failed_word = w;
+            r.value_error = std::move(why);
+            r.in_key_values = true;
+            return r;
+          }
+          std::string k, v;
+          util::splitKeyValue(w, k, v);
+          const ArgSpec& key = *keyOf(a, k);
+          out.setText(a.name + "." + k, v);  // a key given twice: the last value
+          if (key.kind == Kind::kNumber || key.kind == Kind::kInteger) out.setNumber(a.name + "." + k, *util::parseNumber(v));
+        }
+        out.addWord(a.name, w);
+      }
       continue;
     }
     if (j == words.size()) {
@@ -354,6 +404,9 @@ std::variant<CommandArgs, std::string> parseCommandArgs(const std::string& comma
     if (!a.failed->want.empty()) return words[0].text + " '" + a.failed_word + "': want " + a.failed->want;
     return a.value_error;
   }
+  // A form of key=value pairs that the line fits but for one pair says which.
+  const auto kv = std::find_if(attempts.begin(), attempts.end(), [](const Attempt& a) { return a.in_key_values; });
+  if (kv != attempts.end()) return kv->value_error;
   const bool all_by_word = std::all_of(forms.begin(), forms.end(), leadsByWord);
   if (!all_by_word || words.empty()) return syntax;
   // "unknown subcommand 'frob' (show, set, push, revert, export or import)"
@@ -389,12 +442,27 @@ std::vector<std::string> completeArgs(const std::vector<CommandForm>& forms, con
     for (const auto& c : candidates)
       if (c.compare(0, partial.size(), partial) == 0) out.insert(c);
   };
+  const auto offerKeys = [&](const ArgSpec& a) {
+    std::string k, v;
+    if (!util::splitKeyValue(partial, k, v)) {
+      for (const auto& key : a.keys)
+        if (key.name.compare(0, partial.size(), partial) == 0) out.insert(key.name + "=");
+      return;
+    }
+    if (const ArgSpec* key = keyOf(a, k))
+      for (const auto& w : key->words)
+        if (w.compare(0, v.size(), v) == 0) out.insert(k + "=" + w);
+  };
   for (const auto& f : forms) {
     std::size_t j = 0;
     bool ok = true;
     std::size_t i = 0;
     for (; i < f.args.size() && j < done.size(); ++i) {
       const ArgSpec& a = f.args[i];
+      if (a.kind == Kind::kKeyValues && !a.keys.empty()) {
+        j = done.size();  // the pairs go on to the end of the line: offer the keys again
+        break;
+      }
       if (multiWord(a.kind)) {
         j = done.size();
         ok = false;  // free text: nothing to offer
@@ -410,6 +478,7 @@ std::vector<std::string> completeArgs(const std::vector<CommandForm>& forms, con
     if (!ok || j < done.size()) continue;
     // The next word may fill any optional argument up to and including the next required one.
     for (; i < f.args.size(); ++i) {
+      if (f.args[i].kind == Kind::kKeyValues) offerKeys(f.args[i]);
       offer(f.args[i]);
       if (!f.args[i].optional) break;
     }

@@ -41,6 +41,10 @@ struct ArgSpec {
   std::string unit;  // range errors: "-1 s is outside [0, 3600]"
   std::string want;  // value errors in a keyword form: "fps 'many': want 1 to 120"
   enum class Source { kNone, kCommands, kRobots } completes = Source::kNone;
+  /// kKeyValues: the keys accepted, each a number, whole number, choice or
+  /// word named by its key ("evals", "ref"); empty = any name=value, checked
+  /// by the handler. Values are read as "<name>.<key>".
+  std::vector<ArgSpec> keys;
 };
 
 namespace args {
@@ -54,7 +58,7 @@ ArgSpec size(const std::string& name);
 ArgSpec word(const std::string& name, const std::string& noun = "");
 ArgSpec words(const std::string& shown);
 ArgSpec rest(const std::string& name, const std::string& shown = "");
-ArgSpec keyValues(const std::string& name, const std::string& shown);
+ArgSpec keyValues(const std::string& name, const std::string& shown, std::vector<ArgSpec> keys = {});
 /// The same argument, optional ("[<speed_m_s>]").
 ArgSpec opt(ArgSpec a);
 /// The same number, checked in [lo, hi] (`unit` names it in the error).
@@ -119,7 +123,8 @@ std::variant<CommandArgs, std::string> parseCommandArgs(const std::string& comma
 std::string formProblems(const std::string& command, const std::vector<CommandForm>& forms);
 
 /// The words that may come next after `done` (complete words) and start with
-/// `partial`, from the forms' keywords and choices; `dynamic` answers the
+/// `partial`, from the forms' keywords, choices and keys ("evals=", "ref=line");
+/// `dynamic` answers the
 /// sources (robots, commands). Sorted, without duplicates.
 std::vector<std::string> completeArgs(const std::vector<CommandForm>& forms, const std::vector<std::string>& done,
                                       const std::string& partial,

@@ -37,7 +37,6 @@ class Recorder;
 namespace scene {
 class SiteMaps;
 }
-struct KeyValueOption;
 
 class Console {
  public:
@@ -201,10 +200,12 @@ class Console {
   bool gainsSet(const CommandArgs& a, TuningState& ts);
   /// `tune list`: the tuning sessions in the catalog, newest first.
   bool cmdTuneList();
-  /// tune's key=value options, each setting its part of `s`, the plant's
-  /// description or the start gains (parsed by applyKeyValues).
-  std::vector<KeyValueOption> tuneOptions(TuningState& ts, tuning::TuneSetup& s, std::string& plant_source,
-                                          std::string& start);
+  /// tune's key=value options for the command table: each key's type and range.
+  static std::vector<ArgSpec> tuneOptionKeys();
+  /// Sets from tune's key=value options (parsed by the command table) each
+  /// part of `s`, the plant's description and the start gains; "" or why not.
+  std::string applyTuneOptions(const CommandArgs& a, TuningState& ts, tuning::TuneSetup& s,
+                               std::string& plant_source, std::string& start);
   /// Runs the optimiser from `start` with its progress line (Ctrl-C cancels); nullopt (printed why) on failure.
   std::optional<tuning::TuneResult> runTuner(tuning::Tuner& tuner, const control::GainSet& start);
   /// Writes the session's files under the tuning directory and books it in the

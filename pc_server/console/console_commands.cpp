@@ -196,7 +196,7 @@ std::vector<Console::CommandDef> Console::tuningCommands() {
      "  'last' = the newest identification run. Record one with `route identification`.\n"
      "  example: identify last\n",
      &Console::cmdIdentify},
-    {"tune", {{subcommand("list")}, {opt(keyValues("options", "key=value ..."))}}, "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
+    {"tune", {{subcommand("list")}, {opt(keyValues("options", "key=value ...", tuneOptionKeys()))}}, "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
      "  Closed-loop simulations of the robot's own tracker on the plant (nominal, or the last\n"
      "  `identify`), each candidate over plant variations x noise seeds; cost = weighted max/RMS\n"
      "  position and angle error, convergence time, effort and saturation (docs/tuning.md).\n"

@@ -13,7 +13,6 @@
 #include <sstream>
 
 #include "pc_server/console/console.hpp"
-#include "pc_server/console/key_value_options.hpp"
 #include "pc_server/console/tuning_state.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/console/text_util.hpp"
@@ -45,6 +44,7 @@ std::string wheelLine(const char* name, const control::WheelMotorModel& m) {
 }
 
 constexpr double kMaxTuneReference_s = 300.0;
+constexpr double kTuneMinSpeed_m_s = 0.05;
 
 std::string sessionStamp() {
   const auto now = std::chrono::system_clock::now();
@@ -166,80 +166,87 @@ bool Console::cmdTuneList() {
   return true;
 }
 
-std::vector<KeyValueOption> Console::tuneOptions(TuningState& ts, tuning::TuneSetup& s, std::string& plant_source,
-                                                 std::string& start) {
-  using Kind = KeyValueOption::Kind;
-  const auto number = [](std::string key, double lo, double hi, std::function<void(double)> set) {
-    return KeyValueOption{std::move(key), Kind::kNumber, lo, hi, {}, [set](double x, const std::string&) {
-                            set(x);
-                            return std::string();
-                          }};
-  };
-  const auto count = [&](std::string key, double lo, double hi, int& field) {
-    return number(std::move(key), lo, hi, [&field](double x) { field = static_cast<int>(x); });
-  };
-  return {
-      {"ref", Kind::kWord, 0, 0, {"circle", "line", "waypoints"},
-       [&s](double, const std::string& v) {
-         using K = tuning::TuneReference::Kind;
-         s.reference.kind = v == "circle" ? K::kCircle : v == "line" ? K::kLine : K::kWaypoints;
-         return std::string();
-       }},
-      number("radius", 0.5, 50.0, [&s](double x) { s.reference.radius_m = x; }),
-      number("speed", 0.05, ts.robot.limits.max_v_m_s, [&s](double x) { s.reference.speed_m_s = x; }),
-      number("laps", 0.1, 10.0, [&s](double x) { s.reference.laps = x; }),
-      number("length", 1.0, 100.0, [&s](double x) { s.reference.length_m = x; }),
-      count("evals", 10, 100000, s.max_evals),
-      count("variations", 1, 64, s.plant_variations),
-      count("seeds", 1, 64, s.seeds),
-      count("threads", 0, 64, s.threads),
-      number("seed", 0, 4294967295.0, [&s](double x) { s.seed = static_cast<uint32_t>(x); }),
-      {"params", Kind::kWord, 0, 0, {},
-       [&s](double, const std::string& v) {
-         s.params.clear();
-         if (v == "all") {
-           s.params.assign(control::kGainNames.begin(), control::kGainNames.end());
-           return std::string();
-         }
-         std::stringstream ss(v);
-         std::string p;
-         while (std::getline(ss, p, ',')) {
-           control::GainSet probe;
-           if (!control::gainByName(probe, p))
-             return "params: unknown gain '" + p + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3, or all)";
-           s.params.push_back(p);
-         }
-         return std::string();
-       }},
-      {"plant", Kind::kWord, 0, 0, {},
-       [this, &ts, &s, &plant_source](double, const std::string& v) -> std::string {
-         if (v == "current") return "";
-         if (v == "nominal") {
-           s.plant = sim::nominalPlant(ts.robot);
-           plant_source = "nominal (config/robot.yaml)";
-           return "";
-         }
-         try {
-           std::string path = v;
-           if (!fs::exists(path) && recorder_) {  // a run id: its identified plant
-             path = recorder_->config().dir + "/" + v + "/plant.yaml";
-             if (!fs::exists(path))
-               return "plant=" + v + ": no such file, and no run '" + v + "' with plant.yaml (identify it first)";
-           }
-           s.plant = tuning::loadPlantFile(path);
-           plant_source = "from " + path;
-           return "";
-         } catch (const std::exception& e) {
-           return std::string("plant=") + v + ": " + e.what();
-         }
-       }},
-      {"start", Kind::kWord, 0, 0, {"working", "paper", "tuned"},
-       [&ts, &start](double, const std::string& v) -> std::string {
-         if (v == "tuned" && !ts.tuned) return "start=tuned: nothing tuned yet";
-         start = v;
-         return "";
-       }},
-  };
+std::vector<ArgSpec> Console::tuneOptionKeys() {
+  using namespace args;
+  const auto count = [](const char* key, double lo, double hi) { return within(integer(key), lo, hi); };
+  return {choice("ref", {"circle", "line", "waypoints"}),
+          within(number("radius"), 0.5, 50.0),
+          within(number("speed"), kTuneMinSpeed_m_s, 10.0),  // and at most the robot's max_v (applyTuneOptions)
+          within(number("laps"), 0.1, 10.0),
+          within(number("length"), 1.0, 100.0),
+          count("evals", 10, 100000),
+          count("variations", 1, 64),
+          count("seeds", 1, 64),
+          count("threads", 0, 64),
+          count("seed", 0, 4294967295.0),
+          word("params"),
+          word("plant"),
+          choice("start", {"working", "paper", "tuned"})};
+}
+
+std::string Console::applyTuneOptions(const CommandArgs& a, TuningState& ts, tuning::TuneSetup& s,
+                                      std::string& plant_source, std::string& start) {
+  // Types and ranges are checked by the command table (tuneOptionKeys); what
+  // depends on this robot and these files is checked here.
+  const auto number = [&a](const char* key) { return a.number(std::string("options.") + key); };
+  const auto text = [&a](const char* key) -> const std::string& { return a.text(std::string("options.") + key); };
+  if (const std::string& ref = text("ref"); !ref.empty()) {
+    using K = tuning::TuneReference::Kind;
+    s.reference.kind = ref == "circle" ? K::kCircle : ref == "line" ? K::kLine : K::kWaypoints;
+  }
+  if (const auto x = number("radius")) s.reference.radius_m = *x;
+  if (const auto x = number("speed")) {
+    if (*x > ts.robot.limits.max_v_m_s)
+      return "speed=" + text("speed") + ": expected a number in [" + fmtShort(kTuneMinSpeed_m_s) + ", " +
+             fmtShort(ts.robot.limits.max_v_m_s) + "] (the robot's max_v)";
+    s.reference.speed_m_s = *x;
+  }
+  if (const auto x = number("laps")) s.reference.laps = *x;
+  if (const auto x = number("length")) s.reference.length_m = *x;
+  if (const auto x = number("evals")) s.max_evals = static_cast<int>(*x);
+  if (const auto x = number("variations")) s.plant_variations = static_cast<int>(*x);
+  if (const auto x = number("seeds")) s.seeds = static_cast<int>(*x);
+  if (const auto x = number("threads")) s.threads = static_cast<int>(*x);
+  if (const auto x = number("seed")) s.seed = static_cast<uint32_t>(*x);
+  if (const std::string& v = text("params"); !v.empty()) {
+    s.params.clear();
+    if (v == "all") {
+      s.params.assign(control::kGainNames.begin(), control::kGainNames.end());
+    } else {
+      std::stringstream ss(v);
+      std::string p;
+      while (std::getline(ss, p, ',')) {
+        control::GainSet probe;
+        if (!control::gainByName(probe, p))
+          return "params: unknown gain '" + p + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3, or all)";
+        s.params.push_back(p);
+      }
+    }
+  }
+  if (const std::string& v = text("plant"); !v.empty() && v != "current") {
+    if (v == "nominal") {
+      s.plant = sim::nominalPlant(ts.robot);
+      plant_source = "nominal (config/robot.yaml)";
+    } else {
+      try {
+        std::string path = v;
+        if (!fs::exists(path) && recorder_) {  // a run id: its identified plant
+          path = recorder_->config().dir + "/" + v + "/plant.yaml";
+          if (!fs::exists(path))
+            return "plant=" + v + ": no such file, and no run '" + v + "' with plant.yaml (identify it first)";
+        }
+        s.plant = tuning::loadPlantFile(path);
+        plant_source = "from " + path;
+      } catch (const std::exception& e) {
+        return std::string("plant=") + v + ": " + e.what();
+      }
+    }
+  }
+  if (const std::string& v = text("start"); !v.empty()) {
+    if (v == "tuned" && !ts.tuned) return "start=tuned: nothing tuned yet";
+    start = v;
+  }
+  return "";
 }
 
 std::optional<tuning::TuneResult> Console::runTuner(tuning::Tuner& tuner, const control::GainSet& start_gains) {
@@ -341,8 +348,7 @@ bool Console::cmdTune(const CommandArgs& a) {
   s.plant = ts->plant;
   std::string plant_source = ts->plant_source;
   std::string start = "working";
-  if (const std::string why = applyKeyValues(a.list("options"), tuneOptions(*ts, s, plant_source, start), "tune");
-      !why.empty())
+  if (const std::string why = applyTuneOptions(a, *ts, s, plant_source, start); !why.empty())
     return fail("tune", why);
   const control::GainSet start_gains = start == "paper" ? ts->paper : start == "tuned" ? *ts->tuned : ts->working;
   // Each run's samples are held in memory: a reference longer than 5 minutes

@@ -113,3 +113,34 @@ TEST(CommandArgs, CompletionOffersWhatMayComeNext) {
   EXPECT_EQ(completeArgs(gains, {"push"}, "robot", robots), (V{"robot1", "robot2"}));
   EXPECT_TRUE(completeArgs(kGoto, {"1", "2", "3"}, "", robots).empty());
 }
+
+TEST(CommandArgs, KeyValuePairsAreCheckedByTheirKeys) {
+  const std::vector<CommandForm> tune{
+      {subcommand("list")},
+      {opt(keyValues("options", "key=value ...",
+                     {choice("ref", {"circle", "line"}), within(integer("evals"), 10, 1000), within(number("speed"), 0.1, 2),
+                      word("plant")}))}};
+  const CommandArgs a = parsed(tune, "evals=20 ref=line speed=0.5 evals=30 plant=run-7");
+  EXPECT_EQ(a.form, 1u);
+  EXPECT_EQ(a.number("options.evals"), 30.0);  // the last of a key given twice
+  EXPECT_EQ(a.text("options.ref"), "line");
+  EXPECT_EQ(a.number("options.speed"), 0.5);
+  EXPECT_EQ(a.text("options.plant"), "run-7");
+  EXPECT_FALSE(a.has("options.radius"));
+  EXPECT_EQ(a.list("options").size(), 5u);
+  EXPECT_EQ(parsed(tune, "").form, 1u);
+  EXPECT_EQ(parsed(tune, "list").form, 0u);
+  EXPECT_EQ(errorOf("tune", tune, "frob"), "'frob' is not key=value");
+  EXPECT_EQ(errorOf("tune", tune, "colour=red"), "unknown option 'colour' (ref, evals, speed or plant)");
+  EXPECT_EQ(errorOf("tune", tune, "evals=5"), "evals=5: expected a number in [10, 1000]");
+  EXPECT_EQ(errorOf("tune", tune, "evals=abc"), "evals=abc: expected a number in [10, 1000]");
+  EXPECT_EQ(errorOf("tune", tune, "evals=20.5"), "evals=20.5: expected a whole number in [10, 1000]");
+  EXPECT_EQ(errorOf("tune", tune, "ref=line ref=spiral"), "ref=spiral: expected circle or line");
+  EXPECT_EQ(errorOf("tune", tune, "list extra"), "syntax: tune list | tune [key=value ...]");
+  // Completion offers the keys, then a choice's values.
+  using V = std::vector<std::string>;
+  EXPECT_EQ(completeArgs(tune, {}, "", {}), (V{"evals=", "list", "plant=", "ref=", "speed="}));
+  EXPECT_EQ(completeArgs(tune, {"evals=20"}, "r", {}), (V{"ref="}));
+  EXPECT_EQ(completeArgs(tune, {}, "ref=c", {}), (V{"ref=circle"}));
+  EXPECT_TRUE(completeArgs(tune, {}, "speed=", {}).empty());
+}

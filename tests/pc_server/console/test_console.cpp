@@ -164,6 +164,8 @@ TEST_F(ConsoleTest, CompletionComesFromTheCommandTable) {
   EXPECT_EQ(console_.completions("gains push r"), (V{"robot1"}));
   EXPECT_EQ(console_.completions("help dri"), (V{"drive"}));
   EXPECT_EQ(console_.completions("control take f"), (V{"force"}));
+  EXPECT_EQ(console_.completions("tune evals=30 s"), (V{"seed=", "seeds=", "speed=", "start="}));
+  EXPECT_EQ(console_.completions("tune start=p"), (V{"start=paper"}));
   EXPECT_TRUE(console_.completions("drive 0.1 ").empty());
   EXPECT_TRUE(console_.completions("nonsense ").empty());
   // Help shows the same syntax the errors quote.
