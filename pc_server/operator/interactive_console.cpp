@@ -22,6 +22,7 @@ InteractiveConsole::InteractiveConsole(Console& console, StopFlag& stop, double 
       stop_(stop),
       term_(0, 1),
       reader_(0, stop),
+      editor_(kPrompt, [&console](const std::string& before) { return console.completions(before); }),
       status_period_(std::chrono::nanoseconds(static_cast<int64_t>(1e9 / status_refresh_hz))) {}
 
 std::string InteractiveConsole::statusText() const {
@@ -41,10 +42,29 @@ void InteractiveConsole::refreshStatus(bool force) {
   term_.drawStatus(statusText(), alarm);
 }
 
-void InteractiveConsole::printAbove(const std::string& text, const std::string& redraw) {
+void InteractiveConsole::printAbove(const std::string& text) {
   if (text.empty()) return;
-  std::cout << "\r\x1b[K" << text << redraw;
+  std::cout << "\r\x1b[K" << text << (term_.rawMode() ? editor_.render() : std::string(kPrompt));
   std::cout.flush();
+}
+
+LineReader::Result InteractiveConsole::nextLine(std::string& line) {
+  if (!term_.rawMode()) return reader_.nextLine(line, kPollMs);
+  if (pending_.empty()) {
+    const auto r = reader_.readChunk(pending_, kPollMs);
+    if (r != LineReader::Result::kData) return r;
+  }
+  // Feed up to the end of a line; the rest (a pasted second line) waits for the next call.
+  std::size_t used = 0;
+  auto outcome = LineEditor::Outcome::kEditing;
+  while (used < pending_.size() && outcome == LineEditor::Outcome::kEditing) outcome = editor_.feed(pending_[used++]);
+  pending_.erase(0, used);
+  std::cout << editor_.takeOutput();
+  std::cout.flush();
+  if (outcome == LineEditor::Outcome::kEof) return LineReader::Result::kEof;
+  if (outcome != LineEditor::Outcome::kLine) return LineReader::Result::kTimeout;
+  line = editor_.takeLine();
+  return LineReader::Result::kData;
 }
 
 void InteractiveConsole::run() {
@@ -52,6 +72,7 @@ void InteractiveConsole::run() {
   if (tty) {
     console_.setTeleopHandler([this](KeyboardTeleop::Mode m, const std::string& r) { return teleop(m, r); });
     term_.enableStatusLine();
+    term_.enterRawMode();  // keys to the line editor
     console_.setAlarmStyle(true);
   }
   console_.setIdleHook([this] { refreshStatus(false); });
@@ -61,7 +82,7 @@ void InteractiveConsole::run() {
   int line_no = 0;
   while (!console_.quitRequested()) {
     std::string line;
-    const auto r = reader_.nextLine(line, kPollMs);
+    const auto r = nextLine(line);
     if (r == LineReader::Result::kStopped) break;
     if (r == LineReader::Result::kEof) {
       std::cout << "\n";
@@ -70,10 +91,10 @@ void InteractiveConsole::run() {
     if (r == LineReader::Result::kData) {
       console_.execute(line, ++line_no);
       if (console_.quitRequested()) break;
-      std::cout << kPrompt;
+      std::cout << (tty ? editor_.render() : std::string(kPrompt));
       std::cout.flush();
     } else {
-      printAbove(console_.background(), kPrompt);
+      printAbove(console_.background());
     }
     refreshStatus(false);
   }
@@ -97,7 +118,9 @@ bool InteractiveConsole::teleop(KeyboardTeleop::Mode mode, const std::string& ro
             << (mode == KeyboardTeleop::Mode::kStep ? "w/s or Up/Down: v -+0.05 m/s, a/d or Left/Right: w +-0.1 rad/s"
                                                     : "hold w/s/a/d or arrows to drive (release stops)")
             << "; space: zero; q/Esc: leave\n";
+  const bool was_raw = term_.rawMode();  // the line editor's mode: given back as found
   term_.enterRawMode();
+  term_.showCursor(false);  // while the gauge is shown
   uint64_t last_id = 0;
   std::string note;
   auto gauge = [&] {
@@ -157,7 +180,8 @@ bool InteractiveConsole::teleop(KeyboardTeleop::Mode mode, const std::string& ro
   stop.mutable_stop();
   const bool sent = sink.sendCommand(robot_id, stop) != 0;
   if (!sent) sink.clearTeleop(robot_id);
-  term_.leaveRawMode();
+  if (was_raw) term_.showCursor(true);
+  else term_.leaveRawMode();
   std::cout << "\r\x1b[K" << "teleop: left" << (sent ? ", stop sent to " + robot_id : "") << "\n";
   std::cout.flush();
   return ok;

@@ -1,10 +1,13 @@
 #pragma once
-// The console on a terminal: a prompt, a live status line of the selected robot
-// on the bottom row, robot events as they arrive, and keyboard teleop.
+// The console on a terminal: a prompt with line editing, history and Tab
+// completion (LineEditor), a live status line of the selected robot on the
+// bottom row, robot events as they arrive above the line being typed, and
+// keyboard teleop. From a pipe: lines as they come, no editing.
 #include <chrono>
 #include <string>
 
 #include "pc_server/console/console.hpp"
+#include "pc_server/operator/line_editor.hpp"
 #include "pc_server/operator/line_reader.hpp"
 #include "pc_server/app/stop_flag.hpp"
 #include "pc_server/operator/terminal.hpp"
@@ -23,13 +26,18 @@ class InteractiveConsole {
   /// Redraws the status line when its period is due (or `force`).
   void refreshStatus(bool force);
   std::string statusText() const;
-  /// Prints background text (events) above the current input line, then `redraw`.
-  void printAbove(const std::string& text, const std::string& redraw);
+  /// Prints background text (events) above the current input line, then redraws it.
+  void printAbove(const std::string& text);
+  /// One line from the terminal through the editor, or from a pipe as it comes:
+  /// kData (a line), kEof, kStopped or kTimeout (nothing yet).
+  LineReader::Result nextLine(std::string& line);
 
   Console& console_;
   StopFlag& stop_;
   Terminal term_;
   LineReader reader_;
+  LineEditor editor_;
+  std::string pending_;  // bytes read from the terminal, not yet fed to the editor
   std::chrono::steady_clock::duration status_period_;
   std::chrono::steady_clock::time_point next_status_{};
 };

@@ -78,14 +78,17 @@ void Terminal::enterRawMode() {
   t.c_cc[VTIME] = 0;
   if (::tcsetattr(in_fd_, TCSAFLUSH, &t) != 0) return;
   raw_ = true;
-  writeOut("\x1b[?25l");  // hide the cursor while the gauge is shown
+}
+
+void Terminal::showCursor(bool show) {
+  if (tty_) writeOut(show ? "\x1b[?25h" : "\x1b[?25l");
 }
 
 void Terminal::leaveRawMode() {
   if (!raw_) return;
   raw_ = false;
   if (saved_) ::tcsetattr(in_fd_, TCSAFLUSH, &*saved_);
-  writeOut("\x1b[?25h");
+  showCursor(true);
 }
 
 }  // namespace inspect::server

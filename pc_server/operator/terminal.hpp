@@ -25,9 +25,13 @@ class Terminal {
   void disableStatusLine();
   /// Redraws the status line (cursor position is kept). `alarm` draws it in red.
   void drawStatus(const std::string& text, bool alarm);
-  /// Keys without Enter and without echo (Ctrl-C still raises SIGINT).
+  /// Keys without Enter and without echo (Ctrl-C still raises SIGINT); the
+  /// line editor and teleop read keys in it.
   void enterRawMode();
+  /// Back to the mode before enterRawMode, with the cursor shown.
   void leaveRawMode();
+  /// Hides the cursor (teleop's gauge) or shows it again.
+  void showCursor(bool show);
   bool rawMode() const { return raw_; }
 
  private:

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
+#include <sys/ioctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -45,6 +47,7 @@ class Program {
       ::kill(pid_, SIGKILL);
       ::waitpid(pid_, nullptr, 0);
     }
+    if (pty_ >= 0) ::close(pty_);
     fs::remove_all(dir_);
   }
 
@@ -55,10 +58,7 @@ class Program {
   }
   fs::path path(const std::string& name) const { return dir_ / name; }
 
-  void start(std::vector<std::string> args, const std::string& stdin_text = "") {
-    const auto in_path = file("stdin.txt", stdin_text);
-    const auto out_path = path("stdout.txt");
-    const auto err_path = path("stderr.txt");
+  static std::vector<std::string> withDefaults(std::vector<std::string> args) {
     // No UDP video port 5600 (tests run in parallel); the video tests ask for an ephemeral one.
     if (std::find(args.begin(), args.end(), "--video-port") == args.end()) args.push_back("--no-video");
     // Nor the Foxglove bridge's TCP port 8765 and a token file in the working directory.
@@ -72,6 +72,22 @@ class Program {
       args.push_back(testCertsDir());
     }
     args.insert(args.begin(), kBinary);
+    return args;
+  }
+
+  [[noreturn]] static void exec(std::vector<std::string>& args) {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(kBinary.c_str(), argv.data());
+    ::_exit(127);
+  }
+
+  void start(std::vector<std::string> args, const std::string& stdin_text = "") {
+    const auto in_path = file("stdin.txt", stdin_text);
+    const auto out_path = path("stdout.txt");
+    const auto err_path = path("stderr.txt");
+    args = withDefaults(std::move(args));
     pid_ = ::fork();
     ASSERT_GE(pid_, 0);
     if (pid_ == 0) {
@@ -81,13 +97,57 @@ class Program {
       ::dup2(in, 0);
       ::dup2(out, 1);
       ::dup2(err, 2);
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(kBinary.c_str(), argv.data());
-      ::_exit(127);
+      exec(args);
     }
   }
+
+  /// Starts it on a pseudo-terminal (stdin, stdout and stderr; 100 x 30), as
+  /// an operator's terminal: ptyWrite types, ptyReadUntil reads the screen's bytes.
+  void startOnPty(std::vector<std::string> args) {
+    args = withDefaults(std::move(args));
+    pty_ = ::posix_openpt(O_RDWR | O_NOCTTY);
+    ASSERT_GE(pty_, 0);
+    ASSERT_EQ(::grantpt(pty_), 0);
+    ASSERT_EQ(::unlockpt(pty_), 0);
+    const std::string slave = ::ptsname(pty_);
+    winsize ws{};
+    ws.ws_row = 30;
+    ws.ws_col = 100;
+    ::ioctl(pty_, TIOCSWINSZ, &ws);
+    pid_ = ::fork();
+    ASSERT_GE(pid_, 0);
+    if (pid_ == 0) {
+      ::setsid();
+      const int fd = ::open(slave.c_str(), O_RDWR);  // the controlling terminal
+      ::dup2(fd, 0);
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      exec(args);
+    }
+  }
+
+  void ptyWrite(const std::string& keys) { ASSERT_EQ(::write(pty_, keys.data(), keys.size()), static_cast<ssize_t>(keys.size())); }
+
+  /// Reads the terminal until `needle` appears after what was read before, up
+  /// to `timeout`; true when it did. ptyText() has all that was read.
+  bool ptyReadUntil(const std::string& needle, std::chrono::milliseconds timeout = 5000ms) {
+    const std::size_t from = pty_seen_;
+    const auto deadline = Clock::now() + timeout;
+    while (Clock::now() < deadline) {
+      if (const auto at = pty_text_.find(needle, from); at != std::string::npos) {
+        pty_seen_ = at + needle.size();
+        return true;
+      }
+      pollfd p{pty_, POLLIN, 0};
+      if (::poll(&p, 1, 20) <= 0) continue;
+      char buf[4096];
+      const auto n = ::read(pty_, buf, sizeof buf);
+      if (n <= 0) return false;  // the program closed the terminal
+      pty_text_.append(buf, static_cast<std::size_t>(n));
+    }
+    return false;
+  }
+  const std::string& ptyText() const { return pty_text_; }
 
   /// The port from --port-file, waiting up to 5 s for the file.
   uint16_t waitPort(const fs::path& port_file) {
@@ -120,6 +180,9 @@ class Program {
  private:
   fs::path dir_;
   pid_t pid_ = -1;
+  int pty_ = -1;
+  std::string pty_text_;
+  std::size_t pty_seen_ = 0;
 };
 
 #define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
@@ -191,6 +254,22 @@ TEST(Program, PipedStdinRunsLikeAScript) {
   EXPECT_EQ(p.wait(), 0) << p.out() << p.err();
   EXPECT_HAS(p.out(), "[1] echo hi");
   EXPECT_HAS(p.out(), "expect ok (line 2): robots = 0");
+}
+
+TEST(Program, OnATerminalTheConsoleEditsCompletesAndRecalls) {
+  Program p("pty");
+  p.startOnPty({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--plaintext"});
+  ASSERT_TRUE(p.ptyReadUntil("\n> ")) << p.ptyText();
+  p.ptyWrite("help dri\t\r");  // Tab completes the command name after help
+  EXPECT_TRUE(p.ptyReadUntil("drive <v_m_s> <w_rad_s>")) << p.ptyText();
+  p.ptyWrite("tune s\t");  // seed=, seeds=, speed=, start=: listed
+  EXPECT_TRUE(p.ptyReadUntil("seed=  seeds=  speed=  start=")) << p.ptyText();
+  p.ptyWrite("\x15" "echo 1x\x02\x7f" "2\r");  // Ctrl-U, type, Left, Backspace, "2": "echo 2x"
+  EXPECT_TRUE(p.ptyReadUntil("\n2x")) << p.ptyText();
+  p.ptyWrite("\x1b[A\x1b[D\x1b[D3\r");  // Up recalls "echo 2x"; edited in the middle
+  EXPECT_TRUE(p.ptyReadUntil("\n32x")) << p.ptyText();
+  p.ptyWrite("\x04");  // Ctrl-D on an empty line leaves
+  EXPECT_EQ(p.wait(), 0) << p.ptyText();
 }
 
 TEST(Program, BadConfigIsOneLineAndExitTwo) {
