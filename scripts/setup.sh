@@ -18,6 +18,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev
   nlohmann-json3-dev
   libsqlite3-dev sqlite3
+  libpq-dev postgresql
   libnlopt-cxx-dev
   libzstd-dev zlib1g-dev
   fuzzylite libfuzzylite-dev

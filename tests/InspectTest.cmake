@@ -61,6 +61,17 @@ add_library(inspect_test_support STATIC
 target_link_libraries(inspect_test_support PUBLIC inspect_test_paths Threads::Threads)
 target_compile_options(inspect_test_support PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})
 
+# A real PostgreSQL server (tests/support/postgres_server.hpp): the fixture
+# `postgres` below starts one for the whole ctest run; tests that use it
+# take INSPECT_POSTGRES_TEST_PROPERTIES (the fixture and the file naming it).
+if(NOT INSPECT_ROBOT_ONLY)
+  add_library(inspect_test_postgres STATIC ${PROJECT_SOURCE_DIR}/tests/support/postgres_server.cpp)
+  target_link_libraries(inspect_test_postgres PUBLIC inspect_test_paths PkgConfig::LIBPQ)
+  target_compile_options(inspect_test_postgres PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})
+  set(INSPECT_POSTGRES_FILE ${CMAKE_BINARY_DIR}/Testing/postgres-dir)
+  set(INSPECT_POSTGRES_TEST_PROPERTIES FIXTURES_REQUIRED postgres ENVIRONMENT INSPECT_TEST_PG_FILE=${INSPECT_POSTGRES_FILE})
+endif()
+
 # The one fake robot (tests/support/fake_robot): its messages, the fleet robot
 # (asynchronous, many per io_context); the scripted robot is header-only.
 add_library(inspect_fake_robot STATIC

@@ -1,25 +1,25 @@
 #include "shared/catalog/catalog.hpp"
+#include "shared/catalog/sql_backend.hpp"
 #include "shared/catalog/time_text.hpp"
-
-#include <sqlite3.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <limits>
 #include <mutex>
 #include <type_traits>
-#include <unordered_map>
 
 namespace inspect::catalog {
 
 namespace {
 
-// PRAGMA application_id of a catalog ("INSP"): tells it from other SQLite files.
-constexpr int32_t kApplicationId = 0x494E5350;
-constexpr int kBusyTimeoutMs = 5000;
 constexpr int kMaxRunIdSuffix = 10000;
-
+// "No limit" for LIMIT ?: both engines take the largest 64-bit integer.
+// A parameter that may be NULL is CAST where it is first used (`CAST(?1 AS
+// TEXT) IS NULL OR ...`): PostgreSQL must know its type, SQLite reads the
+// same CAST (DOUBLE PRECISION has REAL affinity there).
+constexpr int64_t kNoLimit = std::numeric_limits<int64_t>::max();
 
 // Adds a robot (id, software_version, time), completed by what to do if it exists.
 #define INSERT_ROBOT                                                                                   \
@@ -67,149 +67,137 @@ std::optional<std::string_view> nullIfEmpty(const std::string& s) {
   return s.empty() ? std::nullopt : std::optional<std::string_view>(s);
 }
 
-struct StmtFinalizer {
-  void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
-};
-struct DbCloser {
-  void operator()(sqlite3* d) const { sqlite3_close_v2(d); }
-};
+int64_t limitOf(int limit) { return limit > 0 ? limit : kNoLimit; }
 
 }  // namespace
 
 // ---------------------------------------------------------------------------
 
 struct Catalog::Impl {
-  std::string path;
-  std::unique_ptr<sqlite3, DbCloser> db;  // declared before `cache`: closed after the statements
-  std::unordered_map<std::string_view, std::unique_ptr<sqlite3_stmt, StmtFinalizer>> cache;
+  std::unique_ptr<SqlBackend> db;
   std::mutex mu;
 
-  [[noreturn]] void fail(const std::string& what) const {
-    std::string msg = "catalog " + path + ": " + what;
-    if (db) msg += std::string(": ") + sqlite3_errmsg(db.get());
-    throw CatalogError(msg);
-  }
-  [[noreturn]] void failPlain(const std::string& what) const { throw CatalogError("catalog " + path + ": " + what); }
-
-  void exec(const char* sql, const char* what) {
-    if (sqlite3_exec(db.get(), sql, nullptr, nullptr, nullptr) != SQLITE_OK) fail(what);
+  [[noreturn]] void failPlain(const std::string& what) const {
+    throw CatalogError("catalog " + db->where() + ": " + what);
   }
 
-  // A cached prepared statement, reset and unbound when the Query goes.
+  // A statement, its parameters bound in order, then its rows read.
   class Query {
    public:
-    Query(Impl& impl, sqlite3_stmt* s) : impl_(impl), s_(s) {}
+    Query(Impl& impl, std::string_view sql) : impl_(impl), sql_(sql) {}
     Query(const Query&) = delete;
     Query& operator=(const Query&) = delete;
-    ~Query() {
-      sqlite3_reset(s_);
-      sqlite3_clear_bindings(s_);
-    }
 
     // Binds the arguments to ?1, ?2, ... in order; a Time takes two: ISO text, unix seconds.
     template <class... A>
     Query& bind(const A&... a) {
-      int i = 0;
-      (bindOne(i, a), ...);
+      (bindOne(a), ...);
       return *this;
     }
-    // True: a row is ready; false: done. Throws on error.
+    // True: a row is ready; false: done. Runs the statement at the first call.
     bool step() {
-      const int rc = sqlite3_step(s_);
-      if (rc == SQLITE_ROW) return true;
-      if (rc == SQLITE_DONE) return false;
-      impl_.fail(std::string("cannot run '") + sqlite3_sql(s_) + "'");
-    }
-    void run() {
-      while (step()) {
+      if (!ran_) {
+        result_ = impl_.db->run(sql_, params_);
+        ran_ = true;
+        row_ = 0;
+      } else {
+        ++row_;
       }
+      return row_ < result_.rows.size();
+    }
+    // Runs the statement; the rows it changed.
+    int64_t run() {
+      step();
+      return result_.changed;
     }
 
     // Reads columns 0, 1, ... of the current row into the arguments in order
     // (a Time from unix seconds; an optional stays empty for NULL).
     template <class... A>
     void read(A&... a) const {
-      int c = 0;
+      std::size_t c = 0;
       (readOne(c++, a), ...);
     }
     template <class T>
-    T column(int c) const {
+    T column(std::size_t c) const {
       T v{};
       readOne(c, v);
       return v;
     }
 
    private:
-    void readOne(int c, std::string& v) const {
-      const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(s_, c));
-      v = p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(s_, c))) : std::string();
+    const SqlValue& at(std::size_t c) const { return result_.rows[row_][c]; }
+    double number(std::size_t c) const {
+      const SqlValue& v = at(c);
+      if (const auto* d = std::get_if<double>(&v)) return *d;
+      if (const auto* n = std::get_if<int64_t>(&v)) return static_cast<double>(*n);
+      if (const auto* t = std::get_if<std::string>(&v)) return std::strtod(t->c_str(), nullptr);
+      return 0.0;
     }
-    void readOne(int c, double& v) const { v = sqlite3_column_double(s_, c); }
-    void readOne(int c, int64_t& v) const { v = sqlite3_column_int64(s_, c); }
-    void readOne(int c, Time& v) const { v = fromUnix(sqlite3_column_double(s_, c)); }
+    void readOne(std::size_t c, std::string& v) const {
+      const SqlValue& x = at(c);
+      if (const auto* t = std::get_if<std::string>(&x)) v = *t;
+      else if (const auto* n = std::get_if<int64_t>(&x)) v = std::to_string(*n);
+      else v.clear();
+    }
+    void readOne(std::size_t c, double& v) const { v = number(c); }
+    void readOne(std::size_t c, int64_t& v) const {
+      const SqlValue& x = at(c);
+      const auto* n = std::get_if<int64_t>(&x);
+      v = n ? *n : static_cast<int64_t>(number(c));
+    }
+    void readOne(std::size_t c, Time& v) const { v = fromUnix(number(c)); }
     template <class T>
-    void readOne(int c, std::optional<T>& v) const {
-      if (sqlite3_column_type(s_, c) == SQLITE_NULL) {
+    void readOne(std::size_t c, std::optional<T>& v) const {
+      if (std::holds_alternative<std::monostate>(at(c))) {
         v.reset();
       } else {
         readOne(c, v.emplace());
       }
     }
 
-    void check(int rc) {
-      if (rc != SQLITE_OK) impl_.fail("cannot bind a parameter");
-    }
-    void bindOne(int& i, std::string_view v) {
-      check(sqlite3_bind_text(s_, ++i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
-    }
-    void bindOne(int& i, const std::string& v) { bindOne(i, std::string_view(v)); }
-    void bindOne(int& i, const char* v) { bindOne(i, std::string_view(v)); }
-    void bindOne(int& i, double v) { check(sqlite3_bind_double(s_, ++i, v)); }
-    void bindOne(int& i, int64_t v) { check(sqlite3_bind_int64(s_, ++i, v)); }
-    void bindOne(int& i, int v) { check(sqlite3_bind_int64(s_, ++i, v)); }
-    void bindOne(int& i, Time t) {
-      bindOne(i, formatIsoUtc(t));
-      bindOne(i, unixSeconds(t));
+    void bindOne(std::string_view v) { params_.emplace_back(std::string(v)); }
+    void bindOne(const std::string& v) { params_.emplace_back(v); }
+    void bindOne(const char* v) { params_.emplace_back(std::string(v)); }
+    void bindOne(double v) { params_.emplace_back(v); }
+    void bindOne(int64_t v) { params_.emplace_back(v); }
+    void bindOne(int v) { params_.emplace_back(static_cast<int64_t>(v)); }
+    void bindOne(Time t) {
+      bindOne(formatIsoUtc(t));
+      bindOne(unixSeconds(t));
     }
     template <class T>
-    void bindOne(int& i, const std::optional<T>& v) {
+    void bindOne(const std::optional<T>& v) {
       static_assert(!std::is_same_v<T, Time>, "an empty optional<Time> would bind one NULL for two parameters");
       if (v) {
-        bindOne(i, *v);
+        bindOne(*v);
       } else {
-        check(sqlite3_bind_null(s_, ++i));
+        params_.emplace_back(std::monostate{});
       }
     }
 
     Impl& impl_;
-    sqlite3_stmt* s_;
+    std::string_view sql_;
+    std::vector<SqlValue> params_;
+    SqlResult result_;
+    std::size_t row_ = 0;
+    bool ran_ = false;
   };
 
-  // `sql` must outlive the Catalog (a literal): it keys the cache.
-  Query query(std::string_view sql) {
-    auto& slot = cache[sql];
-    if (!slot) {
-      sqlite3_stmt* s = nullptr;
-      if (sqlite3_prepare_v2(db.get(), sql.data(), static_cast<int>(sql.size()), &s, nullptr) != SQLITE_OK)
-        fail("cannot prepare '" + std::string(sql) + "'");
-      slot.reset(s);
-    }
-    return Query(*this, slot.get());
-  }
+  // `sql` must outlive the Catalog (a literal): it keys the prepared statements.
+  Query query(std::string_view sql) { return Query(*this, sql); }
 
   // A transaction rolled back unless committed.
   class Tx {
    public:
-    explicit Tx(Impl& impl, const char* begin = "BEGIN IMMEDIATE") : impl_(impl) {
-      impl_.exec(begin, "cannot begin a transaction");
-    }
+    explicit Tx(Impl& impl, bool write = true) : impl_(impl) { impl_.db->begin(write); }
     Tx(const Tx&) = delete;
     Tx& operator=(const Tx&) = delete;
     ~Tx() {
-      if (!done_) sqlite3_exec(impl_.db.get(), "ROLLBACK", nullptr, nullptr, nullptr);
+      if (!done_) impl_.db->rollback();
     }
     void commit() {
-      impl_.exec("COMMIT", "cannot commit");
+      impl_.db->commit();
       done_ = true;
     }
 
@@ -217,40 +205,6 @@ struct Catalog::Impl {
     Impl& impl_;
     bool done_ = false;
   };
-
-  int64_t pragmaInt(std::string_view sql) {
-    auto q = query(sql);
-    return q.step() ? q.column<int64_t>(0) : 0;
-  }
-
-  // Throws unless the file is new or a catalog of a schema version <= known.
-  void checkIsCatalog(int64_t known) {
-    const int64_t app = pragmaInt("PRAGMA application_id");
-    const int64_t version = pragmaInt("PRAGMA user_version");
-    if (app != 0 && app != kApplicationId) failPlain("not a run catalog (another program's SQLite file)");
-    if (version > known)
-      failPlain("schema version " + std::to_string(version) + " was written by a newer program (this one knows up to " +
-                std::to_string(known) + "); use a newer build or another file");
-    if (version == 0 && app == 0 && pragmaInt("SELECT count(*) FROM sqlite_master") > 0)
-      failPlain("not a run catalog (has tables but no catalog schema version)");
-  }
-
-  void migrate(std::span<const std::string_view> migrations) {
-    const auto known = static_cast<int64_t>(migrations.size());
-    Tx tx(*this);
-    checkIsCatalog(known);  // again, in the transaction: another process may have migrated meanwhile
-    const int64_t version = pragmaInt("PRAGMA user_version");
-    for (int64_t v = version; v < known; ++v) {
-      const std::string sql(migrations[static_cast<std::size_t>(v)]);
-      if (sqlite3_exec(db.get(), sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK)
-        fail("migration " + std::to_string(v + 1));
-    }
-    if (version < known) {
-      exec(("PRAGMA user_version = " + std::to_string(known)).c_str(), "cannot set user_version");
-      exec(("PRAGMA application_id = " + std::to_string(kApplicationId)).c_str(), "cannot set application_id");
-    }
-    tx.commit();
-  }
 
   RunInfo readRun(const Query& q) const {
     RunInfo r;
@@ -319,32 +273,15 @@ Catalog Catalog::open(const std::string& path) { return open(path, schemaMigrati
 
 Catalog Catalog::open(const std::string& path, std::span<const std::string_view> migrations) {
   auto impl = std::make_unique<Impl>();
-  impl->path = path;
-  sqlite3* raw = nullptr;
-  const int rc = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
-                                 nullptr);
-  impl->db.reset(raw);
-  if (rc != SQLITE_OK) impl->fail("cannot open");
-  sqlite3_extended_result_codes(raw, 1);
-  sqlite3_busy_timeout(raw, kBusyTimeoutMs);
-  impl->exec("SELECT count(*) FROM sqlite_master", "cannot read");  // not a database, unreadable, ...
-  impl->checkIsCatalog(static_cast<int64_t>(migrations.size()));  // before WAL changes the file
-  {
-    auto q = impl->query("PRAGMA journal_mode = WAL");
-    const std::string mode = q.step() ? q.column<std::string>(0) : std::string();
-    if (mode != "wal") impl->failPlain("cannot use WAL (journal_mode is '" + mode + "')");
-  }
-  impl->exec("PRAGMA synchronous = NORMAL", "cannot set synchronous");
-  impl->exec("PRAGMA foreign_keys = ON", "cannot enable foreign keys");
-  impl->migrate(migrations);
+  impl->db = isPostgresUrl(path) ? openPostgres(path, migrations) : openSqlite(path, migrations);
   return Catalog(std::move(impl));
 }
 
-const std::string& Catalog::path() const { return impl_->path; }
+const std::string& Catalog::path() const { return impl_->db->where(); }
 
 int Catalog::schemaVersion() {
   std::lock_guard lk(impl_->mu);
-  return static_cast<int>(impl_->pragmaInt("PRAGMA user_version"));
+  return static_cast<int>(impl_->db->schemaVersion());
 }
 
 void Catalog::upsertRobot(const std::string& robot, const std::string& software_version, Time now) {
@@ -366,18 +303,19 @@ RunInfo Catalog::startRun(const RunStart& r) {
       .run();
   const std::string base = strftimeUtc(start, "%Y%m%d-%H%M%S-") + sanitizeRobotId(r.robot);
   std::string id;
+  int64_t rowid = 0;
   for (int n = 1;; ++n) {
     if (n > kMaxRunIdSuffix) impl_->failPlain("no free run id for " + base);
     id = n == 1 ? base : base + "-" + std::to_string(n);
-    auto q = impl_->query("SELECT 1 FROM runs WHERE run_id = ?");
-    if (!q.bind(id).step()) break;
+    // A taken id (this server's or another's sharing the database) inserts nothing.
+    auto q = impl_->query(
+        "INSERT INTO runs (run_id, robot_id, name, route, gains_json, software_version, dir, start_time, start_unix)"
+        " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT (run_id) DO NOTHING RETURNING id");
+    if (q.bind(id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, start).step()) {
+      rowid = q.column<int64_t>(0);
+      break;
+    }
   }
-  impl_->query(
-           "INSERT INTO runs (run_id, robot_id, name, route, gains_json, software_version, dir, start_time, start_unix)"
-           " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)")
-      .bind(id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, start)
-      .run();
-  const int64_t rowid = sqlite3_last_insert_rowid(impl_->db.get());
   tx.commit();
   return RunInfo{rowid, id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, start, {}, {}};
 }
@@ -385,10 +323,10 @@ RunInfo Catalog::startRun(const RunStart& r) {
 bool Catalog::endRun(const std::string& run_id, const std::string& outcome, Time end) {
   if (!isOutcome(outcome)) impl_->failPlain("unknown outcome '" + outcome + "'");
   std::lock_guard lk(impl_->mu);
-  impl_->query("UPDATE runs SET end_time = ?, end_unix = ?, outcome = ? WHERE run_id = ? AND end_time IS NULL")
-      .bind(end, outcome, run_id)
-      .run();
-  if (sqlite3_changes(impl_->db.get()) == 1) return true;
+  if (impl_->query("UPDATE runs SET end_time = ?, end_unix = ?, outcome = ? WHERE run_id = ? AND end_time IS NULL")
+          .bind(end, outcome, run_id)
+          .run() == 1)
+    return true;
   auto q = impl_->query("SELECT 1 FROM runs WHERE run_id = ?");
   if (!q.bind(run_id).step()) impl_->failPlain("no run '" + run_id + "'");
   return false;
@@ -396,8 +334,8 @@ bool Catalog::endRun(const std::string& run_id, const std::string& outcome, Time
 
 void Catalog::setGains(const std::string& run_id, const std::string& gains_json) {
   std::lock_guard lk(impl_->mu);
-  impl_->query("UPDATE runs SET gains_json = ? WHERE run_id = ?").bind(gains_json, run_id).run();
-  if (sqlite3_changes(impl_->db.get()) != 1) impl_->failPlain("no run '" + run_id + "'");
+  if (impl_->query("UPDATE runs SET gains_json = ? WHERE run_id = ?").bind(gains_json, run_id).run() != 1)
+    impl_->failPlain("no run '" + run_id + "'");
 }
 
 std::optional<RunInfo> Catalog::activeRun(const std::string& robot) {
@@ -414,13 +352,15 @@ std::vector<std::string> Catalog::markIncompleteRuns() {
   std::vector<std::pair<std::string, double>> open;
   {
     auto q = impl_->query(
-        "SELECT run_id, max(start_unix,"
+        "SELECT run_id, start_unix,"
         " COALESCE((SELECT max(time_unix) FROM events e WHERE e.run_id = r.run_id), 0),"
-        " COALESCE((SELECT max(time_unix) FROM alarms a WHERE a.run_id = r.run_id), 0))"
+        " COALESCE((SELECT max(time_unix) FROM alarms a WHERE a.run_id = r.run_id), 0)"
         " FROM runs r WHERE end_time IS NULL ORDER BY start_unix, id");
     while (q.step()) {
       auto& [id, last] = open.emplace_back();
-      q.read(id, last);
+      double event = 0, alarm = 0;
+      q.read(id, last, event, alarm);
+      last = std::max({last, event, alarm});
     }
   }
   std::vector<std::string> ids;
@@ -456,9 +396,15 @@ void Catalog::setSummary(const std::string& run_id, const Summary& s) {
   std::lock_guard lk(impl_->mu);
   Impl::Tx tx(*impl_);
   impl_->query(
-           "INSERT OR REPLACE INTO run_summary (run_id, duration_s, distance_m, min_person_m, track_max_pos_err_m,"
+           "INSERT INTO run_summary (run_id, duration_s, distance_m, min_person_m, track_max_pos_err_m,"
            " track_rms_pos_err_m, track_max_angle_err_rad, video_frames_received, video_frames_decoded,"
-           " video_packets_lost) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
+           " video_packets_lost) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"
+           " ON CONFLICT (run_id) DO UPDATE SET duration_s = excluded.duration_s, distance_m = excluded.distance_m,"
+           " min_person_m = excluded.min_person_m, track_max_pos_err_m = excluded.track_max_pos_err_m,"
+           " track_rms_pos_err_m = excluded.track_rms_pos_err_m,"
+           " track_max_angle_err_rad = excluded.track_max_angle_err_rad,"
+           " video_frames_received = excluded.video_frames_received,"
+           " video_frames_decoded = excluded.video_frames_decoded, video_packets_lost = excluded.video_packets_lost")
       .bind(run_id, s.duration_s, s.distance_m, s.min_person_m, s.track_max_pos_err_m, s.track_rms_pos_err_m,
             s.track_max_angle_err_rad, s.video_frames_received, s.video_frames_decoded, s.video_packets_lost)
       .run();
@@ -486,13 +432,13 @@ std::vector<RunInfo> Catalog::listRuns(const RunFilter& f) {
   if (f.since) since = unixSeconds(*f.since);
   std::lock_guard lk(impl_->mu);
   auto q = impl_->query("SELECT " RUN_COLUMNS
-                        " FROM runs WHERE (?1 IS NULL OR robot_id = ?1)"
-                        " AND (?2 IS NULL OR instr(lower(name), lower(?2)) > 0)"
-                        " AND (?3 IS NULL OR outcome = ?3 OR (?3 = 'running' AND outcome IS NULL))"
-                        " AND (?4 IS NULL OR start_unix >= ?4)"
+                        " FROM runs WHERE (CAST(?1 AS TEXT) IS NULL OR robot_id = ?1)"
+                        " AND (CAST(?2 AS TEXT) IS NULL OR instr(lower(name), lower(?2)) > 0)"
+                        " AND (CAST(?3 AS TEXT) IS NULL OR outcome = ?3 OR (?3 = 'running' AND outcome IS NULL))"
+                        " AND (CAST(?4 AS DOUBLE PRECISION) IS NULL OR start_unix >= ?4)"
                         " ORDER BY start_unix DESC, id DESC LIMIT ?5");
   q.bind(nullIfEmpty(f.robot), nullIfEmpty(f.name_contains), nullIfEmpty(f.outcome), since,
-         f.limit > 0 ? f.limit : -1);
+         limitOf(f.limit));
   std::vector<RunInfo> out;
   while (q.step()) out.push_back(impl_->readRun(q));
   return out;
@@ -500,7 +446,7 @@ std::vector<RunInfo> Catalog::listRuns(const RunFilter& f) {
 
 std::optional<RunDetail> Catalog::run(const std::string& run_id) {
   std::lock_guard lk(impl_->mu);
-  Impl::Tx tx(*impl_, "BEGIN");  // one snapshot for all the reads
+  Impl::Tx tx(*impl_, false);  // one snapshot for all the reads
   RunDetail d;
   if (auto info = impl_->findRun(run_id)) {
     d.info = std::move(*info);
@@ -546,7 +492,7 @@ void Catalog::addTuningSession(const TuningSession& s) {
 std::vector<TuningSession> Catalog::listTuningSessions(int limit) {
   std::lock_guard lk(impl_->mu);
   auto q = impl_->query("SELECT " TUNING_COLUMNS " FROM tuning_sessions ORDER BY created_unix DESC, id DESC LIMIT ?");
-  q.bind(limit > 0 ? limit : -1);
+  q.bind(limitOf(limit));
   std::vector<TuningSession> out;
   while (q.step()) out.push_back(impl_->readTuningSession(q));
   return out;
@@ -573,9 +519,9 @@ void Catalog::addGainsPush(const GainsPush& p) {
 std::vector<GainsPush> Catalog::listGainsPushes(const std::string& robot, int limit) {
   std::lock_guard lk(impl_->mu);
   auto q = impl_->query("SELECT " PUSH_COLUMNS
-                        " FROM gains_pushes WHERE (?1 IS NULL OR robot_id = ?1)"
+                        " FROM gains_pushes WHERE (CAST(?1 AS TEXT) IS NULL OR robot_id = ?1)"
                         " ORDER BY time_unix DESC, id DESC LIMIT ?2");
-  q.bind(nullIfEmpty(robot), limit > 0 ? limit : -1);
+  q.bind(nullIfEmpty(robot), limitOf(limit));
   std::vector<GainsPush> out;
   while (q.step()) out.push_back(impl_->readGainsPush(q));
   return out;
@@ -583,10 +529,7 @@ std::vector<GainsPush> Catalog::listGainsPushes(const std::string& robot, int li
 
 std::string Catalog::integrityCheck() {
   std::lock_guard lk(impl_->mu);
-  auto q = impl_->query("PRAGMA integrity_check");
-  std::string out;
-  while (q.step()) out += (out.empty() ? "" : "\n") + q.column<std::string>(0);
-  return out;
+  return impl_->db->integrityCheck();
 }
 
 }  // namespace inspect::catalog

@@ -1,11 +1,13 @@
 #pragma once
-// The run catalog: one SQLite file (`catalog.sqlite`, WAL) listing robots,
-// runs, their events and alarms, summary figures and files. Schema and example
-// queries: docs/catalog.md.
+// The run catalog: robots, runs, their events and alarms, summary figures
+// and files. One SQLite file (`catalog.sqlite`, WAL) by default, or a
+// PostgreSQL database that a fleet's servers share (`postgresql://...`);
+// the same schema, migrations and queries on both (sql_backend.hpp). Schema
+// and example queries: docs/catalog.md.
 //
 // One connection per Catalog, every call under a mutex: the server may call
 // from several threads. Each write is its own transaction, so what a call has
-// written survives a kill of the process (WAL, synchronous=NORMAL).
+// written survives a kill of the process (SQLite: WAL, synchronous=NORMAL).
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -20,7 +22,8 @@ namespace inspect::catalog {
 
 using Time = std::chrono::system_clock::time_point;
 
-/// Any failure: the message names the catalog file and gives SQLite's reason.
+/// Any failure: the message names the catalog (file, or URL without its
+/// password) and gives the engine's reason.
 class CatalogError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -128,10 +131,12 @@ std::optional<Time> parseIsoUtc(std::string_view text);
 
 class Catalog {
  public:
-  /// Opens or creates the file, sets WAL, synchronous=NORMAL, foreign keys and
-  /// a busy timeout, and applies the pending migrations in one transaction.
-  /// Throws CatalogError (file missing directory, not a database, not a
-  /// catalog, written by a newer program, ...).
+  /// Opens or creates the file (sets WAL, synchronous=NORMAL, foreign keys and
+  /// a busy timeout), or connects to the PostgreSQL database of a
+  /// "postgresql://" URL, and applies the pending migrations in one
+  /// transaction. Throws CatalogError (file missing directory, not a
+  /// database, server unreachable, not a catalog, written by a newer
+  /// program, ...).
   static Catalog open(const std::string& path);
   /// The same with another migration list (tests: an older schema).
   static Catalog open(const std::string& path, std::span<const std::string_view> migrations);
@@ -140,6 +145,7 @@ class Catalog {
   Catalog& operator=(Catalog&&) noexcept;
   ~Catalog();
 
+  /// The file path, or the URL without its password.
   const std::string& path() const;
   int schemaVersion();
 
@@ -186,7 +192,7 @@ class Catalog {
   /// Newest first; `robot` "" = every robot; `limit` <= 0: all.
   std::vector<GainsPush> listGainsPushes(const std::string& robot, int limit = 100);
 
-  /// "ok", or SQLite's messages one per line.
+  /// "ok", or the engine's messages one per line.
   std::string integrityCheck();
 
  private:

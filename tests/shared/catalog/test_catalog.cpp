@@ -1,7 +1,13 @@
-// Run catalog (SQLite) on real files in a temporary directory: creation and
-// migrations (v1 -> latest, v3 -> latest, refusing a newer schema), runs,
-// events, alarms, summaries, files, filters, tuning sessions, gains pushes, a SIGKILL during a run, the sqlite3 shell, bad
-// files, concurrent writers, and the time format.
+// Run catalog on both engines: real SQLite files in a temporary directory and
+// real PostgreSQL databases on the suite's server (tests/support/pg_cluster.sh).
+// On both (CatalogTest, one instance per engine): reopening, run ids, runs,
+// events, alarms, summaries, files, filters, tuning sessions, gains pushes,
+// incomplete runs, concurrent writers. SQLite's own (SqliteCatalogTest):
+// WAL, migrations (v1 -> latest, v3 -> latest, refusing a newer schema), a
+// SIGKILL during a run, the sqlite3 shell, bad files. PostgreSQL's own
+// (PostgresCatalogTest): two servers' connections sharing one database,
+// refusing a newer schema or a foreign database, an unreachable server
+// named without its password. And the time format.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sqlite3.h>
@@ -15,6 +21,8 @@
 #include <thread>
 
 #include "shared/catalog/catalog.hpp"
+#include "shared/catalog/sql_backend.hpp"
+#include "tests/support/postgres_server.hpp"
 
 using namespace inspect::catalog;
 namespace fs = std::filesystem;
@@ -36,8 +44,9 @@ RunStart runOf(const std::string& robot, const std::string& name, Time start) {
   return r;
 }
 
-// First column of every row of `sql`, through SQLite directly (not the Catalog).
+// First column of every row of `sql`, through SQLite or libpq directly (not the Catalog).
 std::vector<std::string> rawQuery(const std::string& path, const std::string& sql) {
+  if (isPostgresUrl(path)) return inspect::test::postgresQuery(path, sql);
   sqlite3* db = nullptr;
   std::vector<std::string> rows;
   if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr) == SQLITE_OK) {
@@ -67,12 +76,13 @@ std::string errorOf(F&& f) {
   return "";
 }
 
-class CatalogTest : public ::testing::Test {
+class SqliteCatalogTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("catalog_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = info->name();
+    for (char& c : name) if (c == '/') c = '_';
+    dir_ = fs::temp_directory_path() / ("catalog_test_" + std::to_string(::getpid()) + "_" + name);
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     path_ = (dir_ / "catalog.sqlite").string();
@@ -80,11 +90,32 @@ class CatalogTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   fs::path dir_;
-  std::string path_;
+  std::string path_;  // the SQLite file, or the PostgreSQL database's URL (CatalogTest)
   const Time t0_ = at("2026-11-22T08:30:15.250Z");
 };
 
-TEST_F(CatalogTest, CreatesWalDatabaseAtLatestVersion) {
+enum class Engine { kSqlite, kPostgres };
+
+/// The same tests on each engine: path_ is a SQLite file or a fresh PostgreSQL database.
+class CatalogTest : public SqliteCatalogTest, public ::testing::WithParamInterface<Engine> {
+ protected:
+  void SetUp() override {
+    SqliteCatalogTest::SetUp();
+    if (GetParam() == Engine::kPostgres)
+      path_ = inspect::test::freshPostgresDatabase(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+};
+
+/// PostgreSQL's own: path_ is a fresh database.
+class PostgresCatalogTest : public SqliteCatalogTest {
+ protected:
+  void SetUp() override {
+    SqliteCatalogTest::SetUp();
+    path_ = inspect::test::freshPostgresDatabase(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+};
+
+TEST_F(SqliteCatalogTest, CreatesWalDatabaseAtLatestVersion) {
   auto cat = Catalog::open(path_);
   EXPECT_TRUE(fs::exists(path_));
   EXPECT_EQ(cat.schemaVersion(), static_cast<int>(schemaMigrations().size()));
@@ -95,7 +126,7 @@ TEST_F(CatalogTest, CreatesWalDatabaseAtLatestVersion) {
                                       "run_overview", "run_summary", "runs", "tuning_sessions"}));
 }
 
-TEST_F(CatalogTest, ReopeningKeepsDataAndVersion) {
+TEST_P(CatalogTest, ReopeningKeepsDataAndVersion) {
   std::string id;
   {
     auto cat = Catalog::open(path_);
@@ -108,7 +139,7 @@ TEST_F(CatalogTest, ReopeningKeepsDataAndVersion) {
   EXPECT_EQ(runs[0].id, id);
 }
 
-TEST_F(CatalogTest, UpgradesVersion1ToLatest) {
+TEST_F(SqliteCatalogTest, UpgradesVersion1ToLatest) {
   std::string id;
   {
     auto v1 = Catalog::open(path_, schemaMigrations().first(1));
@@ -136,7 +167,7 @@ TEST_F(CatalogTest, UpgradesVersion1ToLatest) {
   EXPECT_EQ(cat.integrityCheck(), "ok");
 }
 
-TEST_F(CatalogTest, UpgradesVersion3ToLatestWithTheTuningTables) {
+TEST_F(SqliteCatalogTest, UpgradesVersion3ToLatestWithTheTuningTables) {
   std::string id;
   {
     auto v3 = Catalog::open(path_, schemaMigrations().first(3));
@@ -161,7 +192,7 @@ TEST_F(CatalogTest, UpgradesVersion3ToLatestWithTheTuningTables) {
   EXPECT_EQ(cat.integrityCheck(), "ok");
 }
 
-TEST_F(CatalogTest, RefusesANewerSchema) {
+TEST_F(SqliteCatalogTest, RefusesANewerSchema) {
   { auto cat = Catalog::open(path_); }
   // A program that knows only version 1 must not touch a later catalog.
   const std::string older = errorOf([&] { Catalog::open(path_, schemaMigrations().first(1)); });
@@ -176,7 +207,7 @@ TEST_F(CatalogTest, RefusesANewerSchema) {
   EXPECT_EQ(rawQuery(path_, "PRAGMA user_version"), std::vector<std::string>{std::to_string(future)});
 }
 
-TEST_F(CatalogTest, RunIdsAreUniqueWithinASecond) {
+TEST_P(CatalogTest, RunIdsAreUniqueWithinASecond) {
   auto cat = Catalog::open(path_);
   const auto a = cat.startRun(runOf("robot1", "a", t0_));
   const auto b = cat.startRun(runOf("robot1", "b", t0_ + milliseconds(300)));
@@ -192,7 +223,7 @@ TEST_F(CatalogTest, RunIdsAreUniqueWithinASecond) {
   EXPECT_FALSE(errorOf([&] { cat.startRun(runOf("", "x", t0_)); }).empty());
 }
 
-TEST_F(CatalogTest, StartAndEndRuns) {
+TEST_P(CatalogTest, StartAndEndRuns) {
   auto cat = Catalog::open(path_);
   cat.upsertRobot("robot1", "0.1.0", t0_ - milliseconds(60000));
   const auto r = cat.startRun(runOf("robot1", "night", t0_));
@@ -223,14 +254,17 @@ TEST_F(CatalogTest, StartAndEndRuns) {
             std::vector<std::string>{"2026-11-22T08:30:15.250Z 2026-11-22T08:31:45.750Z"});
 }
 
-TEST_F(CatalogTest, EventsAlarmsSummaryAndFilesRoundTrip) {
+TEST_P(CatalogTest, EventsAlarmsSummaryAndFilesRoundTrip) {
   auto cat = Catalog::open(path_);
   const auto r = cat.startRun(runOf("robot1", "gas round", t0_));
   cat.addEvent(r.id, "robot1", t0_ + milliseconds(100), "connected", "");
   cat.addEvent(r.id, "robot1", t0_ + milliseconds(200), "disconnected", "link lost");
   cat.addEvent("", "robot1", t0_ + milliseconds(250), "note", "between runs");
   cat.addAlarm(r.id, "robot1", t0_ + milliseconds(300), "CH4", "alarm", "raised", 812.5, 3.25, -1.5);
-  EXPECT_NE(errorOf([&] { cat.addEvent("nope", "robot1", t0_, "x", ""); }).find("FOREIGN KEY"), std::string::npos);
+  // SQLite: "FOREIGN KEY constraint failed"; PostgreSQL: "... violates foreign key constraint ...".
+  std::string fk = errorOf([&] { cat.addEvent("nope", "robot1", t0_, "x", ""); });
+  for (char& c : fk) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  EXPECT_NE(fk.find("foreign key"), std::string::npos) << fk;
 
   Summary s;
   s.duration_s = 95.5;
@@ -288,7 +322,7 @@ TEST_F(CatalogTest, EventsAlarmsSummaryAndFilesRoundTrip) {
   EXPECT_TRUE(bare.files.empty());
 }
 
-TEST_F(CatalogTest, ListRunsFilters) {
+TEST_P(CatalogTest, ListRunsFilters) {
   auto cat = Catalog::open(path_);
   const auto a = cat.startRun(runOf("robot1", "Night round A", at("2026-11-20T22:00:00Z")));
   const auto b = cat.startRun(runOf("robot2", "night round B", at("2026-11-21T22:00:00Z")));
@@ -342,7 +376,7 @@ TuningSession sessionOf(const std::string& id, const std::string& robot, Time cr
   return s;
 }
 
-TEST_F(CatalogTest, TuningSessionsRoundTrip) {
+TEST_P(CatalogTest, TuningSessionsRoundTrip) {
   auto cat = Catalog::open(path_);
   cat.addTuningSession(sessionOf("tune-a", "robot1", t0_));
   auto b = sessionOf("tune-b", "", t0_ + milliseconds(60000));  // for no robot in particular
@@ -394,7 +428,7 @@ TEST_F(CatalogTest, TuningSessionsRoundTrip) {
   EXPECT_EQ(cat.listTuningSessions().size(), 3u);
 }
 
-TEST_F(CatalogTest, GainsPushesRoundTrip) {
+TEST_P(CatalogTest, GainsPushesRoundTrip) {
   auto cat = Catalog::open(path_);
   cat.addTuningSession(sessionOf("tune-a", "robot1", t0_));
   const auto push = [](const std::string& robot, Time t, int64_t version, const std::string& status,
@@ -441,7 +475,7 @@ TEST_F(CatalogTest, GainsPushesRoundTrip) {
   EXPECT_EQ(cat.listGainsPushes("").size(), 3u);
 }
 
-TEST_F(CatalogTest, MarkIncompleteRunsEndsThemAtTheirLastRecord) {
+TEST_P(CatalogTest, MarkIncompleteRunsEndsThemAtTheirLastRecord) {
   auto cat = Catalog::open(path_);
   const auto a = cat.startRun(runOf("robot1", "a", t0_));
   const auto b = cat.startRun(runOf("robot2", "b", t0_));
@@ -461,7 +495,7 @@ TEST_F(CatalogTest, MarkIncompleteRunsEndsThemAtTheirLastRecord) {
 
 // A server killed with SIGKILL in the middle of a run: every committed write is
 // there, the file is sound, and the run is marked incomplete at the next start.
-TEST_F(CatalogTest, SurvivesSigkillDuringARun) {
+TEST_F(SqliteCatalogTest, SurvivesSigkillDuringARun) {
   constexpr int kAcksBeforeKill = 300;
   constexpr int kMaxEvents = 100000;  // bound if the kill never came
   int fds[2];
@@ -525,7 +559,7 @@ TEST_F(CatalogTest, SurvivesSigkillDuringARun) {
   EXPECT_GE(d.info.end.value(), t0_ + milliseconds(last_ack));
 }
 
-TEST_F(CatalogTest, ReadableWithTheSqlite3Shell) {
+TEST_F(SqliteCatalogTest, ReadableWithTheSqlite3Shell) {
   if (!fs::exists("/usr/bin/sqlite3")) GTEST_SKIP() << "no /usr/bin/sqlite3 (Debian sqlite3)";
   {
     auto cat = Catalog::open(path_);
@@ -547,7 +581,7 @@ TEST_F(CatalogTest, ReadableWithTheSqlite3Shell) {
   EXPECT_EQ(out, "ok\n2\nCH4|812.5|120.25\nrunning\n");
 }
 
-TEST_F(CatalogTest, BadFilesGiveErrorsNamingThePath) {
+TEST_F(SqliteCatalogTest, BadFilesGiveErrorsNamingThePath) {
   const std::string missing = (dir_ / "no_such_dir" / "catalog.sqlite").string();
   const std::string e1 = errorOf([&] { Catalog::open(missing); });
   EXPECT_NE(e1.find(missing), std::string::npos) << e1;
@@ -573,7 +607,7 @@ TEST_F(CatalogTest, BadFilesGiveErrorsNamingThePath) {
   EXPECT_EQ(rawQuery(foreign, "PRAGMA journal_mode"), std::vector<std::string>{"delete"});
 }
 
-TEST_F(CatalogTest, ConcurrentWritersShareOneCatalog) {
+TEST_P(CatalogTest, ConcurrentWritersShareOneCatalog) {
   auto cat = Catalog::open(path_);
   const auto r = cat.startRun(runOf("robot1", "busy", t0_));
   constexpr int kThreads = 4, kEach = 100;
@@ -592,6 +626,51 @@ TEST_F(CatalogTest, ConcurrentWritersShareOneCatalog) {
   const auto d = cat.run(r.id).value();
   EXPECT_EQ(d.event_count + d.alarm_count, kThreads * kEach);
   EXPECT_EQ(cat.integrityCheck(), "ok");
+}
+
+INSTANTIATE_TEST_SUITE_P(Engines, CatalogTest, ::testing::Values(Engine::kSqlite, Engine::kPostgres),
+                         [](const auto& info) { return info.param == Engine::kSqlite ? "sqlite" : "postgresql"; });
+
+TEST_F(PostgresCatalogTest, TwoServersShareOneDatabase) {
+  // Two connections as two pc_servers would hold: the schema is migrated once,
+  // run ids stay unique across them, each sees the other's writes at once.
+  auto a = Catalog::open(path_);
+  auto b = Catalog::open(path_);
+  EXPECT_EQ(b.schemaVersion(), static_cast<int>(schemaMigrations().size()));
+  const auto ra = a.startRun(runOf("robot1", "a", t0_));
+  const auto rb = b.startRun(runOf("robot1", "b", t0_));
+  EXPECT_EQ(ra.id, "20261122-083015-robot1");
+  EXPECT_EQ(rb.id, "20261122-083015-robot1-2");
+  b.addAlarm(ra.id, "robot1", t0_ + milliseconds(5), "H2S", "alarm", "raised", 12.5, 1.0, 2.0);
+  EXPECT_EQ(a.run(ra.id).value().alarm_count, 1);
+  EXPECT_EQ(a.listRuns().size(), 2u);
+  EXPECT_EQ(rawQuery(path_, "SELECT value FROM catalog_meta WHERE key = 'schema_version'"),
+            std::vector<std::string>{std::to_string(schemaMigrations().size())});
+}
+
+TEST_F(PostgresCatalogTest, RefusesANewerSchemaAndAForeignDatabase) {
+  { auto cat = Catalog::open(path_); }
+  rawQuery(path_, "UPDATE catalog_meta SET value = '999' WHERE key = 'schema_version'");
+  EXPECT_NE(errorOf([&] { Catalog::open(path_); }).find("schema version 999 was written by a newer program"),
+            std::string::npos);
+  const std::string foreign = inspect::test::freshPostgresDatabase("foreign");
+  rawQuery(foreign, "CREATE TABLE t (x int)");
+  EXPECT_EQ(errorOf([&] { Catalog::open(foreign); }),
+            "catalog " + foreign + ": not a run catalog (has tables but no catalog_meta)");
+  EXPECT_EQ(rawQuery(foreign, "SELECT count(*) FROM information_schema.tables WHERE table_schema = 'public'"),
+            std::vector<std::string>{"1"});  // untouched
+}
+
+TEST_F(PostgresCatalogTest, AnUnreachableServerIsNamedWithoutItsPassword) {
+  const std::string url = "postgresql://inspect:s3cret@127.0.0.1:1/fleet?connect_timeout=2";
+  const std::string e = errorOf([&] { Catalog::open(url); });
+  EXPECT_EQ(e.rfind("catalog postgresql://inspect@127.0.0.1:1/fleet?connect_timeout=2: cannot connect: ", 0), 0u) << e;
+  EXPECT_EQ(e.find("s3cret"), std::string::npos) << e;
+  EXPECT_EQ(redactUrl("postgres://u:p@h/db?sslmode=require&password=x&a=b"),
+            "postgres://u@h/db?sslmode=require&password=***&a=b");
+  EXPECT_EQ(postgresParams("SELECT ?, ?, '?' WHERE a = ?2"), "SELECT $1, $2, '?' WHERE a = $2");
+  EXPECT_EQ(postgresDdl("id INTEGER PRIMARY KEY, n INTEGER NOT NULL, x REAL"),
+            "id BIGINT GENERATED BY DEFAULT AS IDENTITY PRIMARY KEY, n BIGINT NOT NULL, x DOUBLE PRECISION");
 }
 
 TEST(CatalogTime, FormatsAndParsesIsoUtc) {
