@@ -1,6 +1,7 @@
 #include "pc_server/app/cli_options.hpp"
 
 #include "pc_server/app/server_config.hpp"
+#include "shared/catalog/sql_backend.hpp"
 
 namespace inspect::server {
 
@@ -22,6 +23,13 @@ CliOptions parseCli(const std::vector<std::string>& args) {
     else if (a.is("--no-video")) o.no_video = true;
     else if (a.is("--runs-dir")) o.runs_dir = a.path();
     else if (a.is("--no-record")) o.no_record = true;
+    else if (a.is("--catalog")) {
+      o.catalog = a.path();
+      // The command line is in `ps` for every user of the machine.
+      if (catalog::redactUrl(*o.catalog) != *o.catalog)
+        a.fail("the URL carries a password, which ps shows to every user; put it in ~/.pgpass, PGPASSFILE or "
+               "PGPASSWORD, or in recording.catalog of the config file");
+    } else if (a.is("--server-id")) o.server_id = a.path();
     else if (a.is("--certs")) o.certs_dir = a.path();
     else if (a.is("--no-foxglove")) o.no_foxglove = true;
     else if (a.is("--foxglove-port")) o.foxglove_port = a.port();
@@ -59,6 +67,10 @@ std::string usageText() {
          "  --no-video        do not receive video (overrides video.enabled)\n"
          "  --runs-dir DIR    recorded runs and catalog.sqlite (overrides recording.dir; default runs)\n"
          "  --no-record       keep no catalog and record nothing (overrides recording.enabled)\n"
+         "  --catalog URL|FILE  the run catalog: a SQLite file or a postgresql:// URL that several servers share\n"
+         "                    (overrides recording.catalog; default DIR/catalog.sqlite); no password in the URL:\n"
+         "                    libpq reads it from ~/.pgpass, PGPASSFILE or PGPASSWORD\n"
+         "  --server-id ID    this server in a shared catalog (overrides server_id; default: the host name)\n"
          "  --certs DIR       TLS files DIR/ca.pem, DIR/server.pem, DIR/server.key (overrides tls.*; default certs;\n"
          "                    make them with scripts/make_certs.sh)\n"
          "  --plaintext       no TLS: the robot link is neither encrypted nor authenticated (test benches only;\n"
@@ -78,7 +90,8 @@ std::string usageText() {
          "\n"
          "Without --script the console is interactive when stdin is a terminal; otherwise commands are read\n"
          "from stdin like a script and the server exits at end of input. See docs/console.md.\n"
-         "Exit status: 0 ok, 1 script failure, 2 bad command line or config, 3 cannot listen / write port file.\n";
+         "Exit status: 0 ok, 1 script failure, 2 bad command line or config, 3 cannot start (listen, write the\n"
+         "port file, open the catalog).\n";
 }
 
 }  // namespace inspect::server

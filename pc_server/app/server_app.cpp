@@ -81,6 +81,8 @@ ServerConfig resolveConfig(const CliOptions& options) {
   if (options.no_video) c.video.enabled = false;
   if (options.runs_dir) c.recording.dir = *options.runs_dir;
   if (options.no_record) c.recording.enabled = false;
+  if (options.catalog) c.recording.catalog = *options.catalog;
+  if (options.server_id) c.recording.server_id = *options.server_id;
   if (options.certs_dir) {
     c.tls.ca = *options.certs_dir + "/ca.pem";
     c.tls.cert = *options.certs_dir + "/server.pem";
@@ -151,7 +153,10 @@ std::unique_ptr<Recorder> startRecorder(const ServerConfig& config, LinkServer& 
     return snap->hello;
   });
   recorder->setScene(&site_maps, geometry);
-  std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog.sqlite)";
+  const auto& cat = recorder->catalog();
+  std::cout << "pc_server: recording runs in " << config.recording.dir << "/ (catalog "
+            << (config.recording.catalog.empty() ? "catalog.sqlite" : cat.path())
+            << (cat.serverId().empty() ? "" : ", server " + cat.serverId()) << ")";
   if (!recorder->startupReport().empty()) std::cout << "; " << recorder->startupReport();
   std::cout << std::endl;
   return recorder;

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <cstdio>
 #include <variant>
 
@@ -295,7 +296,10 @@ bool Console::cmdRuns(const CommandArgs& args) {
   if (!recorder_) return fail("runs", "the server records nothing (recording.enabled: false or --no-record)");
   catalog::RunFilter f;
   f.limit = 20;
-  for (const auto& a : args.words) {
+  const bool fleet = args.has("--fleet");
+  auto& cat = recorder_->catalog();
+  if (!fleet) f.server = cat.serverId();  // "" = every run (a catalog of one server)
+  for (const auto& a : args.list("words")) {
     if (const auto n = parseInteger(a); n && *n > 0) {
       f.limit = static_cast<int>(*n);
     } else if (a == "completed" || a == "stopped" || a == "failed" || a == "incomplete" || a == "running") {
@@ -306,12 +310,22 @@ bool Console::cmdRuns(const CommandArgs& args) {
       f.name_contains = a;
     }
   }
-  const auto runs = recorder_->catalog().listRuns(f);
+  const auto runs = cat.listRuns(f);
+  std::map<std::string, std::string> attach;  // server id -> where to attach
+  if (fleet)
+    for (const auto& sv : cat.listServers()) attach[sv.id] = sv.attach;
   out_ << padRight("run", 28) << padRight("robot", 10) << padRight("started (UTC)", 26) << padRight("outcome", 12)
-       << "name\n";
-  for (const auto& r : runs)
+       << (fleet ? padRight("server", 22) : "") << "name\n";
+  for (const auto& r : runs) {
+    std::string server;
+    if (fleet) {
+      server = r.server.empty() ? "-" : r.server;
+      if (const auto at = attach.find(r.server); at != attach.end() && !at->second.empty()) server += " @" + at->second;
+    }
     out_ << padRight(r.id, 28) << padRight(r.robot, 10) << padRight(catalog::formatIsoUtc(r.start), 26)
-         << padRight(r.outcome.empty() ? "running" : r.outcome, 12) << r.name << "\n";
+         << padRight(r.outcome.empty() ? "running" : r.outcome, 12) << (fleet ? padRight(server, 22) : "") << r.name
+         << "\n";
+  }
   out_ << runs.size() << " run" << (runs.size() == 1 ? "" : "s") << "\n";
   return true;
 }

@@ -241,10 +241,14 @@ std::vector<Console::CommandDef> Console::runCommands() {
      "  when they complete or fail; record stop ends it ('stopped'). The status line shows REC.\n"
      "  example: record start night round B\n",
      &Console::cmdRecord},
-    {"runs", {{words("[robot|outcome|text] [limit]")}}, "list recorded runs, newest first",
+    {"runs", {{keyword("--fleet"), words("[robot|outcome|text] [limit]")}, {words("[robot|outcome|text] [limit]")}},
+     "list recorded runs, newest first",
      "  A filter word is a robot id, an outcome (completed, stopped, failed, incomplete,\n"
      "  running) or text in the run's name. Default limit 20.\n"
-     "  example: runs robot1\n",
+     "  With a catalog that several servers share (--catalog postgresql://...), the runs of\n"
+     "  this server; --fleet: every server's, with the server and where to attach to it.\n"
+     "  example: runs robot1\n"
+     "  example: runs --fleet incomplete\n",
      &Console::cmdRuns},
     {"run", {{subcommand("show"), word("run-id")}}, "a recorded run's summary, files and counts",
      "  example: run show 20261122-083015-robot1\n", &Console::cmdRun},

@@ -14,6 +14,13 @@ struct RecordingServerConfig {
   bool auto_start = true;
   std::string compression = "zstd";
   double max_fragment_s = 0.5;
+  /// The run catalog: "" = <dir>/catalog.sqlite; a SQLite path; or a
+  /// "postgresql://" URL a fleet's servers share (docs/catalog.md).
+  std::string catalog;
+  /// This server in a shared catalog (its runs, events and alarms; which open
+  /// runs it ends at start-up). "" = the host name with a PostgreSQL catalog,
+  /// none with a SQLite file (one server's).
+  std::string server_id;
 };
 
 }  // namespace inspect::server

@@ -35,8 +35,10 @@ constexpr int64_t kNoLimit = std::numeric_limits<int64_t>::max();
 #define PUSH_COLUMNS "id, robot_id, time_unix, version, gains_json, status, reason, COALESCE(session_id, '')"
 
 // Columns read into a RunInfo by readRun(), in this order.
-#define RUN_COLUMNS \
-  "id, run_id, robot_id, name, route, gains_json, software_version, dir, start_unix, end_unix, COALESCE(outcome, '')"
+#define RUN_COLUMNS                                                                                                \
+  "id, run_id, robot_id, name, route, gains_json, software_version, dir, start_unix, end_unix, COALESCE(outcome, ''),"  \
+  " server_id"
+
 
 std::string sanitizeRobotId(const std::string& robot) {
   std::string out = robot;
@@ -76,6 +78,8 @@ int64_t limitOf(int limit) { return limit > 0 ? limit : kNoLimit; }
 struct Catalog::Impl {
   std::unique_ptr<SqlBackend> db;
   std::mutex mu;
+  std::string server_id;
+  bool fleet = true;  // the schema has version 5's server columns (false only when opened older, in tests)
 
   [[noreturn]] void failPlain(const std::string& what) const {
     throw CatalogError("catalog " + db->where() + ": " + what);
@@ -208,7 +212,8 @@ struct Catalog::Impl {
 
   RunInfo readRun(const Query& q) const {
     RunInfo r;
-    q.read(r.rowid, r.id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, r.start, r.end, r.outcome);
+    q.read(r.rowid, r.id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, r.start, r.end, r.outcome,
+           r.server);
     return r;
   }
 
@@ -274,6 +279,7 @@ Catalog Catalog::open(const std::string& path) { return open(path, schemaMigrati
 Catalog Catalog::open(const std::string& path, std::span<const std::string_view> migrations) {
   auto impl = std::make_unique<Impl>();
   impl->db = isPostgresUrl(path) ? openPostgres(path, migrations) : openSqlite(path, migrations);
+  impl->fleet = migrations.size() >= 5;
   return Catalog(std::move(impl));
 }
 
@@ -282,6 +288,65 @@ const std::string& Catalog::path() const { return impl_->db->where(); }
 int Catalog::schemaVersion() {
   std::lock_guard lk(impl_->mu);
   return static_cast<int>(impl_->db->schemaVersion());
+}
+
+void Catalog::setServerId(const std::string& id) {
+  std::lock_guard lk(impl_->mu);
+  impl_->server_id = id;
+}
+
+const std::string& Catalog::serverId() const { return impl_->server_id; }
+
+void Catalog::upsertServer(const ServerInfo& s) {
+  if (s.id.empty()) impl_->failPlain("a server needs an id");
+  std::lock_guard lk(impl_->mu);
+  impl_->query(
+           "INSERT INTO servers (id, attach, runs_root, software_version, started_time, started_unix, seen_time,"
+           " seen_unix) VALUES (?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT (id) DO UPDATE SET attach = excluded.attach,"
+           " runs_root = excluded.runs_root, software_version = excluded.software_version,"
+           " started_time = excluded.started_time, started_unix = excluded.started_unix,"
+           " seen_time = excluded.seen_time, seen_unix = excluded.seen_unix")
+      .bind(s.id, s.attach, s.runs_root, s.software_version, s.started, s.seen)
+      .run();
+}
+
+std::vector<ServerInfo> Catalog::listServers() {
+  std::lock_guard lk(impl_->mu);
+  auto q = impl_->query(
+      "SELECT id, attach, runs_root, software_version, started_unix, seen_unix FROM servers"
+      " ORDER BY seen_unix DESC, id");
+  std::vector<ServerInfo> out;
+  while (q.step()) {
+    auto& s = out.emplace_back();
+    q.read(s.id, s.attach, s.runs_root, s.software_version, s.started, s.seen);
+  }
+  return out;
+}
+
+void Catalog::setPresence(const RobotPresence& p) {
+  if (p.robot.empty() || p.server.empty()) impl_->failPlain("a presence needs a robot and a server id");
+  std::lock_guard lk(impl_->mu);
+  impl_->query(
+           "INSERT INTO robot_presence (robot_id, server_id, online, mode, x_m, y_m, seen_time, seen_unix)"
+           " VALUES (?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT (robot_id) DO UPDATE SET server_id = excluded.server_id,"
+           " online = excluded.online, mode = excluded.mode, x_m = excluded.x_m, y_m = excluded.y_m,"
+           " seen_time = excluded.seen_time, seen_unix = excluded.seen_unix")
+      .bind(p.robot, p.server, int64_t{p.online ? 1 : 0}, p.mode, p.x_m, p.y_m, p.seen)
+      .run();
+}
+
+std::vector<RobotPresence> Catalog::listPresence() {
+  std::lock_guard lk(impl_->mu);
+  auto q = impl_->query(
+      "SELECT robot_id, server_id, online, mode, x_m, y_m, seen_unix FROM robot_presence ORDER BY robot_id");
+  std::vector<RobotPresence> out;
+  while (q.step()) {
+    auto& p = out.emplace_back();
+    int64_t online = 0;
+    q.read(p.robot, p.server, online, p.mode, p.x_m, p.y_m, p.seen);
+    p.online = online != 0;
+  }
+  return out;
 }
 
 void Catalog::upsertRobot(const std::string& robot, const std::string& software_version, Time now) {
@@ -308,16 +373,23 @@ RunInfo Catalog::startRun(const RunStart& r) {
     if (n > kMaxRunIdSuffix) impl_->failPlain("no free run id for " + base);
     id = n == 1 ? base : base + "-" + std::to_string(n);
     // A taken id (this server's or another's sharing the database) inserts nothing.
-    auto q = impl_->query(
-        "INSERT INTO runs (run_id, robot_id, name, route, gains_json, software_version, dir, start_time, start_unix)"
-        " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT (run_id) DO NOTHING RETURNING id");
-    if (q.bind(id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, start).step()) {
+    auto q = impl_->fleet
+                 ? impl_->query("INSERT INTO runs (run_id, robot_id, name, route, gains_json, software_version, dir,"
+                                " start_time, start_unix, server_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"
+                                " ON CONFLICT (run_id) DO NOTHING RETURNING id")
+                 : impl_->query("INSERT INTO runs (run_id, robot_id, name, route, gains_json, software_version, dir,"
+                                " start_time, start_unix) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)"
+                                " ON CONFLICT (run_id) DO NOTHING RETURNING id");
+    q.bind(id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, start);
+    if (impl_->fleet) q.bind(impl_->server_id);
+    if (q.step()) {
       rowid = q.column<int64_t>(0);
       break;
     }
   }
   tx.commit();
-  return RunInfo{rowid, id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, start, {}, {}};
+  return RunInfo{rowid, id, r.robot, r.name, r.route, r.gains_json, r.software_version, r.dir, start, {}, {},
+                 impl_->server_id};
 }
 
 bool Catalog::endRun(const std::string& run_id, const std::string& outcome, Time end) {
@@ -355,7 +427,8 @@ std::vector<std::string> Catalog::markIncompleteRuns() {
         "SELECT run_id, start_unix,"
         " COALESCE((SELECT max(time_unix) FROM events e WHERE e.run_id = r.run_id), 0),"
         " COALESCE((SELECT max(time_unix) FROM alarms a WHERE a.run_id = r.run_id), 0)"
-        " FROM runs r WHERE end_time IS NULL ORDER BY start_unix, id");
+        " FROM runs r WHERE end_time IS NULL AND (server_id = ? OR server_id = '') ORDER BY start_unix, id");
+    q.bind(impl_->server_id);
     while (q.step()) {
       auto& [id, last] = open.emplace_back();
       double event = 0, alarm = 0;
@@ -377,18 +450,24 @@ std::vector<std::string> Catalog::markIncompleteRuns() {
 void Catalog::addEvent(const std::string& run_id, const std::string& robot, Time t, const std::string& kind,
                        const std::string& text) {
   std::lock_guard lk(impl_->mu);
-  impl_->query("INSERT INTO events (run_id, robot_id, time, time_unix, kind, text) VALUES (?, ?, ?, ?, ?, ?)")
-      .bind(nullIfEmpty(run_id), robot, t, kind, text)
-      .run();
+  if (impl_->fleet)
+    impl_->query("INSERT INTO events (run_id, robot_id, time, time_unix, kind, text, server_id)"
+                 " VALUES (?, ?, ?, ?, ?, ?, ?)")
+        .bind(nullIfEmpty(run_id), robot, t, kind, text, impl_->server_id)
+        .run();
+  else
+    impl_->query("INSERT INTO events (run_id, robot_id, time, time_unix, kind, text) VALUES (?, ?, ?, ?, ?, ?)")
+        .bind(nullIfEmpty(run_id), robot, t, kind, text)
+        .run();
 }
 
 void Catalog::addAlarm(const std::string& run_id, const std::string& robot, Time t, const std::string& channel,
                        const std::string& level, const std::string& state, double value, double x_m, double y_m) {
   std::lock_guard lk(impl_->mu);
   impl_->query(
-           "INSERT INTO alarms (run_id, robot_id, time, time_unix, channel, level, state, value, x_m, y_m)"
-           " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
-      .bind(nullIfEmpty(run_id), robot, t, channel, level, state, value, x_m, y_m)
+           "INSERT INTO alarms (run_id, robot_id, time, time_unix, channel, level, state, value, x_m, y_m, server_id)"
+           " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
+      .bind(nullIfEmpty(run_id), robot, t, channel, level, state, value, x_m, y_m, impl_->server_id)
       .run();
 }
 
@@ -436,8 +515,9 @@ std::vector<RunInfo> Catalog::listRuns(const RunFilter& f) {
                         " AND (CAST(?2 AS TEXT) IS NULL OR instr(lower(name), lower(?2)) > 0)"
                         " AND (CAST(?3 AS TEXT) IS NULL OR outcome = ?3 OR (?3 = 'running' AND outcome IS NULL))"
                         " AND (CAST(?4 AS DOUBLE PRECISION) IS NULL OR start_unix >= ?4)"
-                        " ORDER BY start_unix DESC, id DESC LIMIT ?5");
-  q.bind(nullIfEmpty(f.robot), nullIfEmpty(f.name_contains), nullIfEmpty(f.outcome), since,
+                        " AND (CAST(?5 AS TEXT) IS NULL OR server_id = ?5)"
+                        " ORDER BY start_unix DESC, id DESC LIMIT ?6");
+  q.bind(nullIfEmpty(f.robot), nullIfEmpty(f.name_contains), nullIfEmpty(f.outcome), since, nullIfEmpty(f.server),
          limitOf(f.limit));
   std::vector<RunInfo> out;
   while (q.step()) out.push_back(impl_->readRun(q));

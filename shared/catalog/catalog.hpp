@@ -49,6 +49,7 @@ struct RunInfo {
   Time start{};
   std::optional<Time> end;
   std::string outcome;     // one of kOutcomes, "" while running
+  std::string server;      // the server that recorded it ("" = a single server's catalog)
 };
 
 struct GasFigures {
@@ -85,7 +86,26 @@ struct RunFilter {
   std::string name_contains;  // substring of the name, case-insensitive (ASCII)
   std::string outcome;        // one of kOutcomes, or "running"
   std::optional<Time> since;  // runs started at or after
+  std::string server;         // exact server id
   int limit = 100;            // newest first; <= 0: no limit
+};
+
+/// A server writing into the catalog (a fleet's shared one), kept fresh by it.
+struct ServerInfo {
+  std::string id;
+  std::string attach;            // where an operator reaches it, e.g. "ops-pc-2:7600"
+  std::string runs_root;         // its runs directory (shared root or its own)
+  std::string software_version;
+  Time started{}, seen{};
+};
+
+/// Where a robot is: the server holding its link, as that server last wrote.
+struct RobotPresence {
+  std::string robot, server;
+  bool online = false;
+  std::string mode;                   // e.g. "TELEOP", "ESTOP"
+  std::optional<double> x_m, y_m;
+  Time seen{};
 };
 
 /// A tuning session of the fuzzy-PID tuner (docs/tuning.md), as one row.
@@ -149,6 +169,20 @@ class Catalog {
   const std::string& path() const;
   int schemaVersion();
 
+  /// This server's id: written on its runs, events and alarms, and
+  /// markIncompleteRuns ends only its own runs (and those of no server).
+  /// "" (the default) is a catalog that one server keeps.
+  void setServerId(const std::string& id);
+  const std::string& serverId() const;
+  /// Adds the server or updates its row (started is kept from its last start).
+  void upsertServer(const ServerInfo& s);
+  /// Every server, most recently seen first.
+  std::vector<ServerInfo> listServers();
+  /// Replaces the robot's presence row.
+  void setPresence(const RobotPresence& p);
+  /// Every robot's presence, by robot id.
+  std::vector<RobotPresence> listPresence();
+
   /// Adds the robot or updates its software version and last_seen.
   void upsertRobot(const std::string& robot, const std::string& software_version, Time now);
 
@@ -162,8 +196,9 @@ class Catalog {
   void setGains(const std::string& run_id, const std::string& gains_json);
   /// The robot's run that has not ended (the newest), e.g. to carry on after a reconnect.
   std::optional<RunInfo> activeRun(const std::string& robot);
-  /// At start-up: every run without an end becomes 'incomplete', its end time
-  /// the last event or alarm recorded (else its start). Returns their ids.
+  /// At start-up: every run of this server (or of none) without an end
+  /// becomes 'incomplete', its end time the last event or alarm recorded
+  /// (else its start). Returns their ids.
   std::vector<std::string> markIncompleteRuns();
 
   /// run_id "" = not during a run.

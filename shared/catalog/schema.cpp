@@ -137,6 +137,34 @@ CREATE TABLE gains_pushes (
 );
 CREATE INDEX gains_pushes_by_robot ON gains_pushes(robot_id, time_unix);
 )sql",
+    // 5: a fleet's servers sharing one catalog: who recorded what, which
+    // servers there are, and where each robot is online (docs/catalog.md).
+    R"sql(
+ALTER TABLE runs ADD COLUMN server_id TEXT NOT NULL DEFAULT '';
+ALTER TABLE events ADD COLUMN server_id TEXT NOT NULL DEFAULT '';
+ALTER TABLE alarms ADD COLUMN server_id TEXT NOT NULL DEFAULT '';
+CREATE INDEX runs_by_server ON runs(server_id, start_unix);
+CREATE TABLE servers (
+  id           TEXT PRIMARY KEY,
+  attach       TEXT NOT NULL DEFAULT '',
+  runs_root    TEXT NOT NULL DEFAULT '',
+  software_version TEXT NOT NULL DEFAULT '',
+  started_time TEXT NOT NULL,
+  started_unix REAL NOT NULL,
+  seen_time    TEXT NOT NULL,
+  seen_unix    REAL NOT NULL
+);
+CREATE TABLE robot_presence (
+  robot_id  TEXT PRIMARY KEY,
+  server_id TEXT NOT NULL,
+  online    INTEGER NOT NULL CHECK (online IN (0, 1)),
+  mode      TEXT NOT NULL DEFAULT '',
+  x_m       REAL,
+  y_m       REAL,
+  seen_time TEXT NOT NULL,
+  seen_unix REAL NOT NULL
+);
+)sql",
 };
 
 }  // namespace

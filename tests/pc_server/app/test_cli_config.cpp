@@ -78,6 +78,9 @@ TEST(Cli, ErrorsNameTheFlag) {
   EXPECT_EQ(cliError({"--no-console=1"}), "--no-console: takes no value");
   EXPECT_EQ(cliError({"stray"}), "unexpected argument 'stray'");
   EXPECT_EQ(cliError({"--runs-dir="}), "--runs-dir: empty value");
+  EXPECT_EQ(cliError({"--catalog", "postgresql://ops:s3cret@db/fleet"}),
+            "--catalog: the URL carries a password, which ps shows to every user; put it in ~/.pgpass, PGPASSFILE "
+            "or PGPASSWORD, or in recording.catalog of the config file");
   EXPECT_EQ(parseCli({"--attach=/tmp/op.sock"}).attach, "/tmp/op.sock");
   EXPECT_NE(cliError({"--attach", "/tmp/op.sock", "--plaintext"}).find("takes no other flags"), std::string::npos);
   EXPECT_NE(cliError({"--no-console", "--script", "x"}).find("cannot be combined"), std::string::npos);

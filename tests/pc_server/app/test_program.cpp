@@ -272,6 +272,18 @@ TEST(Program, OnATerminalTheConsoleEditsCompletesAndRecalls) {
   EXPECT_EQ(p.wait(), 0) << p.ptyText();
 }
 
+TEST(Program, AnUnreachableCatalogIsOneLineNamingItAndExitThree) {
+  Program p("catalog_down");
+  // Port 1 on loopback: nothing listens there; the password comes from the environment, not the URL.
+  p.start({"--config", kConfig, "--bind", "127.0.0.1", "--port", "0", "--runs-dir", p.path("runs").string(),
+           "--catalog", "postgresql://fleet@127.0.0.1:1/inspect?connect_timeout=2", "--no-console"});
+  EXPECT_EQ(p.wait(), 3) << p.out() << p.err();  // a start-up failure, as a port that cannot be bound
+  const std::string err = p.err();
+  EXPECT_HAS(err, "pc_server: recording: catalog postgresql://fleet@127.0.0.1:1/inspect?connect_timeout=2: "
+                  "cannot connect: ");
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
 TEST(Program, BadConfigIsOneLineAndExitTwo) {
   Program p("bad_config");
   const auto cfg = p.file("server.yaml", "port: 7600\nsession_timeout_s: -1\n");

@@ -3,6 +3,8 @@
 // going on while one waits, and a client that leaves interrupted at once.
 #include <gtest/gtest.h>
 
+#include "tests/support/null_command_sink.hpp"
+
 #include <chrono>
 #include <condition_variable>
 #include <future>
@@ -20,13 +22,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-class NullSink : public CommandSink {
- public:
-  uint64_t setTeleop(const std::string&, double, double, double) override { return 0; }
-  void clearTeleop(const std::string&) override {}
-  uint64_t sendCommand(const std::string&, v1::Command) override { return 0; }
-  void consoleAlive() override {}
-};
+using NullSink = inspect::test::NullCommandSink;
 
 /// The answers a client got, in the order they came.
 struct Answers {

@@ -3,6 +3,10 @@
 // summary figures.
 #include <gtest/gtest.h>
 
+#include "tests/support/null_command_sink.hpp"
+
+#include "tests/support/postgres_server.hpp"
+
 #include <filesystem>
 #include <sstream>
 
@@ -28,6 +32,8 @@ RecordingConfig recordingIn(const fs::path& dir) {
   c.dir = dir.string();
   return c;
 }
+
+using NullSink = inspect::test::NullCommandSink;
 
 v1::Envelope telemetry(double x, double person, double gas, v1::Mode mode = v1::IDLE, double err = 0) {
   v1::Envelope e;
@@ -68,6 +74,58 @@ TEST(RunStats, SumsARunUp) {
   ASSERT_EQ(f.gas.size(), 1u);
   EXPECT_DOUBLE_EQ(f.gas[0].max, 10);
   EXPECT_NEAR(f.gas[0].mean, 65.0 / 12, 1e-9);  // 0..10, then 10 again
+}
+
+TEST(Recorder, ServersSharingACatalogOnPostgresKeepTheirOwnRuns) {
+  // Two servers' recorders, each with its runs directory, one PostgreSQL catalog.
+  TempRuns tmp_a, tmp_b;
+  const std::string url = inspect::test::freshPostgresDatabase("recorder_fleet");
+  auto config = [&](const fs::path& dir, const std::string& id) {
+    RecordingConfig c = recordingIn(dir);
+    c.catalog = url;
+    c.server_id = id;
+    return c;
+  };
+  auto a = std::make_unique<Recorder>(config(tmp_a.dir, "ops-a"), "test");
+  Recorder b(config(tmp_b.dir, "ops-b"), "test");
+  const std::string ra = a->start("robot1", "north wing");
+  const std::string rb = b.start("robot2", "south wing");
+  b.onEnvelope("robot2", "127.0.0.1:2", telemetry(0.5, 2.0, 1), true, monoNowUs());
+  EXPECT_TRUE(fs::exists(tmp_a.dir / ra / "run.mcap"));
+  EXPECT_TRUE(fs::exists(tmp_b.dir / rb / "run.mcap"));
+
+  RobotRegistry registry;
+  NullSink sink;
+  std::ostringstream out;
+  StopFlag stop;
+  Console console(registry, sink, out, stop);
+  console.setRecorder(a.get());
+  ASSERT_TRUE(console.execute("runs", 1));
+  EXPECT_NE(out.str().find(ra), std::string::npos) << out.str();
+  EXPECT_EQ(out.str().find(rb), std::string::npos) << "another server's run in plain `runs`: " << out.str();
+  EXPECT_NE(out.str().find("1 run\n"), std::string::npos) << out.str();
+  out.str("");
+  b.catalog().upsertServer({"ops-b", "ops-b:7600", tmp_b.dir.string(), "test", catalog::Time{}, catalog::Time{}});
+  ASSERT_TRUE(console.execute("runs --fleet", 2));
+  EXPECT_NE(out.str().find(rb), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("ops-b @ops-b:7600"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("2 runs"), std::string::npos) << out.str();
+
+  // ops-a stops; a run it left open (as a killed server would) is ended
+  // when it starts again, ops-b's running run is not.
+  console.setRecorder(nullptr);
+  a.reset();
+  EXPECT_EQ(b.catalog().run(ra).value().info.outcome, "stopped");
+  auto left = catalog::Catalog::open(url);
+  left.setServerId("ops-a");
+  const std::string open_run = left.startRun({"robot1", "killed", "", "{}", "test", "", std::nullopt}).id;
+  Recorder a2(config(tmp_a.dir, "ops-a"), "test");
+  EXPECT_NE(a2.startupReport().find(open_run + ": marked incomplete"), std::string::npos) << a2.startupReport();
+  EXPECT_EQ(a2.startupReport().find(rb), std::string::npos) << a2.startupReport();
+  EXPECT_EQ(b.catalog().run(rb).value().info.outcome, "");
+  EXPECT_EQ(b.activeRun("robot2"), rb);
+  EXPECT_EQ(b.stop("robot2"), rb);
+  EXPECT_EQ(a2.catalog().run(rb).value().info.outcome, "stopped");
 }
 
 TEST(Recorder, ConsoleRunAndTrackRunAreRecordedAndListed) {
@@ -117,12 +175,7 @@ TEST(Recorder, ConsoleRunAndTrackRunAreRecordedAndListed) {
 
     // The console lists and shows them.
     RobotRegistry registry;
-    struct NullSink : CommandSink {
-      uint64_t setTeleop(const std::string&, double, double, double) override { return 0; }
-      void clearTeleop(const std::string&) override {}
-      uint64_t sendCommand(const std::string&, v1::Command) override { return 0; }
-      void consoleAlive() override {}
-    } sink;
+    NullSink sink;
     std::ostringstream out;
     StopFlag stop;
     Console console(registry, sink, out, stop);

@@ -122,8 +122,9 @@ TEST_F(SqliteCatalogTest, CreatesWalDatabaseAtLatestVersion) {
   EXPECT_EQ(cat.integrityCheck(), "ok");
   EXPECT_EQ(rawQuery(path_, "PRAGMA journal_mode"), std::vector<std::string>{"wal"});
   EXPECT_EQ(rawQuery(path_, "SELECT name FROM sqlite_master WHERE type IN ('table', 'view') ORDER BY name"),
-            (std::vector<std::string>{"alarms", "events", "gains_pushes", "robots", "run_files", "run_gas",
-                                      "run_overview", "run_summary", "runs", "tuning_sessions"}));
+            (std::vector<std::string>{"alarms", "events", "gains_pushes", "robot_presence", "robots", "run_files",
+                                      "run_gas", "run_overview", "run_summary", "runs", "servers",
+                                      "tuning_sessions"}));
 }
 
 TEST_P(CatalogTest, ReopeningKeepsDataAndVersion) {
@@ -626,6 +627,55 @@ TEST_P(CatalogTest, ConcurrentWritersShareOneCatalog) {
   const auto d = cat.run(r.id).value();
   EXPECT_EQ(d.event_count + d.alarm_count, kThreads * kEach);
   EXPECT_EQ(cat.integrityCheck(), "ok");
+}
+
+TEST_P(CatalogTest, ServersKeepTheirOwnRunsAndSayWhereEachRobotIs) {
+  // Two servers writing into one catalog (one file, or one database).
+  auto a = Catalog::open(path_);
+  auto b = Catalog::open(path_);
+  a.setServerId("ops-a");
+  b.setServerId("ops-b");
+  const auto ra = a.startRun(runOf("robot1", "a", t0_));
+  const auto rb = b.startRun(runOf("robot2", "b", t0_));
+  EXPECT_EQ(ra.server, "ops-a");
+  a.addEvent(ra.id, "robot1", t0_ + milliseconds(10), "note", "x");
+  b.addAlarm(rb.id, "robot2", t0_ + milliseconds(20), "H2S", "alarm", "raised", 15, 1, 2);
+  EXPECT_EQ(rawQuery(path_, "SELECT server_id FROM alarms"), std::vector<std::string>{"ops-b"});
+  EXPECT_EQ(rawQuery(path_, "SELECT server_id FROM events"), std::vector<std::string>{"ops-a"});
+  RunFilter f;
+  f.server = "ops-b";
+  const auto only_b = a.listRuns(f);
+  ASSERT_EQ(only_b.size(), 1u);
+  EXPECT_EQ(only_b[0].id, rb.id);
+  EXPECT_EQ(only_b[0].server, "ops-b");
+  // A restarted ops-a ends its own open run, never ops-b's running one.
+  EXPECT_EQ(a.markIncompleteRuns(), std::vector<std::string>{ra.id});
+  EXPECT_EQ(b.run(rb.id).value().info.outcome, "");
+  EXPECT_EQ(b.run(ra.id).value().info.outcome, "incomplete");
+
+  a.upsertServer({"ops-a", "ops-a:7600", "/srv/runs", "0.9.0", t0_, t0_ + milliseconds(1000)});
+  b.upsertServer({"ops-b", "ops-b:7600", "/srv/runs", "0.9.0", t0_, t0_ + milliseconds(2000)});
+  a.upsertServer({"ops-a", "ops-a:7601", "/srv/runs", "0.9.1", t0_, t0_ + milliseconds(3000)});
+  const auto servers = b.listServers();
+  ASSERT_EQ(servers.size(), 2u);
+  EXPECT_EQ(servers[0].id, "ops-a");  // seen most recently
+  EXPECT_EQ(servers[0].attach, "ops-a:7601");
+  EXPECT_EQ(servers[0].software_version, "0.9.1");
+  EXPECT_EQ(servers[0].seen, t0_ + milliseconds(3000));
+
+  b.setPresence({"robot2", "ops-b", true, "TELEOP", 1.5, -2.25, t0_});
+  a.setPresence({"robot1", "ops-a", false, "", std::nullopt, std::nullopt, t0_});
+  a.setPresence({"robot2", "ops-a", true, "AUTO", 3.0, 4.0, t0_ + milliseconds(500)});  // robot2 moved to ops-a
+  const auto where = b.listPresence();
+  ASSERT_EQ(where.size(), 2u);
+  EXPECT_EQ(where[0].robot, "robot1");
+  EXPECT_FALSE(where[0].online);
+  EXPECT_FALSE(where[0].x_m);
+  EXPECT_EQ(where[1].server, "ops-a");
+  EXPECT_EQ(where[1].mode, "AUTO");
+  EXPECT_EQ(where[1].x_m, 3.0);
+  EXPECT_EQ(where[1].seen, t0_ + milliseconds(500));
+  EXPECT_FALSE(errorOf([&] { a.setPresence({"robot3", "", true, "", {}, {}, t0_}); }).empty());
 }
 
 INSTANTIATE_TEST_SUITE_P(Engines, CatalogTest, ::testing::Values(Engine::kSqlite, Engine::kPostgres),
