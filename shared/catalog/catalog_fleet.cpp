@@ -1,0 +1,66 @@
+// The catalog of a fleet's servers: each server's id on what it writes, the
+// servers' rows and where each robot is (docs/catalog.md, version 5).
+#include "shared/catalog/catalog_impl.hpp"
+
+namespace inspect::catalog {
+
+void Catalog::setServerId(const std::string& id) {
+  std::lock_guard lk(impl_->mu);
+  impl_->server_id = id;
+}
+
+const std::string& Catalog::serverId() const { return impl_->server_id; }
+
+void Catalog::upsertServer(const ServerInfo& s) {
+  if (s.id.empty()) impl_->failPlain("a server needs an id");
+  std::lock_guard lk(impl_->mu);
+  impl_->query(
+           "INSERT INTO servers (id, attach, runs_root, software_version, started_time, started_unix, seen_time,"
+           " seen_unix) VALUES (?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT (id) DO UPDATE SET attach = excluded.attach,"
+           " runs_root = excluded.runs_root, software_version = excluded.software_version,"
+           " started_time = excluded.started_time, started_unix = excluded.started_unix,"
+           " seen_time = excluded.seen_time, seen_unix = excluded.seen_unix")
+      .bind(s.id, s.attach, s.runs_root, s.software_version, s.started, s.seen)
+      .run();
+}
+
+std::vector<ServerInfo> Catalog::listServers() {
+  std::lock_guard lk(impl_->mu);
+  auto q = impl_->query(
+      "SELECT id, attach, runs_root, software_version, started_unix, seen_unix FROM servers"
+      " ORDER BY seen_unix DESC, id");
+  std::vector<ServerInfo> out;
+  while (q.step()) {
+    auto& s = out.emplace_back();
+    q.read(s.id, s.attach, s.runs_root, s.software_version, s.started, s.seen);
+  }
+  return out;
+}
+
+void Catalog::setPresence(const RobotPresence& p) {
+  if (p.robot.empty() || p.server.empty()) impl_->failPlain("a presence needs a robot and a server id");
+  std::lock_guard lk(impl_->mu);
+  impl_->query(
+           "INSERT INTO robot_presence (robot_id, server_id, online, mode, x_m, y_m, seen_time, seen_unix)"
+           " VALUES (?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT (robot_id) DO UPDATE SET server_id = excluded.server_id,"
+           " online = excluded.online, mode = excluded.mode, x_m = excluded.x_m, y_m = excluded.y_m,"
+           " seen_time = excluded.seen_time, seen_unix = excluded.seen_unix")
+      .bind(p.robot, p.server, int64_t{p.online ? 1 : 0}, p.mode, p.x_m, p.y_m, p.seen)
+      .run();
+}
+
+std::vector<RobotPresence> Catalog::listPresence() {
+  std::lock_guard lk(impl_->mu);
+  auto q = impl_->query(
+      "SELECT robot_id, server_id, online, mode, x_m, y_m, seen_unix FROM robot_presence ORDER BY robot_id");
+  std::vector<RobotPresence> out;
+  while (q.step()) {
+    auto& p = out.emplace_back();
+    int64_t online = 0;
+    q.read(p.robot, p.server, online, p.mode, p.x_m, p.y_m, p.seen);
+    p.online = online != 0;
+  }
+  return out;
+}
+
+}  // namespace inspect::catalog
