@@ -84,8 +84,7 @@ void LineEditor::recall(int step) {
 void LineEditor::complete() {
   if (!completer_) return;
   const std::string before = buf_.substr(0, cur_);
-  const std::size_t word_start = before.find_last_of(" \t") == std::string::npos ? 0 : before.find_last_of(" \t") + 1;
-  const std::string partial = before.substr(word_start);
+  const std::string partial = before.substr(before.find_last_of(" \t") + 1);  // npos + 1 = 0: the whole line
   const auto candidates = completer_(before);
   if (candidates.empty()) {
     out_ += kBell;

@@ -8,6 +8,8 @@
 
 namespace inspect::catalog {
 
+void failCatalog(const std::string& where, const std::string& what) { throw CatalogError("catalog " + where + ": " + what); }
+
 namespace {
 
 constexpr int kMaxRunIdSuffix = 10000;
@@ -50,7 +52,7 @@ Catalog Catalog::open(const std::string& path) { return open(path, schemaMigrati
 Catalog Catalog::open(const std::string& path, std::span<const std::string_view> migrations) {
   auto impl = std::make_unique<Impl>();
   impl->db = isPostgresUrl(path) ? openPostgres(path, migrations) : openSqlite(path, migrations);
-  impl->fleet = migrations.size() >= 5;
+  impl->fleet = migrations.size() >= detail::kServerIdsVersion;
   return Catalog(std::move(impl));
 }
 

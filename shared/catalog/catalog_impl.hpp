@@ -31,6 +31,9 @@ inline constexpr int64_t kNoLimit = std::numeric_limits<int64_t>::max();
 
 inline int64_t limitOf(int limit) { return limit > 0 ? limit : kNoLimit; }
 
+// The schema version that adds server_id to runs, events and alarms.
+inline constexpr std::size_t kServerIdsVersion = 5;
+
 inline bool allDigits(const std::string& s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
@@ -53,7 +56,7 @@ struct Catalog::Impl {
   bool fleet = true;  // the schema has version 5's server columns (false only when opened older, in tests)
 
   [[noreturn]] void failPlain(const std::string& what) const {
-    throw CatalogError("catalog " + db->where() + ": " + what);
+    failCatalog(db->where(), what);
   }
 
   // A statement, its parameters bound in order, then its rows read.

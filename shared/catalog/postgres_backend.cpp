@@ -131,7 +131,7 @@ class PostgresBackend final : public SqlBackend {
   }
 
  private:
-  [[noreturn]] void failPlain(const std::string& what) const { throw CatalogError("catalog " + where_ + ": " + what); }
+  [[noreturn]] void failPlain(const std::string& what) const { failCatalog(where_, what); }
 
   void check(PGresult* r, const std::string& what) {
     const auto st = r ? PQresultStatus(r) : PGRES_FATAL_ERROR;

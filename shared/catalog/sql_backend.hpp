@@ -45,6 +45,9 @@ class SqlBackend {
   virtual std::string integrityCheck() = 0;
 };
 
+/// Throws CatalogError "catalog <where>: <what>": every catalog error's form.
+[[noreturn]] void failCatalog(const std::string& where, const std::string& what);
+
 /// True for "postgresql://..." and "postgres://..." (libpq's URLs).
 bool isPostgresUrl(std::string_view target);
 /// The URL without its password ("postgresql://inspect@db/fleet").

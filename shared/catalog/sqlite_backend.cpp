@@ -107,11 +107,9 @@ class SqliteBackend final : public SqlBackend {
 
  private:
   [[noreturn]] void fail(const std::string& what) const {
-    std::string msg = "catalog " + path_ + ": " + what;
-    if (db_) msg += std::string(": ") + sqlite3_errmsg(db_.get());
-    throw CatalogError(msg);
+    failCatalog(path_, db_ ? what + ": " + sqlite3_errmsg(db_.get()) : what);
   }
-  [[noreturn]] void failPlain(const std::string& what) const { throw CatalogError("catalog " + path_ + ": " + what); }
+  [[noreturn]] void failPlain(const std::string& what) const { failCatalog(path_, what); }
 
   void exec(const char* sql, const char* what) {
     if (sqlite3_exec(db_.get(), sql, nullptr, nullptr, nullptr) != SQLITE_OK) fail(what);
