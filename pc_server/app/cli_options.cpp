@@ -29,7 +29,10 @@ CliOptions parseCli(const std::vector<std::string>& args) {
       if (catalog::redactUrl(*o.catalog) != *o.catalog)
         a.fail("the URL carries a password, which ps shows to every user; put it in ~/.pgpass, PGPASSFILE or "
                "PGPASSWORD, or in recording.catalog of the config file");
-    } else if (a.is("--server-id")) o.server_id = a.path();
+    } else if (a.is("--server-id")) {
+      o.server_id = a.path();
+      if (o.server_id->size() > 64) a.fail("must be 1 to 64 characters (as server_id)");
+    }
     else if (a.is("--certs")) o.certs_dir = a.path();
     else if (a.is("--no-foxglove")) o.no_foxglove = true;
     else if (a.is("--foxglove-port")) o.foxglove_port = a.port();
@@ -70,7 +73,8 @@ std::string usageText() {
          "  --catalog URL|FILE  the run catalog: a SQLite file or a postgresql:// URL that several servers share\n"
          "                    (overrides recording.catalog; default DIR/catalog.sqlite); no password in the URL:\n"
          "                    libpq reads it from ~/.pgpass, PGPASSFILE or PGPASSWORD\n"
-         "  --server-id ID    this server in a shared catalog (overrides server_id; default: the host name)\n"
+         "  --server-id ID    this server's name (overrides server_id): in HelloReply, and its id in a shared\n"
+         "                    catalog (where the default pc_server stands for the host name)\n"
          "  --certs DIR       TLS files DIR/ca.pem, DIR/server.pem, DIR/server.key (overrides tls.*; default certs;\n"
          "                    make them with scripts/make_certs.sh)\n"
          "  --plaintext       no TLS: the robot link is neither encrypted nor authenticated (test benches only;\n"

@@ -28,6 +28,7 @@
 #include "pc_server/link/link_server.hpp"
 #include "pc_server/operator/operator_socket.hpp"
 #include "pc_server/link/robot_registry.hpp"
+#include "shared/catalog/sql_backend.hpp"
 #include "shared/util/startup_error.hpp"
 #include "pc_server/app/stop_flag.hpp"
 #include "pc_server/recording/recorder.hpp"
@@ -67,6 +68,14 @@ static std::string localUserName() {
   return "operator";
 }
 
+std::string catalogServerId(const ServerConfig& c) {
+  if (!catalog::isPostgresUrl(c.recording.catalog)) return "";  // one server's file
+  if (c.server_id != LinkConfig{}.server_id) return c.server_id;
+  char host[256] = {};  // the default name: every server would share it, so the host's name instead
+  if (::gethostname(host, sizeof host - 1) != 0 || host[0] == '\0') return c.server_id;
+  return host;
+}
+
 ServerConfig resolveConfig(const CliOptions& options) {
   ServerConfig c;
   if (options.config_path) {
@@ -82,7 +91,7 @@ ServerConfig resolveConfig(const CliOptions& options) {
   if (options.runs_dir) c.recording.dir = *options.runs_dir;
   if (options.no_record) c.recording.enabled = false;
   if (options.catalog) c.recording.catalog = *options.catalog;
-  if (options.server_id) c.recording.server_id = *options.server_id;
+  if (options.server_id) c.server_id = *options.server_id;
   if (options.certs_dir) {
     c.tls.ca = *options.certs_dir + "/ca.pem";
     c.tls.cert = *options.certs_dir + "/server.pem";
@@ -97,6 +106,7 @@ ServerConfig resolveConfig(const CliOptions& options) {
     c.foxglove.auth = "token";
   }
   if (options.site_map) c.site_map = *options.site_map;
+  c.recording.server_id = catalogServerId(c);
   return c;
 }
 

@@ -1,14 +1,12 @@
 #include "pc_server/recording/recorder.hpp"
 
 #include <nlohmann/json.hpp>
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 
 #include "foxglove/CompressedVideo.pb.h"
-#include "shared/catalog/sql_backend.hpp"
 #include "pc_server/scene/scene_feed.hpp"
 #include "pc_server/scene/topics.hpp"
 #include "shared/record/mcap_writer.hpp"
@@ -25,13 +23,6 @@ using util::fmtShort;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// This machine's name: a server's id in a shared catalog unless configured.
-std::string hostName() {
-  char buf[256] = {};
-  if (::gethostname(buf, sizeof buf - 1) != 0 || buf[0] == '\0') return "pc_server";
-  return buf;
-}
 
 int64_t fileBytes(const std::string& path) {
   std::error_code ec;
@@ -94,9 +85,7 @@ Recorder::Recorder(const RecordingConfig& config, std::string software_version)
   if (ec) throw std::runtime_error("recording.dir: cannot create '" + config_.dir + "': " + ec.message());
   const std::string target = config_.catalog.empty() ? config_.dir + "/catalog.sqlite" : config_.catalog;
   catalog_ = std::make_unique<catalog::Catalog>(catalog::Catalog::open(target));
-  std::string server_id = config_.server_id;
-  if (server_id.empty() && catalog::isPostgresUrl(target)) server_id = hostName();
-  catalog_->setServerId(server_id);
+  catalog_->setServerId(config_.server_id);
   const auto incomplete = catalog_->markIncompleteRuns();  // this server's only
   for (const auto& id : incomplete) {
     const auto detail = catalog_->run(id);

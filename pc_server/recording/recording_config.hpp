@@ -18,8 +18,9 @@ struct RecordingServerConfig {
   /// "postgresql://" URL a fleet's servers share (docs/catalog.md).
   std::string catalog;
   /// This server in a shared catalog (its runs, events and alarms; which open
-  /// runs it ends at start-up). "" = the host name with a PostgreSQL catalog,
-  /// none with a SQLite file (one server's).
+  /// runs it ends at start-up); "" = none (a SQLite file is one server's).
+  /// Not a key of its own: resolveConfig derives it from the server's
+  /// server_id (catalogServerId).
   std::string server_id;
 };
 

@@ -1,7 +1,10 @@
 // Command line and config/server.yaml: defaults, overrides, errors that name the flag or key.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include "pc_server/app/cli_options.hpp"
+#include "pc_server/app/server_app.hpp"
 #include "pc_server/app/server_config.hpp"
 #include "tests/support/paths.hpp"
 
@@ -131,4 +134,18 @@ TEST(ServerConfig, BadValuesNameFileAndKey) {
   EXPECT_EQ(configError("heartbeat_period: 0.1\n"),
             "server.yaml: heartbeat_period: unknown key (misspelt, or not used by this program)");
   EXPECT_EQ(configError("server_id: ''\n"), "server.yaml: server_id: must be 1 to 64 characters");
+}
+
+TEST(Cli, TheCatalogIdIsTheServersNameOnlyInASharedCatalog) {
+  ServerConfig c;
+  EXPECT_EQ(catalogServerId(c), "");  // a SQLite file: one server's
+  c.server_id = "ops-a";
+  EXPECT_EQ(catalogServerId(c), "");
+  c.recording.catalog = "postgresql://fleet@db/inspect";
+  EXPECT_EQ(catalogServerId(c), "ops-a");
+  c.server_id = LinkConfig{}.server_id;  // the default every server would share: the host's name instead
+  char host[256] = {};
+  ASSERT_EQ(::gethostname(host, sizeof host - 1), 0);
+  EXPECT_EQ(catalogServerId(c), host);
+  EXPECT_EQ(cliError({"--server-id", std::string(65, 'x')}), "--server-id: must be 1 to 64 characters (as server_id)");
 }
