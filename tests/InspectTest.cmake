@@ -65,8 +65,9 @@ target_compile_options(inspect_test_support PRIVATE ${INSPECT_TEST_COMPILE_OPTIO
 # `postgres` below starts one for the whole ctest run; tests that use it
 # take INSPECT_POSTGRES_TEST_PROPERTIES (the fixture and the file naming it).
 if(NOT INSPECT_ROBOT_ONLY)
-  add_library(inspect_test_postgres STATIC ${PROJECT_SOURCE_DIR}/tests/support/postgres_server.cpp)
-  target_link_libraries(inspect_test_postgres PUBLIC inspect_test_paths PkgConfig::LIBPQ)
+  add_library(inspect_test_postgres STATIC ${PROJECT_SOURCE_DIR}/tests/support/postgres_server.cpp
+    ${PROJECT_SOURCE_DIR}/tests/support/sql_query.cpp)
+  target_link_libraries(inspect_test_postgres PUBLIC inspect_test_paths inspect_catalog PkgConfig::LIBPQ)
   target_compile_options(inspect_test_postgres PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})
   set(INSPECT_POSTGRES_FILE ${CMAKE_BINARY_DIR}/Testing/postgres-dir)
   set(INSPECT_POSTGRES_TEST_PROPERTIES FIXTURES_REQUIRED postgres ENVIRONMENT INSPECT_TEST_PG_FILE=${INSPECT_POSTGRES_FILE})

@@ -21,15 +21,6 @@
 namespace inspect::server {
 
 namespace {
-std::string padRight(std::string s, std::size_t w) {
-  if (s.size() < w) s.append(w - s.size(), ' ');
-  return s;
-}
-std::string padLeft(std::string s, std::size_t w) {
-  if (s.size() < w) s.insert(0, w - s.size(), ' ');
-  return s;
-}
-
 /// Removes a comment: '#' at the start or after a blank.
 std::string stripComment(const std::string& line) {
   for (std::size_t i = 0; i < line.size(); ++i)
@@ -117,6 +108,9 @@ std::string Console::background() {
     else
       s += line + "\n";
   }
+  // The catalog went away or came back (the spool): every console says so.
+  if (recorder_)
+    for (const auto& note : recorder_->catalogNotices(catalog_notices_)) s += note + "\n";
   for (auto it = runs_.begin(); it != runs_.end();) {
     const auto a = registry_.ack(it->robot_id, it->command_id);
     if (a && a->status() == v1::Ack::COMPLETED) {

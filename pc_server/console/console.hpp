@@ -124,6 +124,7 @@ class Console {
   /// Enables record/runs/run (null: the server records nothing).
   void setRecorder(Recorder* r) {
     recorder_ = r;
+    catalog_notices_ = 0;
     service_->setRunContext(recorder_, site_maps_);
   }
   Recorder* recorder() const { return recorder_; }
@@ -260,6 +261,7 @@ class Console {
   VideoHub* video_ = nullptr;
   std::string drive_robot_;  // the robot this session's last accepted `drive` went to
   Recorder* recorder_ = nullptr;
+  uint64_t catalog_notices_ = 0;  // the recorder's catalog notices printed so far
   std::function<std::string()> foxglove_report_;
   scene::SiteMaps* site_maps_ = nullptr;
   bool alarm_style_ = false;

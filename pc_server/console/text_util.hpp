@@ -19,6 +19,8 @@ inline constexpr const char* kUnknown = "unknown";
 using util::fmtFixed;
 using util::fmtShort;
 using util::fmtSigned;
+using util::padLeft;
+using util::padRight;
 using util::parseInteger;
 using util::parseNumber;
 using util::splitKeyValue;

@@ -86,6 +86,11 @@ Recorder::Recorder(const RecordingConfig& config, std::string software_version)
   const std::string target = config_.catalog.empty() ? config_.dir + "/catalog.sqlite" : config_.catalog;
   catalog_ = std::make_unique<catalog::Catalog>(catalog::Catalog::open(target));
   catalog_->setServerId(config_.server_id);
+  spool_ = std::make_unique<catalog::CatalogSpool>(*catalog_, config_.dir + "/catalog-spool.sqlite");
+  // What a server stopped during an outage kept goes in first (its runs' ends included).
+  if (!spool_->flush(std::chrono::seconds(10)))
+    log::warn(log::tag::kRecord, spool_->status().pending, " writes kept in ", spool_->path(),
+              " are not in the catalog yet: ", spool_->status().error);
   const auto incomplete = catalog_->markIncompleteRuns();  // this server's only
   for (const auto& id : incomplete) {
     const auto detail = catalog_->run(id);
@@ -99,13 +104,13 @@ Recorder::Recorder(const RecordingConfig& config, std::string software_version)
           what += r.was_complete ? ", MCAP complete"
                                  : ", MCAP repaired (" + std::to_string(r.messages_kept) + " messages kept, " +
                                        std::to_string(r.bytes_dropped) + " bytes of an unfinished chunk dropped)";
-          catalog_->addFile(id, "mcap", mcap, fileBytes(mcap));
+          spool_->addFile(id, "mcap", mcap, fileBytes(mcap));
         }
       } catch (const std::exception& e) {
         what += std::string(", MCAP not repaired: ") + e.what();
       }
       const std::string mp4 = dir + "/video.mp4";
-      if (fs::exists(mp4)) catalog_->addFile(id, "video", mp4, fileBytes(mp4));
+      if (fs::exists(mp4)) spool_->addFile(id, "video", mp4, fileBytes(mp4));
     }
     log::warn(log::tag::kRecord, what);
     startup_report_ += (startup_report_.empty() ? "" : "; ") + what;
@@ -143,7 +148,7 @@ void Recorder::setRunMap(const std::string& robot, const std::string& map_path) 
   }
   if (auto it = runs_.find(robot); it != runs_.end()) {
     try {
-      catalog_->addFile(it->second->info.id, "map", map_path, fileBytes(map_path));
+      spool_->addFile(it->second->info.id, "map", map_path, fileBytes(map_path));
     } catch (const std::exception& e) {
       log::error(log::tag::kRecord, robot, ": run map not in the catalog: ", e.what());
     }
@@ -159,7 +164,7 @@ void Recorder::noteAlarmAck(const std::string& robot, const v1::GasAlarm& a, con
   const std::string run_id = it == runs_.end() ? "" : it->second->info.id;
   try {
     if (it != runs_.end()) noteLocked(*it->second, robot, text);
-    catalog_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), v1::GasAlarm::Level_Name(a.level()),
+    spool_->addAlarm(run_id, robot, std::chrono::system_clock::now(), a.channel_name(), v1::GasAlarm::Level_Name(a.level()),
                        "acked", a.value(), a.pose().x_m(), a.pose().y_m());
   } catch (const std::exception& e) {
     log::error(log::tag::kRecord, robot, ": alarm acknowledgement not recorded: ", e.what());
@@ -200,8 +205,11 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
   // Chunks closed by 0.8 s of log time (ticks every 0.2 s): a kill loses at most 1 s.
   mo.chunk_max_age_ns = 800'000'000;
   auto run = std::make_unique<Run>(mo);
-  run->info = catalog_->startRun(rs);
-  run->info.dir = config_.dir + "/" + run->info.id;
+  rs.start = std::chrono::system_clock::now();
+  rs.id = newRunId(robot, *rs.start);
+  spool_->startRun(rs);
+  run->info = catalog::RunInfo{0, rs.id, robot, name, route, rs.gains_json, software_version_,
+                               config_.dir + "/" + rs.id, *rs.start, {}, {}, catalog_->serverId()};
   try {
     fs::create_directories(run->info.dir);
     run->mcap.open(run->info.dir + "/run.mcap");
@@ -226,7 +234,7 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
     ms.max_fragment_s = config_.max_fragment_s;
     run->mp4 = std::make_unique<video::Mp4Writer>(run->info.dir + "/video.mp4", ms);
   } catch (const std::exception& e) {
-    catalog_->endRun(run->info.id, "failed", std::chrono::system_clock::now());
+    spool_->endRun(run->info.id, "failed", std::chrono::system_clock::now());
     throw std::runtime_error("run " + run->info.id + ": " + e.what());
   }
   run->command_id = command_id;
@@ -235,9 +243,9 @@ std::string Recorder::startLocked(const std::string& robot, const std::string& n
   if (!run->gains.is_object()) run->gains = nlohmann::json::object();
   const std::string id = run->info.id;
   noteLocked(*run, robot, "run " + id + " started" + (name.empty() ? "" : " (" + name + ")"));
-  catalog_->addFile(id, "mcap", run->info.dir + "/run.mcap", 0);
+  spool_->addFile(id, "mcap", run->info.dir + "/run.mcap", 0);
   if (auto pm = pending_map_.find(robot); pm != pending_map_.end()) {
-    catalog_->addFile(id, "map", pm->second, fileBytes(pm->second));
+    spool_->addFile(id, "map", pm->second, fileBytes(pm->second));
     pending_map_.erase(pm);
   }
   // The robot as it announced itself (gas channels and units), for reports and tools.
@@ -289,11 +297,15 @@ std::string Recorder::stopLocked(const std::string& robot, const std::string& ou
     s.gas.push_back({named ? hello->second.gas_channels(static_cast<int>(g.channel)).name() : "gas" + std::to_string(g.channel),
                      named ? hello->second.gas_channels(static_cast<int>(g.channel)).unit() : "", g.max, g.mean});
   }
-  catalog_->setSummary(r.info.id, s);
-  catalog_->addFile(r.info.id, "mcap", r.info.dir + "/run.mcap", fileBytes(r.info.dir + "/run.mcap"));
+  spool_->setSummary(r.info.id, s);
+  spool_->addFile(r.info.id, "mcap", r.info.dir + "/run.mcap", fileBytes(r.info.dir + "/run.mcap"));
   if (r.mp4)
-    for (const auto& f : r.mp4->files()) catalog_->addFile(r.info.id, "video", f, fileBytes(f));
-  catalog_->endRun(r.info.id, outcome, std::chrono::system_clock::now());
+    for (const auto& f : r.mp4->files()) spool_->addFile(r.info.id, "video", f, fileBytes(f));
+  const auto end = std::chrono::system_clock::now();
+  spool_->endRun(r.info.id, outcome, end);
+  auto& ended = ended_[robot];
+  ended.push_back({r.info.id, r.info.start, end});
+  if (ended.size() > 20) ended.erase(ended.begin());
   log::info(log::tag::kRecord, robot, ": run ", r.info.id, " ended (", outcome, "): ", r.mcap.stats().messages, " messages, ",
             r.video_frames, " video frames");
   return r.info.id;
@@ -307,10 +319,10 @@ void Recorder::noteLocked(Run& r, const std::string& robot, const std::string& t
   e.set_robot_time_us(monoNowUs());
   const uint64_t t = wall_ns ? wall_ns : wallNowNs();
   r.mcap.write(r.ch_server, t, t, e);
-  catalog_->addEvent(r.info.id, robot,
-                     std::chrono::system_clock::time_point(
-                         std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::nanoseconds(t))),
-                     kind, text);
+  spool_->addEvent(r.info.id, robot,
+                   std::chrono::system_clock::time_point(
+                       std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::nanoseconds(t))),
+                   kind, text);
 }
 
 void Recorder::autoStartLocked(const std::string& robot, const v1::Command& c) {
@@ -334,7 +346,7 @@ void Recorder::catalogAlarmLocked(const std::string& robot, const v1::Envelope& 
   if (inbound && env.has_event() && env.event().has_gas_alarm()) {
     const auto& a = env.event().gas_alarm();
     try {
-      catalog_->addAlarm(run_id, robot, when, a.channel_name(), v1::GasAlarm::Level_Name(a.level()),
+      spool_->addAlarm(run_id, robot, when, a.channel_name(), v1::GasAlarm::Level_Name(a.level()),
                          a.active() ? "raised" : "cleared", a.value(), a.pose().x_m(), a.pose().y_m());
     } catch (const std::exception& e) {
       log::error(log::tag::kRecord, robot, ": alarm not in the catalog: ", e.what());
@@ -360,7 +372,7 @@ void Recorder::recordTelemetryLocked(Run& r, const std::string& robot, const v1:
     if (from_t.is_object())
       for (const auto& [k, v] : from_t.items())
         if (!r.gains.contains(k)) r.gains[k] = v;
-    catalog_->setGains(r.info.id, r.gains.dump());
+    spool_->setGains(r.info.id, r.gains.dump());
     r.gains_known = true;
   }
   r.mcap.write(r.ch_telemetry, log_ns, env.send_time_us() * 1000, t);
@@ -384,9 +396,9 @@ void Recorder::recordEventLocked(Run& r, const std::string& robot, const v1::Env
     r.gains = nlohmann::json::parse(runGainsJson(e.gains(), e.gains_version()));
     if (!controller.empty()) r.gains["controller"] = controller;
     r.gains["changes_in_run"] = changes;
-    catalog_->setGains(r.info.id, r.gains.dump());
+    spool_->setGains(r.info.id, r.gains.dump());
   }
-  catalog_->addEvent(r.info.id, robot, when, v1::Event::Kind_Name(e.kind()), e.text());
+  spool_->addEvent(r.info.id, robot, when, v1::Event::Kind_Name(e.kind()), e.text());
 }
 
 void Recorder::onEnvelope(const std::string& robot, const std::string& address, const v1::Envelope& env,
@@ -411,7 +423,7 @@ void Recorder::onEnvelope(const std::string& robot, const std::string& address, 
   if (!in_open_run) {
     if (inbound && env.has_event() && !run_id.empty()) {
       try {
-        catalog_->addEvent(run_id, robot, when, v1::Event::Kind_Name(env.event().kind()),
+        spool_->addEvent(run_id, robot, when, v1::Event::Kind_Name(env.event().kind()),
                            env.event().text() + " (stored by the robot; filed after the run's recording closed)");
       } catch (const std::exception& e) {
         log::error(log::tag::kRecord, robot, ": event not in the catalog: ", e.what());
@@ -454,7 +466,13 @@ bool Recorder::isLate(const v1::Envelope& env) {
 }
 
 std::string Recorder::runAt(const std::string& robot, catalog::Time t) {
+  if (const auto it = ended_.find(robot); it != ended_.end())
+    for (auto r = it->second.rbegin(); r != it->second.rend(); ++r)
+      if (r->start <= t && t <= r->end) return r->id;
+  // A run of an earlier process: the catalog, unless it is away (the link's thread never waits for it).
+  if (!spool_->status().reachable) return "";
   try {
+    spool_->flush(std::chrono::seconds(2));
     catalog::RunFilter f;
     f.robot = robot;
     f.limit = 20;
@@ -464,6 +482,23 @@ std::string Recorder::runAt(const std::string& robot, catalog::Time t) {
     log::error(log::tag::kRecord, robot, ": catalog: ", e.what());
   }
   return "";
+}
+
+std::string Recorder::newRunId(const std::string& robot, catalog::Time start) const {
+  const std::string base = catalog::runIdBase(robot, start);
+  std::string id = base;
+  for (int n = 2; fs::exists(config_.dir + "/" + id); ++n) id = base + "-" + std::to_string(n);
+  return id;
+}
+
+void Recorder::notePresence(const catalog::ServerInfo& server, const std::vector<catalog::RobotPresence>& robots) {
+  spool_->upsertServer(server);
+  for (const auto& p : robots) spool_->setPresence(p);
+}
+
+catalog::Catalog& Recorder::catalog() {
+  if (spool_->status().reachable) spool_->flush(std::chrono::seconds(5));
+  return *catalog_;
 }
 
 void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us) {

@@ -6,7 +6,9 @@
 // re-encode), listed in <dir>/catalog.sqlite with its summary figures.
 // A run survives robot reconnects (marked in the log). At start-up, runs a
 // killed server left open are marked incomplete and their MCAP files repaired.
-// Thread-safe.
+// The catalog's writes go through a local spool (<dir>/catalog-spool.sqlite,
+// shared/catalog/catalog_spool.hpp): recording never waits for the catalog,
+// and goes on while a shared catalog is away. Thread-safe.
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -23,6 +25,7 @@
 #include "pc_server/scene/site_maps.hpp"
 #include "pc_server/recording/recording_config.hpp"
 #include "shared/catalog/catalog.hpp"
+#include "shared/catalog/catalog_spool.hpp"
 #include "shared/video/rtp_h264.hpp"
 
 namespace inspect::server {
@@ -79,7 +82,16 @@ class Recorder {
   /// The operator acknowledged a gas alarm: /server_event and the catalog's alarms.
   void noteAlarmAck(const std::string& robot, const v1::GasAlarm& alarm, const std::string& text);
 
-  catalog::Catalog& catalog() { return *catalog_; }
+  /// The catalog to read, with every write queued so far in it (waits up to
+  /// 5 s for the spool, not at all while the catalog is away).
+  catalog::Catalog& catalog();
+  /// The spool's state: reachable, writes kept, written, dropped.
+  catalog::SpoolStatus catalogStatus() const { return spool_->status(); }
+  /// This server's row and its robots' presence in a shared catalog
+  /// (fleet_presence.hpp): written when the catalog is there, latest only.
+  void notePresence(const catalog::ServerInfo& server, const std::vector<catalog::RobotPresence>& robots);
+  /// The catalog's notices after `cursor` (away, back, a refused write); advances it.
+  std::vector<std::string> catalogNotices(uint64_t& cursor) const { return spool_->noticesSince(cursor); }
   const RecordingConfig& config() const { return config_; }
   /// What start-up found: "2 runs marked incomplete (…), MCAP repaired: …".
   const std::string& startupReport() const { return startup_report_; }
@@ -104,14 +116,23 @@ class Recorder {
                          uint64_t log_ns, catalog::Time when);
   /// A stored event or ack the robot sent late (store-and-forward).
   static bool isLate(const v1::Envelope& env);
-  /// The id of the robot's run recording at `t` (catalog), "" = none.
+  /// The id of the robot's run recording at `t` (runs this process ended,
+  /// else the catalog), "" = none.
   std::string runAt(const std::string& robot, catalog::Time t);
+  /// A run id not used yet: runIdBase, with "-2", "-3"... when its directory exists.
+  std::string newRunId(const std::string& robot, catalog::Time start) const;
   /// Telemetry absent this long within a run is marked as a gap.
   static constexpr uint64_t kTelemetryGapNs = 1'000'000'000;
 
   RecordingConfig config_;
   std::string software_version_;
   std::unique_ptr<catalog::Catalog> catalog_;
+  std::unique_ptr<catalog::CatalogSpool> spool_;  // every write to catalog_ (destroyed first)
+  struct RunSpan {
+    std::string id;
+    catalog::Time start, end;
+  };
+  std::map<std::string, std::vector<RunSpan>> ended_;  // robot -> its latest runs ended here, newest last
   std::string startup_report_;
   std::function<std::optional<VideoFigures>(const std::string&)> video_figures_;
   std::function<std::string(const std::string&)> gains_source_;

@@ -9,6 +9,9 @@
 namespace inspect::catalog {
 
 void failCatalog(const std::string& where, const std::string& what) { throw CatalogError("catalog " + where + ": " + what); }
+void failUnavailable(const std::string& where, const std::string& what) {
+  throw CatalogUnavailable("catalog " + where + ": " + what);
+}
 
 namespace {
 
@@ -37,10 +40,9 @@ bool isOutcome(std::string_view s) {
 
 }  // namespace
 
-// ---------------------------------------------------------------------------
-
-
-// ---------------------------------------------------------------------------
+std::string runIdBase(const std::string& robot, Time start) {
+  return strftimeUtc(start, "%Y%m%d-%H%M%S-") + sanitizeRobotId(robot);
+}
 
 Catalog::Catalog(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Catalog::Catalog(Catalog&&) noexcept = default;
@@ -80,7 +82,7 @@ RunInfo Catalog::startRun(const RunStart& r) {
   impl_->query(INSERT_ROBOT "NOTHING")
       .bind(r.robot, r.software_version, start)
       .run();
-  const std::string base = strftimeUtc(start, "%Y%m%d-%H%M%S-") + sanitizeRobotId(r.robot);
+  const std::string base = r.id.empty() ? runIdBase(r.robot, start) : r.id;
   std::string id;
   int64_t rowid = 0;
   for (int n = 1;; ++n) {
@@ -99,6 +101,17 @@ RunInfo Catalog::startRun(const RunStart& r) {
     if (q.step()) {
       rowid = q.column<int64_t>(0);
       break;
+    }
+    if (!r.id.empty()) {
+      // The id was given: the same run written again (a spool's replay) is that row.
+      auto old = impl_->findRun(id);
+      if (old && old->robot == r.robot && old->server == impl_->server_id &&
+          std::abs(unixSeconds(old->start) - unixSeconds(start)) < 1e-3) {
+        tx.commit();
+        return *old;
+      }
+      impl_->failPlain("run id '" + id + "' is taken by another run" +
+                       (old && !old->server.empty() ? " (server " + old->server + ")" : ""));
     }
   }
   tx.commit();

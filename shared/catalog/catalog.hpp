@@ -5,11 +5,12 @@
 // the same schema, migrations and queries on both (sql_backend.hpp). Schema
 // and example queries: docs/catalog.md.
 //
-// One connection per Catalog, every call under a mutex: the server may call
-// from several threads. Each write is its own transaction, so what a call has
+// One connection per Catalog, every call under a (recursive) mutex: the
+// server may call from several threads, and applySpooled's writes call back. Each write is its own transaction, so what a call has
 // written survives a kill of the process (SQLite: WAL, synchronous=NORMAL).
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -29,6 +30,13 @@ class CatalogError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The catalog cannot be reached (PostgreSQL down, the connection lost):
+/// the write may succeed later, unlike a CatalogError about the write itself.
+class CatalogUnavailable : public CatalogError {
+ public:
+  using CatalogError::CatalogError;
+};
+
 /// How a run ended. "incomplete": the server stopped without ending it.
 inline constexpr std::string_view kOutcomes[] = {"completed", "stopped", "failed", "incomplete"};
 
@@ -40,6 +48,9 @@ struct RunStart {
   std::string software_version;
   std::string dir;               // where the run's files go
   std::optional<Time> start;     // default: now
+  /// "" = the catalog picks runIdBase() with "-2", "-3"... when taken. Set:
+  /// this id (a spooled start written again is the same run, not an error).
+  std::string id;
 };
 
 struct RunInfo {
@@ -144,6 +155,10 @@ struct GainsPush {
 /// number applied. Append only: a released migration is never edited.
 std::span<const std::string_view> schemaMigrations();
 
+/// A run's id before any suffix: "<UTC start yyyymmdd-hhmmss>-<robot>"
+/// (characters of the robot id outside [A-Za-z0-9_.-] become '_').
+std::string runIdBase(const std::string& robot, Time start);
+
 /// "2026-11-22T08:30:15.123Z" (UTC, milliseconds).
 std::string formatIsoUtc(Time t);
 /// Reads "YYYY-MM-DD", "YYYY-MM-DD[T ]HH:MM[:SS[.fff]][Z]" as UTC; none if malformed.
@@ -186,8 +201,9 @@ class Catalog {
   /// Adds the robot or updates its software version and last_seen.
   void upsertRobot(const std::string& robot, const std::string& software_version, Time now);
 
-  /// A new run, id "<UTC start yyyymmdd-hhmmss>-<robot>" with "-2", "-3"...
-  /// when taken (characters of the robot id outside [A-Za-z0-9_.-] become '_').
+  /// A new run, id runIdBase() with "-2", "-3"... when taken, or r.id. With
+  /// r.id: the row of that id when it is this server's run of the robot
+  /// started at r.start (written before); throws when another run has it.
   RunInfo startRun(const RunStart& r);
   /// Ends a running run. False if it had already ended (unchanged); throws for
   /// an unknown run or outcome.
@@ -229,6 +245,15 @@ class Catalog {
 
   /// "ok", or the engine's messages one per line.
   std::string integrityCheck();
+
+  /// Writes of a local spool (CatalogSpool) exactly once: in one transaction,
+  /// calls `write(i)` for each seqs[i] (ascending) the catalog has not yet
+  /// applied for `spool_id`, and records the last seq as applied. Returns how
+  /// many it ran (0: all written before). A throw from `write` rolls all back.
+  int64_t applySpooled(const std::string& spool_id, std::span<const int64_t> seqs,
+                       const std::function<void(std::size_t i)>& write);
+  /// The last seq applied for the spool (0: none).
+  int64_t spoolApplied(const std::string& spool_id);
 
  private:
   struct Impl;

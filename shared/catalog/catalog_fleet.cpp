@@ -63,4 +63,33 @@ std::vector<RobotPresence> Catalog::listPresence() {
   return out;
 }
 
+int64_t Catalog::applySpooled(const std::string& spool_id, std::span<const int64_t> seqs,
+                              const std::function<void(std::size_t)>& write) {
+  if (seqs.empty()) return 0;
+  std::lock_guard lk(impl_->mu);
+  Impl::Tx tx(*impl_);
+  const int64_t applied = spoolApplied(spool_id);
+  int64_t ran = 0;
+  for (std::size_t i = 0; i < seqs.size(); ++i) {
+    if (seqs[i] <= applied) continue;  // written before (the spool did not hear the commit)
+    write(i);
+    ++ran;
+  }
+  const int64_t last = seqs.back();
+  if (last > applied)
+    impl_->query("INSERT INTO spool_applied (spool_id, server_id, seq, time, time_unix) VALUES (?, ?, ?, ?, ?)"
+                 " ON CONFLICT (spool_id) DO UPDATE SET seq = excluded.seq, time = excluded.time,"
+                 " time_unix = excluded.time_unix")
+        .bind(spool_id, impl_->server_id, last, std::chrono::system_clock::now())
+        .run();
+  tx.commit();
+  return ran;
+}
+
+int64_t Catalog::spoolApplied(const std::string& spool_id) {
+  std::lock_guard lk(impl_->mu);
+  auto q = impl_->query("SELECT seq FROM spool_applied WHERE spool_id = ?");
+  return q.bind(spool_id).step() ? q.column<int64_t>(0) : 0;
+}
+
 }  // namespace inspect::catalog

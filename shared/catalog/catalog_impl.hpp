@@ -51,7 +51,8 @@ inline std::optional<std::string_view> nullIfEmpty(const std::string& s) {
 
 struct Catalog::Impl {
   std::unique_ptr<SqlBackend> db;
-  std::mutex mu;
+  std::recursive_mutex mu;
+  int tx_depth = 0;  // Tx objects alive: only the outermost begins and commits
   std::string server_id;
   bool fleet = true;  // the schema has version 5's server columns (false only when opened older, in tests)
 
@@ -165,22 +166,28 @@ struct Catalog::Impl {
   // `sql` must outlive the Catalog (a literal): it keys the prepared statements.
   Query query(std::string_view sql) { return Query(*this, sql); }
 
-  // A transaction rolled back unless committed.
+  // A transaction rolled back unless committed. Nested in another (a write
+  // of applySpooled), it is part of the outer one, which begins and commits.
   class Tx {
    public:
-    explicit Tx(Impl& impl, bool write = true) : impl_(impl) { impl_.db->begin(write); }
+    explicit Tx(Impl& impl, bool write = true) : impl_(impl), outer_(impl.tx_depth == 0) {
+      if (outer_) impl_.db->begin(write);
+      ++impl_.tx_depth;
+    }
     Tx(const Tx&) = delete;
     Tx& operator=(const Tx&) = delete;
     ~Tx() {
-      if (!done_) impl_.db->rollback();
+      --impl_.tx_depth;
+      if (outer_ && !done_) impl_.db->rollback();
     }
     void commit() {
-      impl_.db->commit();
+      if (outer_) impl_.db->commit();
       done_ = true;
     }
 
    private:
     Impl& impl_;
+    bool outer_;
     bool done_ = false;
   };
 

@@ -33,6 +33,20 @@ struct ConnFinish {
   void operator()(PGconn* c) const { PQfinish(c); }
 };
 
+// libpq waits for ever by default: a server gone from the network would
+// hold the catalog's writer (and a shutdown) until TCP gives up. Unless the
+// URL says otherwise: 10 s to connect, and a dead peer noticed in about 30 s.
+std::string withTimeouts(const std::string& url) {
+  std::string out = url;
+  for (const char* opt : {"connect_timeout=10", "keepalives_idle=15", "keepalives_interval=5", "keepalives_count=3"}) {
+    const std::string key = std::string(opt).substr(0, std::string(opt).find('=') + 1);
+    if (out.find(key) != std::string::npos) continue;
+    out += (out.find('?') == std::string::npos ? "?" : "&");
+    out += opt;
+  }
+  return out;
+}
+
 std::string firstLine(const char* msg) {
   std::string s = msg ? msg : "";
   if (const auto nl = s.find('\n'); nl != std::string::npos) s.resize(nl);
@@ -41,12 +55,12 @@ std::string firstLine(const char* msg) {
 
 class PostgresBackend final : public SqlBackend {
  public:
-  explicit PostgresBackend(const std::string& url) : url_(url), where_(redactUrl(url)) {}
+  explicit PostgresBackend(const std::string& url) : url_(withTimeouts(url)), where_(redactUrl(url)) {}
 
   void open(std::span<const std::string_view> migrations) {
     conn_.reset(PQconnectdb(url_.c_str()));
     if (!conn_ || PQstatus(conn_.get()) != CONNECTION_OK)
-      failPlain("cannot connect: " + firstLine(conn_ ? PQerrorMessage(conn_.get()) : "out of memory"));
+      failUnavailable(where_, "cannot connect: " + firstLine(conn_ ? PQerrorMessage(conn_.get()) : "out of memory"));
     PQsetNoticeProcessor(conn_.get(), [](void*, const char*) {}, nullptr);  // "already exists" notices
     migrate(migrations);
   }
@@ -136,7 +150,10 @@ class PostgresBackend final : public SqlBackend {
   void check(PGresult* r, const std::string& what) {
     const auto st = r ? PQresultStatus(r) : PGRES_FATAL_ERROR;
     if (st == PGRES_COMMAND_OK || st == PGRES_TUPLES_OK) return;
-    failPlain(what + ": " + firstLine(r ? PQresultErrorMessage(r) : PQerrorMessage(conn_.get())));
+    const std::string why = what + ": " + firstLine(r ? PQresultErrorMessage(r) : PQerrorMessage(conn_.get()));
+    // The connection gone (the server stopped, the network cut): a later try may work.
+    if (PQstatus(conn_.get()) != CONNECTION_OK) failUnavailable(where_, why);
+    failPlain(why);
   }
 
   void exec(const char* sql, const char* what) {
@@ -151,7 +168,7 @@ class PostgresBackend final : public SqlBackend {
     PQreset(conn_.get());
     prepared_.clear();
     if (PQstatus(conn_.get()) != CONNECTION_OK)
-      failPlain("connection lost: " + firstLine(PQerrorMessage(conn_.get())));
+      failUnavailable(where_, "connection lost: " + firstLine(PQerrorMessage(conn_.get())));
   }
 
   const std::string& prepare(std::string_view sql) {

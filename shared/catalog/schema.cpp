@@ -165,6 +165,17 @@ CREATE TABLE robot_presence (
   seen_unix REAL NOT NULL
 );
 )sql",
+    // 6: exactly-once writes from each server's local spool, kept while the
+    // catalog was away (CatalogSpool): the last write applied per spool.
+    R"sql(
+CREATE TABLE spool_applied (
+  spool_id  TEXT PRIMARY KEY,
+  server_id TEXT NOT NULL DEFAULT '',
+  seq       INTEGER NOT NULL,
+  time      TEXT NOT NULL,
+  time_unix REAL NOT NULL
+);
+)sql",
 };
 
 }  // namespace

@@ -47,6 +47,8 @@ class SqlBackend {
 
 /// Throws CatalogError "catalog <where>: <what>": every catalog error's form.
 [[noreturn]] void failCatalog(const std::string& where, const std::string& what);
+/// The same as CatalogUnavailable: the engine cannot be reached.
+[[noreturn]] void failUnavailable(const std::string& where, const std::string& what);
 
 /// True for "postgresql://..." and "postgres://..." (libpq's URLs).
 bool isPostgresUrl(std::string_view target);

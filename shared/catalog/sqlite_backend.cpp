@@ -107,7 +107,12 @@ class SqliteBackend final : public SqlBackend {
 
  private:
   [[noreturn]] void fail(const std::string& what) const {
-    failCatalog(path_, db_ ? what + ": " + sqlite3_errmsg(db_.get()) : what);
+    if (!db_) failCatalog(path_, what);
+    const std::string why = what + ": " + sqlite3_errmsg(db_.get());
+    // Another writer holding the file past the busy timeout: a later try may work.
+    const int rc = sqlite3_errcode(db_.get());
+    if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) failUnavailable(path_, why);
+    failCatalog(path_, why);
   }
   [[noreturn]] void failPlain(const std::string& what) const { failCatalog(path_, what); }
 

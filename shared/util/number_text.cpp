@@ -44,4 +44,14 @@ std::string shortest(double v) {
 
 std::string fmtPoint(double x_m, double y_m) { return "(" + fmtFixed(x_m) + ", " + fmtFixed(y_m) + ")"; }
 
+std::string padRight(std::string s, std::size_t width) {
+  if (s.size() < width) s.append(width - s.size(), ' ');
+  return s;
+}
+
+std::string padLeft(std::string s, std::size_t width) {
+  if (s.size() < width) s.insert(0, width - s.size(), ' ');
+  return s;
+}
+
 }  // namespace inspect::util

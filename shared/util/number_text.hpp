@@ -1,6 +1,8 @@
 #pragma once
 // Numbers in messages, tables and reports: the one home of the project's
-// number formatting (the console, the tuning host, the robot's events).
+// number formatting (the console, the tuning host, the robot's events), and
+// table cells.
+#include <cstddef>
 #include <string>
 
 namespace inspect::util {
@@ -17,5 +19,8 @@ std::string significant(double v, int digits);
 std::string shortest(double v);
 /// A point in metres for messages: "(1.25, -0.50)".
 std::string fmtPoint(double x_m, double y_m);
+/// A table's cell: `s` padded with blanks to `width` on the right (text) or the left (numbers).
+std::string padRight(std::string s, std::size_t width);
+std::string padLeft(std::string s, std::size_t width);
 
 }  // namespace inspect::util

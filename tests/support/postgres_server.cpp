@@ -24,6 +24,13 @@ std::string readLine(const std::string& path) {
 
 std::string ownFile;  // the file of a server this process started ("" = the fixture's)
 
+void cluster(const std::string& command, const std::string& file) {
+  const std::string cmd =
+      "bash '" + srcPath("tests/support/pg_cluster.sh") + "' " + command + " '" + file + "' >/dev/null";
+  if (std::system(cmd.c_str()) != 0)
+    throw std::runtime_error("pg_cluster.sh " + command + " " + file + " failed");
+}
+
 void stopOwn() {
   if (ownFile.empty()) return;
   const std::string cmd = "bash '" + srcPath("tests/support/pg_cluster.sh") + "' stop '" + ownFile + "' >/dev/null 2>&1";
@@ -32,9 +39,7 @@ void stopOwn() {
 
 std::string startOwn() {
   ownFile = "/tmp/inspect-pg-own-" + std::to_string(::getpid());
-  const std::string cmd =
-      "bash '" + srcPath("tests/support/pg_cluster.sh") + "' start '" + ownFile + "' >/dev/null";
-  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("cannot start a PostgreSQL server (pg_cluster.sh start)");
+  cluster("start", ownFile);
   std::atexit(stopOwn);
   return readLine(ownFile);
 }
@@ -84,5 +89,26 @@ std::string freshPostgresDatabase(const std::string& tag) {
   if (!r.empty()) throw std::runtime_error("cannot create database " + name + ": " + r.front());
   return postgresUrl(name);
 }
+
+OwnPostgres::OwnPostgres() {
+  static std::atomic<int> counter{0};
+  file_ = "/tmp/inspect-pg-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  cluster("start", file_);
+  dir_ = readLine(file_);
+}
+
+OwnPostgres::~OwnPostgres() {
+  try {
+    cluster("stop", file_);
+  } catch (const std::exception&) {  // nothing more to do in a destructor
+  }
+}
+
+std::string OwnPostgres::url(const std::string& db) const {
+  return "postgresql:///" + db + "?host=" + dir_ + "&user=inspect";
+}
+
+void OwnPostgres::halt() { cluster("halt", file_); }
+void OwnPostgres::resume() { cluster("resume", file_); }
 
 }  // namespace inspect::test

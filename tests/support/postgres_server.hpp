@@ -20,4 +20,22 @@ std::string freshPostgresDatabase(const std::string& tag);
 /// ("error: ..." when it fails).
 std::vector<std::string> postgresQuery(const std::string& url, const std::string& sql);
 
+/// A PostgreSQL server of one test's own, for a test that stops it (an
+/// outage): the suite's shared server stays up for the other tests.
+class OwnPostgres {
+ public:
+  OwnPostgres();   // starts it (1-4 s); throws std::runtime_error
+  ~OwnPostgres();  // stops it and removes its directory
+  OwnPostgres(const OwnPostgres&) = delete;
+  OwnPostgres& operator=(const OwnPostgres&) = delete;
+  /// A URL of database `db` on it.
+  std::string url(const std::string& db = "postgres") const;
+  /// Stops the server, keeping its data (pg_ctl stop -m fast), and starts it again.
+  void halt();
+  void resume();
+
+ private:
+  std::string file_, dir_;
+};
+
 }  // namespace inspect::test

@@ -23,6 +23,7 @@
 #include "shared/catalog/catalog.hpp"
 #include "shared/catalog/sql_backend.hpp"
 #include "tests/support/postgres_server.hpp"
+#include "tests/support/sql_query.hpp"
 
 using namespace inspect::catalog;
 namespace fs = std::filesystem;
@@ -44,26 +45,7 @@ RunStart runOf(const std::string& robot, const std::string& name, Time start) {
   return r;
 }
 
-// First column of every row of `sql`, through SQLite or libpq directly (not the Catalog).
-std::vector<std::string> rawQuery(const std::string& path, const std::string& sql) {
-  if (isPostgresUrl(path)) return inspect::test::postgresQuery(path, sql);
-  sqlite3* db = nullptr;
-  std::vector<std::string> rows;
-  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr) == SQLITE_OK) {
-    sqlite3_stmt* s = nullptr;
-    if (sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) == SQLITE_OK) {
-      while (sqlite3_step(s) == SQLITE_ROW) {
-        const auto* t = reinterpret_cast<const char*>(sqlite3_column_text(s, 0));
-        rows.emplace_back(t ? t : "");
-      }
-    } else {
-      rows.push_back(std::string("error: ") + sqlite3_errmsg(db));
-    }
-    sqlite3_finalize(s);
-  }
-  sqlite3_close(db);
-  return rows;
-}
+using inspect::test::rawQuery;
 
 // The CatalogError message of `f`, "" if it does not throw one.
 template <class F>
@@ -124,7 +106,7 @@ TEST_F(SqliteCatalogTest, CreatesWalDatabaseAtLatestVersion) {
   EXPECT_EQ(rawQuery(path_, "SELECT name FROM sqlite_master WHERE type IN ('table', 'view') ORDER BY name"),
             (std::vector<std::string>{"alarms", "events", "gains_pushes", "robot_presence", "robots", "run_files",
                                       "run_gas", "run_overview", "run_summary", "runs", "servers",
-                                      "tuning_sessions"}));
+                                      "spool_applied", "tuning_sessions"}));
 }
 
 TEST_P(CatalogTest, ReopeningKeepsDataAndVersion) {
