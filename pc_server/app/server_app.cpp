@@ -11,6 +11,8 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -31,6 +33,7 @@
 #include "shared/catalog/sql_backend.hpp"
 #include "shared/util/startup_error.hpp"
 #include "pc_server/app/stop_flag.hpp"
+#include "pc_server/recording/fleet_presence.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/video/video_hub.hpp"
 #include "pc_server/video/video_stats_proto.hpp"
@@ -68,12 +71,18 @@ static std::string localUserName() {
   return "operator";
 }
 
+static std::string hostName() {
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0) return "";
+  return host;
+}
+
 std::string catalogServerId(const ServerConfig& c) {
   if (!catalog::isPostgresUrl(c.recording.catalog)) return "";  // one server's file
   if (c.server_id != LinkConfig{}.server_id) return c.server_id;
-  char host[256] = {};  // the default name: every server would share it, so the host's name instead
-  if (::gethostname(host, sizeof host - 1) != 0 || host[0] == '\0') return c.server_id;
-  return host;
+  // The default name: every server would share it, so the host's name instead.
+  const std::string host = hostName();
+  return host.empty() ? c.server_id : host;
 }
 
 ServerConfig resolveConfig(const CliOptions& options) {
@@ -267,6 +276,53 @@ void tickRecorder(asio::steady_timer& timer, Recorder& recorder) {
   });
 }
 
+/// In a shared catalog: this server's row and its robots' presence every
+/// kPresencePeriod (fleet_presence.hpp); `robots --fleet` reads them.
+struct PresenceTicker {
+  PresenceTicker(asio::io_context& ioc, Recorder& r, RobotRegistry& reg, catalog::ServerInfo i)
+      : timer(ioc), recorder(r), registry(reg), info(std::move(i)) {}
+  asio::steady_timer timer;
+  Recorder& recorder;
+  RobotRegistry& registry;
+  std::mutex mu;  // the timer's handler and the last write at shutdown may run on two io threads
+  catalog::ServerInfo info;
+
+  void write() {
+    std::lock_guard lk(mu);
+    info.seen = std::chrono::system_clock::now();
+    recorder.notePresence(info, presenceOf(registry.snapshots(monoNowNs()), info.id, info.seen));
+  }
+  void tick() {
+    write();
+    timer.expires_after(kPresencePeriod);
+    timer.async_wait([this](const boost::system::error_code& ec) {
+      if (!ec) tick();
+    });
+  }
+};
+
+/// The ticker of a server sharing its catalog (none with a SQLite file). Where an
+/// operator attaches: the Foxglove WebSocket, else the robots' link port.
+std::unique_ptr<PresenceTicker> startPresence(asio::io_context& ioc, const ServerConfig& config, Recorder* recorder,
+                                              RobotRegistry& registry, uint16_t link_port,
+                                              std::optional<uint16_t> foxglove_port) {
+  if (!recorder || config.recording.server_id.empty()) return nullptr;
+  catalog::ServerInfo info;
+  info.id = config.recording.server_id;
+  const std::string host = hostName().empty() ? "localhost" : hostName();
+  info.attach = foxglove_port ? std::string(config.foxglove.tls ? "wss://" : "ws://") + host + ":" +
+                                    std::to_string(*foxglove_port)
+                              : host + ":" + std::to_string(link_port);
+  std::error_code ec;
+  const auto root = std::filesystem::absolute(config.recording.dir, ec);
+  info.runs_root = ec ? config.recording.dir : root.string();
+  info.software_version = INSPECT_VERSION;
+  info.started = std::chrono::system_clock::now();
+  auto t = std::make_unique<PresenceTicker>(ioc, *recorder, registry, std::move(info));
+  t->tick();
+  return t;
+}
+
 /// The server's own console (by its mode) and the attached ones, until the
 /// operator quits or the server is stopped; the exit status (1: the script or stream failed).
 int runConsoles(ConsoleMode mode, const std::vector<std::string>& script, const CliOptions& options,
@@ -362,6 +418,7 @@ int runServer(const CliOptions& options) {
                      (recorder ? recorder->config().dir : config.recording.dir) + "/tuning");
   };
   std::unique_ptr<foxglove::FoxgloveBridge> bridge;
+  std::optional<uint16_t> foxglove_port;
   if (config.foxglove.enabled) {
     auto fo = bridgeOptions(config, copt, video.get());
     fo.recorder = recorder.get();
@@ -370,7 +427,9 @@ int runServer(const CliOptions& options) {
     const auto ep = bridge->start();  // a failure here leaves no pointer to a destroyed bridge
     bridge_ptr = bridge.get();
     announceBridge(config, options, ep.port());
+    foxglove_port = ep.port();
   }
+  auto presence = startPresence(ioc, config, recorder.get(), registry, endpoint.port(), foxglove_port);
 
   StopFlag stop;
   asio::signal_set signals(ioc, SIGINT, SIGTERM);
@@ -389,10 +448,14 @@ int runServer(const CliOptions& options) {
   log::info(log::tag::kServer, "stopping: closing robot sessions");
   link.stop();
   if (!link.waitAllClosed(std::chrono::seconds(1))) log::warn(log::tag::kServer, "some sessions did not close within 1 s");
-  asio::post(ioc, [&signals, &record_timer] {
+  asio::post(ioc, [&signals, &record_timer, &presence] {
     boost::system::error_code ignored;
     signals.cancel(ignored);
     record_timer.cancel();
+    if (presence) {
+      presence->timer.cancel();
+      presence->write();  // the robots' links are closed: the fleet sees them offline
+    }
   });
   if (video) video->stop();
   work.reset();

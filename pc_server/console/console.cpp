@@ -13,6 +13,7 @@
 #include "pc_server/operator/route_file.hpp"
 #include "pc_server/console/status_line.hpp"
 #include "pc_server/console/text_util.hpp"
+#include "pc_server/recording/fleet_presence.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/video/video_hub.hpp"
 #include "shared/config/config_node.hpp"
@@ -82,7 +83,16 @@ bool Console::execute(const std::string& raw_line, int line_no) {
   if (auto* why = std::get_if<std::string>(&parsed)) return fail(c->name, *why);
   auto& args = std::get<CommandArgs>(parsed);
   args.line_no = line_no;
-  const bool ok = (this->*(c->run))(args);
+  bool ok = false;
+  try {
+    ok = (this->*(c->run))(args);
+  } catch (const catalog::CatalogUnavailable& e) {  // runs, run, report... while a shared catalog is away
+    const auto st = recorder_ ? recorder_->catalogStatus() : catalog::SpoolStatus{};
+    ok = fail(c->name, std::string(e.what()) + " (recording goes on; " + std::to_string(st.pending) +
+                           " catalog writes kept until it is back)");
+  } catch (const std::exception& e) {
+    ok = fail(c->name, e.what());
+  }
   out_.flush();
   return ok;
 }
@@ -236,7 +246,16 @@ bool Console::cmdHelp(const CommandArgs& a) {
   return true;
 }
 
-bool Console::cmdRobots(const CommandArgs&) {
+bool Console::cmdRobots(const CommandArgs& a) {
+  if (a.has("--fleet")) {
+    if (!recorder_) return fail("robots", "--fleet reads the catalog, and this server records nothing (--no-record)");
+    auto& cat = recorder_->catalog();
+    if (cat.serverId().empty())
+      return fail("robots", "--fleet needs a catalog that several servers share (--catalog postgresql://...); "
+                            "this server's robots are 'robots'");
+    out_ << fleetTable(cat.listPresence(), cat.listServers(), std::chrono::system_clock::now());
+    return true;
+  }
   const auto all = registry_.snapshots(clock_->nowNs());
   if (all.empty()) {
     out_ << "no robot has connected yet\n";

@@ -37,8 +37,12 @@ std::vector<Console::CommandDef> Console::sessionCommands() {
      "  help          lists every command\n"
      "  help drive    explains one command\n",
      &Console::cmdHelp},
-    {"robots", noArguments(), "table of robots: id, connected, address, telemetry Hz, mode, telemetry age",
-     "  Lists every robot that connected since the server started; '*' marks the selected one.\n",
+    {"robots", {{keyword("--fleet")}, {}}, "table of robots: id, connected, address, telemetry Hz, mode, telemetry age",
+     "  Lists every robot that connected since the server started; '*' marks the selected one.\n"
+     "  --fleet: with a catalog several servers share, every server's robots: online or not\n"
+     "  (unknown when its server has not been seen for 10 s), mode, where, and which server\n"
+     "  holds the link and where to attach to it (commands go to that server).\n"
+     "  example: robots --fleet\n",
      &Console::cmdRobots},
     {"select", {{completing(word("robot", "robot id"), Source::kRobots)}}, "choose the robot that drive/stop/estop/resume/status/expect act on",
      "  The robot need not be connected yet. With no selection, the first robot to connect\n"

@@ -231,4 +231,10 @@ std::string Stack::logs() const {
   return out;
 }
 
+int mcapTopicCount(const std::string& reader_json, const std::string& topic) {
+  const std::regex re("\"" + topic + "\":([0-9]+)");
+  std::smatch m;
+  return std::regex_search(reader_json, m, re) ? std::stoi(m[1]) : -1;
+}
+
 }  // namespace inspect::test

@@ -152,4 +152,8 @@ class Stack {
   std::map<std::string, Process> relays_;
 };
 
+/// A topic's message count in the JSON that tests/tools/mcap_reader prints
+/// ({"/robot1/telemetry": n, ...}); -1 when the topic is not there.
+int mcapTopicCount(const std::string& reader_json, const std::string& topic);
+
 }  // namespace inspect::test

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "pc_server/console/console.hpp"
+#include "pc_server/recording/fleet_presence.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/recording/run_stats.hpp"
 #include "shared/record/mcap_writer.hpp"
@@ -30,6 +31,14 @@ struct TempRuns {
 RecordingConfig recordingIn(const fs::path& dir) {
   RecordingConfig c;
   c.dir = dir.string();
+  return c;
+}
+
+/// A server `id`'s recording in `dir`, its catalog the PostgreSQL database at `url`.
+RecordingConfig sharedCatalogIn(const fs::path& dir, const std::string& url, const std::string& id) {
+  RecordingConfig c = recordingIn(dir);
+  c.catalog = url;
+  c.server_id = id;
   return c;
 }
 
@@ -80,12 +89,7 @@ TEST(Recorder, ServersSharingACatalogOnPostgresKeepTheirOwnRuns) {
   // Two servers' recorders, each with its runs directory, one PostgreSQL catalog.
   TempRuns tmp_a, tmp_b;
   const std::string url = inspect::test::freshPostgresDatabase("recorder_fleet");
-  auto config = [&](const fs::path& dir, const std::string& id) {
-    RecordingConfig c = recordingIn(dir);
-    c.catalog = url;
-    c.server_id = id;
-    return c;
-  };
+  auto config = [&](const fs::path& dir, const std::string& id) { return sharedCatalogIn(dir, url, id); };
   auto a = std::make_unique<Recorder>(config(tmp_a.dir, "ops-a"), "test");
   Recorder b(config(tmp_b.dir, "ops-b"), "test");
   const std::string ra = a->start("robot1", "north wing");
@@ -197,3 +201,84 @@ TEST(Recorder, ConsoleRunAndTrackRunAreRecordedAndListed) {
 
 // A run left open by a killed server (marked incomplete, MCAP repaired at the
 // next start) is tested through the real programs: RecordingStack.*.
+
+TEST(FleetPresence, RobotsOfASilentServerAreNotShownOnline) {
+  const auto now = catalog::parseIsoUtc("2026-12-06T08:30:00Z").value();
+  std::vector<catalog::ServerInfo> servers(2);
+  servers[0].id = "ops-a";
+  servers[0].attach = "ws://ops-a:8765";
+  servers[0].seen = now - std::chrono::seconds(1);
+  servers[1].id = "ops-b";
+  servers[1].attach = "ops-b:7600";
+  servers[1].seen = now - std::chrono::seconds(42);  // killed, or cut off
+  std::vector<catalog::RobotPresence> robots(3);
+  robots[0] = {"robot1", "ops-a", true, "TELEOP", 3.2, -1.25, now};
+  robots[1] = {"robot2", "ops-b", true, "IDLE", std::nullopt, std::nullopt, now - std::chrono::seconds(42)};
+  robots[2] = {"robot3", "ops-a", false, "", std::nullopt, std::nullopt, now};
+  const std::string t = fleetTable(robots, servers, now);
+  EXPECT_NE(t.find("robot1           online                   TELEOP     (3.20, -1.25)    ops-a        ws://ops-a:8765"),
+            std::string::npos) << t;
+  EXPECT_NE(t.find("robot2           unknown (server silent 42 s)"), std::string::npos) << t;
+  EXPECT_NE(t.find("ops-b:7600"), std::string::npos) << t;
+  EXPECT_NE(t.find("robot3           offline"), std::string::npos) << t;
+  EXPECT_EQ(fleetTable({}, servers, now), "no robot in the fleet's catalog yet\n");
+
+  RobotSnapshot snap;
+  snap.id = "robot1";
+  snap.connected = true;
+  snap.has_telemetry = true;
+  snap.telemetry.set_mode(v1::TELEOP);
+  snap.telemetry.mutable_pose()->set_x_m(3.2);
+  snap.telemetry.mutable_pose()->set_y_m(-1.25);
+  RobotSnapshot never;
+  never.id = "robot9";
+  const auto p = presenceOf({snap, never}, "ops-a", now);
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_TRUE(p[0].online);
+  EXPECT_EQ(p[0].mode, "TELEOP");
+  EXPECT_EQ(p[0].x_m, 3.2);
+  EXPECT_EQ(p[0].server, "ops-a");
+  EXPECT_FALSE(p[1].online);
+  EXPECT_FALSE(p[1].x_m.has_value());  // no telemetry: where is unknown, not (0, 0)
+}
+
+TEST(Recorder, AnOperatorOnEitherServerSeesTheFleetsRobotsOnPostgres) {
+  TempRuns tmp_a, tmp_b;
+  const std::string url = inspect::test::freshPostgresDatabase("recorder_presence");
+  auto config = [&](const fs::path& dir, const std::string& id) { return sharedCatalogIn(dir, url, id); };
+  Recorder a(config(tmp_a.dir, "ops-a"), "test"), b(config(tmp_b.dir, "ops-b"), "test");
+  const auto now = std::chrono::system_clock::now();
+  a.notePresence({"ops-a", "ws://ops-a:8765", tmp_a.dir.string(), "test", now, now},
+                 {{"robot1", "ops-a", true, "TELEOP", 1.5, 2.5, now}});
+  b.notePresence({"ops-b", "ops-b:7600", tmp_b.dir.string(), "test", now, now},
+                 {{"robot2", "ops-b", true, "IDLE", 0.0, 0.0, now}});
+  b.catalog();  // b's rows written
+
+  RobotRegistry registry;
+  NullSink sink;
+  std::ostringstream out;
+  StopFlag stop;
+  Console console(registry, sink, out, stop);
+  console.setRecorder(&a);
+  ASSERT_TRUE(console.execute("robots --fleet", 1)) << out.str();
+  EXPECT_NE(out.str().find("robot1           online"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("ws://ops-a:8765"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("robot2           online"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("ops-b:7600"), std::string::npos) << out.str();
+  console.setRecorder(nullptr);
+}
+
+TEST(Recorder, RobotsFleetNeedsASharedCatalog) {
+  TempRuns tmp;
+  Recorder rec(recordingIn(tmp.dir), "test");
+  RobotRegistry registry;
+  NullSink sink;
+  std::ostringstream out;
+  StopFlag stop;
+  Console console(registry, sink, out, stop);
+  console.setRecorder(&rec);
+  EXPECT_FALSE(console.execute("robots --fleet", 1));
+  EXPECT_NE(out.str().find("robots: --fleet needs a catalog that several servers share"), std::string::npos)
+      << out.str();
+  console.setRecorder(nullptr);
+}

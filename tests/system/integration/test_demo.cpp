@@ -192,11 +192,7 @@ TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
       << readFile(counts_path);
   const std::string counts = readFile(counts_path);
   std::printf("MCAP %s\n", counts.c_str());
-  const auto count = [&](const std::string& topic) {
-    std::smatch mm;
-    const std::regex re("\"" + topic + "\":([0-9]+)");
-    return std::regex_search(counts, mm, re) ? std::stol(mm[1]) : 0L;
-  };
+  const auto count = [&](const std::string& topic) { return std::max(mcapTopicCount(counts, topic), 0); };
   for (const std::string topic : {"/robot1/tf", "/robot1/scene", "/robot1/log", "/robot1/gas/CH4", "/robot1/gas/H2S",
                                   "/robot1/telemetry", "/robot1/camera"})
     EXPECT_GT(count(topic), 0) << topic << " missing from the run's MCAP: " << counts;

@@ -23,12 +23,6 @@ using namespace inspect::test;
 namespace {
 
 
-/// {"/robot1/telemetry": n, ...} from tests/tools/mcap_reader (path in INSPECT_MCAP_READER).
-int topicCount(const std::string& json, const std::string& topic) {
-  const std::regex re("\"" + topic + "\":([0-9]+)");
-  std::smatch m;
-  return std::regex_search(json, m, re) ? std::stoi(m[1]) : -1;
-}
 
 int ffprobeFrames(const std::string& mp4) {
   const auto out = captureOutput("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames "
@@ -88,12 +82,12 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
   // 1. The first run, ended normally: every reader opens it.
   const std::string first = runDir(runs, ids[0]);
   const auto counts = captureOutput(std::string("node ") + reader + " " + first + "/run.mcap");
-  EXPECT_GT(topicCount(counts, "/robot1/telemetry"), 150) << counts;  // 50 Hz for ~5 s
-  EXPECT_GT(topicCount(counts, "/robot1/camera"), 90) << counts;      // 30 fps (~150, less the stream's start)
-  EXPECT_GT(topicCount(counts, "/robot1/commands"), 20) << counts;     // teleop re-sent at 20 Hz
-  EXPECT_GT(topicCount(counts, "/robot1/acks"), 20) << counts;
-  EXPECT_GE(topicCount(counts, "/robot1/server_events"), 2) << counts;
-  EXPECT_EQ(topicCount(counts, "/robot1/robot_info"), 1) << counts;  // the robot's Hello at the start
+  EXPECT_GT(mcapTopicCount(counts, "/robot1/telemetry"), 150) << counts;  // 50 Hz for ~5 s
+  EXPECT_GT(mcapTopicCount(counts, "/robot1/camera"), 90) << counts;      // 30 fps (~150, less the stream's start)
+  EXPECT_GT(mcapTopicCount(counts, "/robot1/commands"), 20) << counts;     // teleop re-sent at 20 Hz
+  EXPECT_GT(mcapTopicCount(counts, "/robot1/acks"), 20) << counts;
+  EXPECT_GE(mcapTopicCount(counts, "/robot1/server_events"), 2) << counts;
+  EXPECT_EQ(mcapTopicCount(counts, "/robot1/robot_info"), 1) << counts;  // the robot's Hello at the start
   EXPECT_GT(ffprobeFrames(first + "/video.mp4"), 90);
   // ...and finds exactly the messages the server wrote ("run <id> ended (stopped): N messages" in its log).
   {
@@ -105,7 +99,7 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
     // The live view's names (pc_server/scene/topics), prefixed with the robot.
     for (const char* t : {"telemetry", "camera", "commands", "acks", "events", "server_events", "robot_info", "tf",
                           "scene", "log", "gas/CH4", "gas/H2S", "gas/CO", "gas/O2"})
-      read_total += std::max(topicCount(counts, std::string("/robot1/") + t), 0);
+      read_total += std::max(mcapTopicCount(counts, std::string("/robot1/") + t), 0);
     EXPECT_EQ(read_total, std::stoi(me[1])) << counts;
   }
   EXPECT_NE(out.find("distance "), std::string::npos) << out;  // run show
@@ -148,12 +142,12 @@ TEST(RecordingStack, RunsAreRecordedReadAndSurviveAServerKill) {
     EXPECT_EQ(d->info.outcome, "incomplete");
     // Seconds of telemetry lost: from the last message kept to the kill.
     const auto counts2 = captureOutput(std::string("node ") + reader + " " + second + "/run.mcap");
-    const int telemetry = topicCount(counts2, "/robot1/telemetry");
+    const int telemetry = mcapTopicCount(counts2, "/robot1/telemetry");
     const double recorded_s = std::chrono::duration<double>(kill_time - d->info.start).count();
     const double lost_s = recorded_s - telemetry / 50.0;
     std::printf("second run: %.2f s recorded before the kill, %d telemetry messages kept (%.2f s at 50 Hz): "
                 "about %.2f s lost; %d camera frames kept; mp4 %d frames\n",
-                recorded_s, telemetry, telemetry / 50.0, lost_s, topicCount(counts2, "/robot1/camera"),
+                recorded_s, telemetry, telemetry / 50.0, lost_s, mcapTopicCount(counts2, "/robot1/camera"),
                 ffprobeFrames(second + "/video.mp4"));
     EXPECT_GT(telemetry, 100) << counts2;
     EXPECT_LT(lost_s, 1.5) << counts2;  // 1 s of chunk + telemetry jitter
