@@ -29,6 +29,8 @@ CliOptions parseCli(const std::vector<std::string>& args) {
       if (catalog::redactUrl(*o.catalog) != *o.catalog)
         a.fail("the URL carries a password, which ps shows to every user; put it in ~/.pgpass, PGPASSFILE or "
                "PGPASSWORD, or in recording.catalog of the config file");
+    } else if (a.is("--shared-runs")) {
+      o.shared_runs = a.path();
     } else if (a.is("--server-id")) {
       o.server_id = a.path();
       if (o.server_id->size() > 64) a.fail("must be 1 to 64 characters (as server_id)");
@@ -73,6 +75,8 @@ std::string usageText() {
          "  --catalog URL|FILE  the run catalog: a SQLite file or a postgresql:// URL that several servers share\n"
          "                    (overrides recording.catalog; default DIR/catalog.sqlite); no password in the URL:\n"
          "                    libpq reads it from ~/.pgpass, PGPASSFILE or PGPASSWORD\n"
+         "  --shared-runs DIR  a runs root the fleet's servers share: ended runs are copied to DIR/<server>/<run-id>/\n"
+         "                    for other servers' report, export and replay (overrides recording.shared_runs)\n"
          "  --server-id ID    this server's name (overrides server_id): in HelloReply, and its id in a shared\n"
          "                    catalog (where the default pc_server stands for the host name)\n"
          "  --certs DIR       TLS files DIR/ca.pem, DIR/server.pem, DIR/server.key (overrides tls.*; default certs;\n"

@@ -26,6 +26,7 @@ struct CliOptions {
   std::optional<std::string> runs_dir;
   bool no_record = false;
   std::optional<std::string> catalog;    // --catalog (a URL without a password)
+  std::optional<std::string> shared_runs;  // --shared-runs
   std::optional<std::string> server_id;
   std::optional<std::string> certs_dir;  // --certs DIR: DIR/ca.pem, DIR/server.pem, DIR/server.key
   bool plaintext = false;

@@ -100,6 +100,7 @@ ServerConfig resolveConfig(const CliOptions& options) {
   if (options.runs_dir) c.recording.dir = *options.runs_dir;
   if (options.no_record) c.recording.enabled = false;
   if (options.catalog) c.recording.catalog = *options.catalog;
+  if (options.shared_runs) c.recording.shared_runs = *options.shared_runs;
   if (options.server_id) c.server_id = *options.server_id;
   if (options.certs_dir) {
     c.tls.ca = *options.certs_dir + "/ca.pem";
@@ -313,9 +314,7 @@ std::unique_ptr<PresenceTicker> startPresence(asio::io_context& ioc, const Serve
   info.attach = foxglove_port ? std::string(config.foxglove.tls ? "wss://" : "ws://") + host + ":" +
                                     std::to_string(*foxglove_port)
                               : host + ":" + std::to_string(link_port);
-  std::error_code ec;
-  const auto root = std::filesystem::absolute(config.recording.dir, ec);
-  info.runs_root = ec ? config.recording.dir : root.string();
+  info.runs_root = recorder->runsRoot();
   info.software_version = INSPECT_VERSION;
   info.started = std::chrono::system_clock::now();
   auto t = std::make_unique<PresenceTicker>(ioc, *recorder, registry, std::move(info));

@@ -61,6 +61,7 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
     r.fail("compression", "'" + rc.compression + "' is not one of zstd, none");
   rc.max_fragment_s = r.number("max_fragment_s", rc.max_fragment_s, 0.1, 60);
   rc.catalog = r.string("catalog", rc.catalog);
+  rc.shared_runs = r.string("shared_runs", rc.shared_runs);
   c.operator_socket = root.string("operator_socket", c.operator_socket);
   c.site_map = root.string("site_map", c.site_map);
   const auto f = root.optChild("foxglove");

@@ -81,7 +81,12 @@ std::optional<std::pair<catalog::RunDetail, std::string>> Console::findRun(const
     fail(cmd, "no run '" + id + "' in the catalog (see runs)");
     return std::nullopt;
   }
-  std::string dir = recorder_->config().dir + "/" + d->info.id;
+  std::string why;
+  std::string dir = recorder_->runDir(d->info, &why);
+  if (dir.empty()) {
+    fail(cmd, why);
+    return std::nullopt;
+  }
   return std::make_pair(std::move(*d), std::move(dir));
 }
 

@@ -115,6 +115,56 @@ Recorder::Recorder(const RecordingConfig& config, std::string software_version)
     log::warn(log::tag::kRecord, what);
     startup_report_ += (startup_report_.empty() ? "" : "; ") + what;
   }
+  if (!config_.shared_runs.empty()) {
+    copier_ = std::make_unique<RunCopier>(
+        [this](const std::string& id, const std::string& dst, int64_t bytes, const std::string& error) {
+          if (!error.empty()) {
+            log::error(log::tag::kRecord, "run ", id, " not copied to the shared runs root: ", error);
+            return;
+          }
+          log::info(log::tag::kRecord, "run ", id, " copied to ", dst, " (", bytes, " bytes)");
+          spool_->addFile(id, "shared", dst, bytes);
+        });
+    queueUncopiedRuns();
+  }
+}
+
+std::string Recorder::sharedDir(const std::string& server, const std::string& run_id) const {
+  return config_.shared_runs + "/" + (server.empty() ? "local" : server) + "/" + run_id;
+}
+
+void Recorder::queueUncopiedRuns() {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(config_.dir, ec)) {
+    const std::string id = e.path().filename().string();
+    if (!e.is_directory() || !fs::exists(e.path() / "run.mcap")) continue;
+    if (!fs::exists(sharedDir(config_.server_id, id))) copier_->copy(id, e.path().string(), sharedDir(config_.server_id, id));
+  }
+}
+
+std::string Recorder::runsRoot() const {
+  std::error_code ec;
+  const std::string root =
+      config_.shared_runs.empty() ? config_.dir : config_.shared_runs + "/" + (config_.server_id.empty() ? "local" : config_.server_id);
+  const auto abs = fs::absolute(root, ec);
+  return ec ? root : abs.lexically_normal().string();
+}
+
+std::string Recorder::runDir(const catalog::RunInfo& run, std::string* why) const {
+  if (run.server.empty() || run.server == config_.server_id) return config_.dir + "/" + run.id;
+  if (!config_.shared_runs.empty()) {
+    const std::string shared = sharedDir(run.server, run.id);
+    if (fs::exists(shared + "/run.mcap")) return shared;
+    if (why)
+      *why = "run " + run.id + " was recorded by server " + run.server + " and is not in the shared runs root yet (" +
+             shared + ")";
+    return "";
+  }
+  if (why)
+    *why = "run " + run.id + " was recorded by server " + run.server +
+           ", whose files this server cannot reach: give both servers a shared runs root (recording.shared_runs, "
+           "--shared-runs), or ask on " + run.server;
+  return "";
 }
 
 Recorder::~Recorder() {
@@ -306,6 +356,7 @@ std::string Recorder::stopLocked(const std::string& robot, const std::string& ou
   auto& ended = ended_[robot];
   ended.push_back({r.info.id, r.info.start, end});
   if (ended.size() > 20) ended.erase(ended.begin());
+  if (copier_) copier_->copy(r.info.id, r.info.dir, sharedDir(config_.server_id, r.info.id));
   log::info(log::tag::kRecord, robot, ": run ", r.info.id, " ended (", outcome, "): ", r.mcap.stats().messages, " messages, ",
             r.video_frames, " video frames");
   return r.info.id;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "inspect_robot/v1/link.pb.h"
+#include "pc_server/recording/run_copier.hpp"
 #include "pc_server/recording/run_stats.hpp"
 #include "pc_server/scene/robot_scene.hpp"
 #include "pc_server/scene/site_maps.hpp"
@@ -93,6 +94,15 @@ class Recorder {
   /// The catalog's notices after `cursor` (away, back, a refused write); advances it.
   std::vector<std::string> catalogNotices(uint64_t& cursor) const { return spool_->noticesSince(cursor); }
   const RecordingConfig& config() const { return config_; }
+  /// Where the fleet finds this server's runs: <shared_runs>/<server> when
+  /// configured, else its own runs directory (absolute).
+  std::string runsRoot() const;
+  /// The directory of a run's files as this server reaches it: its own runs
+  /// directory, or another server's run in the shared runs root; "" and
+  /// `why` when it cannot.
+  std::string runDir(const catalog::RunInfo& run, std::string* why = nullptr) const;
+  /// Waits up to `timeout_s` for the copies to the shared runs root; false if some are not done.
+  bool waitForCopies(double timeout_s) { return !copier_ || copier_->waitIdle(timeout_s); }
   /// What start-up found: "2 runs marked incomplete (…), MCAP repaired: …".
   const std::string& startupReport() const { return startup_report_; }
 
@@ -133,6 +143,11 @@ class Recorder {
     catalog::Time start, end;
   };
   std::map<std::string, std::vector<RunSpan>> ended_;  // robot -> its latest runs ended here, newest last
+  /// <shared_runs>/<server ("local" when none)>/<run id>.
+  std::string sharedDir(const std::string& server, const std::string& run_id) const;
+  /// At start-up: every run of this server's directory without a shared copy.
+  void queueUncopiedRuns();
+  std::unique_ptr<RunCopier> copier_;  // ended runs to the shared runs root (null: none); uses spool_
   std::string startup_report_;
   std::function<std::optional<VideoFigures>(const std::string&)> video_figures_;
   std::function<std::string(const std::string&)> gains_source_;

@@ -22,6 +22,10 @@ struct RecordingServerConfig {
   /// Not a key of its own: resolveConfig derives it from the server's
   /// server_id (catalogServerId).
   std::string server_id;
+  /// A runs root the fleet's servers share (a network file system): each
+  /// ended run is copied to <shared_runs>/<server>/<run-id>/, where another
+  /// server's operator reports, exports and replays it; "" = none.
+  std::string shared_runs;
 };
 
 }  // namespace inspect::server

@@ -44,6 +44,17 @@ RecordingConfig sharedCatalogIn(const fs::path& dir, const std::string& url, con
 
 using NullSink = inspect::test::NullCommandSink;
 
+/// An operator's console on a recorder (commands go nowhere).
+struct OperatorConsole {
+  explicit OperatorConsole(Recorder* r) { console.setRecorder(r); }
+  ~OperatorConsole() { console.setRecorder(nullptr); }
+  RobotRegistry registry;
+  NullSink sink;
+  std::ostringstream out;
+  StopFlag stop;
+  Console console{registry, sink, out, stop};
+};
+
 v1::Envelope telemetry(double x, double person, double gas, v1::Mode mode = v1::IDLE, double err = 0) {
   v1::Envelope e;
   auto* t = e.mutable_telemetry();
@@ -254,31 +265,68 @@ TEST(Recorder, AnOperatorOnEitherServerSeesTheFleetsRobotsOnPostgres) {
                  {{"robot2", "ops-b", true, "IDLE", 0.0, 0.0, now}});
   b.catalog();  // b's rows written
 
-  RobotRegistry registry;
-  NullSink sink;
-  std::ostringstream out;
-  StopFlag stop;
-  Console console(registry, sink, out, stop);
-  console.setRecorder(&a);
+  OperatorConsole oc(&a);
+  auto& console = oc.console;
+  auto& out = oc.out;
   ASSERT_TRUE(console.execute("robots --fleet", 1)) << out.str();
   EXPECT_NE(out.str().find("robot1           online"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("ws://ops-a:8765"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("robot2           online"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("ops-b:7600"), std::string::npos) << out.str();
-  console.setRecorder(nullptr);
 }
 
 TEST(Recorder, RobotsFleetNeedsASharedCatalog) {
   TempRuns tmp;
   Recorder rec(recordingIn(tmp.dir), "test");
-  RobotRegistry registry;
-  NullSink sink;
-  std::ostringstream out;
-  StopFlag stop;
-  Console console(registry, sink, out, stop);
-  console.setRecorder(&rec);
+  OperatorConsole oc(&rec);
+  auto& console = oc.console;
+  auto& out = oc.out;
   EXPECT_FALSE(console.execute("robots --fleet", 1));
   EXPECT_NE(out.str().find("robots: --fleet needs a catalog that several servers share"), std::string::npos)
       << out.str();
-  console.setRecorder(nullptr);
+}
+
+TEST(Recorder, AnotherServersRunIsReadFromTheSharedRunsRootOnPostgres) {
+  TempRuns tmp_a, tmp_b, shared;
+  const std::string url = inspect::test::freshPostgresDatabase("recorder_shared");
+  auto with_shared = [&](const fs::path& dir, const std::string& id) {
+    RecordingConfig c = sharedCatalogIn(dir, url, id);
+    c.shared_runs = shared.dir.string();
+    return c;
+  };
+  Recorder a(with_shared(tmp_a.dir, "ops-a"), "test");
+  const std::string rb = [&] {
+    Recorder b(with_shared(tmp_b.dir, "ops-b"), "test");
+    EXPECT_EQ(b.runsRoot(), fs::absolute(shared.dir / "ops-b").lexically_normal().string());
+    const std::string id = b.start("robot2", "south wing");
+    for (int i = 0; i < 20; ++i)
+      b.onEnvelope("robot2", "127.0.0.1:2", telemetry(0.05 * i, 2.0, 1), true, monoNowUs() + 20000ull * i);
+    b.stop("robot2");
+    EXPECT_TRUE(b.waitForCopies(20.0));
+    return id;
+  }();  // ops-b is gone: its own runs directory is not reachable from ops-a
+  fs::remove_all(tmp_b.dir);
+  EXPECT_TRUE(fs::exists(shared.dir / "ops-b" / rb / "run.mcap"));
+  EXPECT_FALSE(fs::exists(shared.dir / "ops-b" / (rb + ".partial")));
+
+  OperatorConsole oc(&a);
+  auto& console = oc.console;
+  auto& out = oc.out;
+  ASSERT_TRUE(console.execute("export " + rb + " csv", 1)) << out.str();
+  EXPECT_NE(out.str().find(rb + ": exported"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find((shared.dir / "ops-b" / rb / "csv").string()), std::string::npos) << out.str();
+  const auto d = a.catalog().run(rb);
+  ASSERT_TRUE(d);
+  bool listed = false;
+  for (const auto& f : d->files) listed |= f.kind == "shared" && f.bytes > 0;
+  EXPECT_TRUE(listed) << "the shared copy is not among the run's files";
+
+  // Without a shared runs root, another server's run is a clear refusal.
+  TempRuns tmp_c;
+  Recorder c(sharedCatalogIn(tmp_c.dir, url, "ops-c"), "test");
+  console.setRecorder(&c);
+  out.str("");
+  EXPECT_FALSE(console.execute("export " + rb + " csv", 2));
+  EXPECT_NE(out.str().find("was recorded by server ops-b, whose files this server cannot reach"), std::string::npos)
+      << out.str();
 }

@@ -5,7 +5,8 @@
 // goes on recording and says so, writes everything through when it is back,
 // and the catalog then holds each event of the run exactly once (as many as
 // the run's MCAP file, read by @mcap/core, has). An operator on either server
-// sees both robots (`robots --fleet`) and both runs (`runs --fleet`).
+// sees both robots (`robots --fleet`) and both runs (`runs --fleet`), and
+// both runs are copied to the fleet's shared runs root.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -48,6 +49,7 @@ TEST(FleetStack, TwoServersShareOneCatalogAndADatabaseOutageLosesNothing) {
   // run's end fall in it; the fleet is listed after.
   Stack a("fleet-a");
   const std::string runs_a = a.dir() / "runs";
+  const std::string shared = a.dir() / "shared";  // the fleet's shared runs root
   ASSERT_TRUE(a.startServer("expect robots >= 1 within 20\n"
                             "record start south aisle\n"
                             "drive 0.35 0\n"
@@ -60,7 +62,7 @@ TEST(FleetStack, TwoServersShareOneCatalogAndADatabaseOutageLosesNothing) {
                             "wait 16\n"
                             "robots --fleet\n"
                             "runs --fleet\n",
-                            {"--runs-dir", runs_a, "--catalog", url, "--server-id", "ops-a"}))
+                            {"--runs-dir", runs_a, "--catalog", url, "--server-id", "ops-a", "--shared-runs", shared}))
       << a.logs();
   // ops-b records a short run before the outage and lists the fleet after it.
   Stack b("fleet-b");
@@ -72,7 +74,7 @@ TEST(FleetStack, TwoServersShareOneCatalogAndADatabaseOutageLosesNothing) {
                             "wait 32\n"
                             "robots --fleet\n"
                             "runs --fleet\n",
-                            {"--runs-dir", runs_b, "--catalog", url, "--server-id", "ops-b"}))
+                            {"--runs-dir", runs_b, "--catalog", url, "--server-id", "ops-b", "--shared-runs", shared}))
       << b.logs();
   a.startRobot("robot1", "gas_lab.yaml");
   b.startRobot("robot2");
@@ -137,6 +139,10 @@ TEST(FleetStack, TwoServersShareOneCatalogAndADatabaseOutageLosesNothing) {
       << "no gas alarm in the run: " << out_a;
   EXPECT_EQ(one(rawQuery(url, "SELECT count(*) FROM runs")), "2");
   EXPECT_EQ(one(rawQuery(runs_a + "/catalog-spool.sqlite", "SELECT count(*) FROM writes")), "0");
+  // Both runs are in the shared runs root, for either server's report, export and replay.
+  EXPECT_TRUE(std::filesystem::exists(shared + "/ops-a/" + run_a + "/run.mcap"));
+  EXPECT_TRUE(std::filesystem::exists(shared + "/ops-b/" + run_b + "/run.mcap"));
+  EXPECT_EQ(one(rawQuery(url, "SELECT count(*) FROM run_files WHERE kind = 'shared'")), "2");
   const std::string rows_a = one(rawQuery(url, "SELECT (SELECT count(*) FROM events WHERE server_id = 'ops-a') || ' events, ' ||"
                                                " (SELECT count(*) FROM alarms WHERE server_id = 'ops-a') || ' alarms'"));
   RecordProperty("catalog_rows_ops_a", rows_a);
