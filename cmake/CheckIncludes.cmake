@@ -18,8 +18,9 @@
 #                 tuning/) include no front end nor the app: not console/,
 #                 operator/, foxglove/, app/ (their config structs live beside
 #                 them; text helpers are shared/util)
-#   experiments/  no robot_client/; of tests/ only tests/support/paths.hpp and
-#                 udp_relay.hpp (the seeded lossy link of bench_video --loss)
+#   experiments/  no robot_client/; of tests/ only tests/support/paths.hpp,
+#                 udp_relay.hpp (the seeded lossy link of bench_video --loss) and
+#                 postgres_server.hpp (bench_catalog's own PostgreSQL server)
 if(NOT ROOT)
   message(FATAL_ERROR "CheckIncludes.cmake: -DROOT=<source tree> is required")
 endif()
@@ -56,10 +57,10 @@ check_folder(pc_server "^(robot_client|experiments|tests)/" "pc_server includes 
 foreach(part link video scene recording tuning)
   check_folder(pc_server/${part} "^pc_server/(console|operator|foxglove|app)/" "pc_server/${part} is below the front ends: it includes no console/, operator/, foxglove/ or app/")
 endforeach()
-check_folder(experiments "^robot_client/|^tests/(.*/)?[a-z_]+\\.hpp$" "an experiment includes no program's code (of tests/ only tests/support/paths.hpp, udp_relay.hpp)")
+check_folder(experiments "^robot_client/|^tests/(.*/)?[a-z_]+\\.hpp$" "an experiment includes no program's code (of tests/ only tests/support/paths.hpp, udp_relay.hpp, postgres_server.hpp)")
 
 # The allowed exception of the rule above.
-string(REGEX REPLACE "\n  experiments/[^:]+: #include \"tests/support/(paths|udp_relay)\\.hpp\": [^\n]*" "" problems "${problems}")
+string(REGEX REPLACE "\n  experiments/[^:]+: #include \"tests/support/(paths|udp_relay|postgres_server)\\.hpp\": [^\n]*" "" problems "${problems}")
 
 if(problems)
   message(FATAL_ERROR "includes that break the dependency arrows of docs/architecture.md:${problems}")
