@@ -149,8 +149,7 @@ TEST_F(CatalogSpoolTest, AWriteTheCatalogAlreadyHasIsNotWrittenTwice) {
   {
     CatalogSpool spool(cat, file("spool.sqlite"));
     EXPECT_EQ(spool.id(), spool_id);
-    EXPECT_EQ(spool.status().pending, 2);
-    ASSERT_TRUE(spool.flush(kFlush));
+    ASSERT_TRUE(spool.flush(kFlush));  // (the writer may have taken them already: no count before)
     EXPECT_EQ(spool.status().written, 0);  // both skipped
     spool.addEvent("r1", "robot1", t0_, "INFO", "three");  // seq 4: never a used one
     ASSERT_TRUE(spool.flush(kFlush));
