@@ -9,6 +9,7 @@
 
 #include "shared/catalog/sql_backend.hpp"
 #include "shared/catalog/time_text.hpp"
+#include "shared/util/number_text.hpp"
 
 namespace inspect::catalog {
 
@@ -49,11 +50,7 @@ std::string newSpoolId() {
   return buf;
 }
 
-std::string seconds(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.2f s", s);
-  return buf;
-}
+std::string seconds(double s) { return util::fmtFixed(s, 2) + " s"; }
 
 }  // namespace
 
@@ -250,12 +247,8 @@ bool CatalogSpool::writeBatch(int limit) {
     throw;
   } catch (const std::exception& e) {  // the catalog refused a write, or a spooled write is unreadable
     if (seqs.size() > 1) {
-      // Find which: one at a time, so that the others go through.
-      while (writeBatch(1) && [&] {
-        std::lock_guard lk(mu_);
-        return done_seq_ < seqs.back();
-      }()) {
-      }
+      // Find which: one at a time (the batch's rows are the spool's first), so that the others go through.
+      for (std::size_t i = 0; i < seqs.size(); ++i) writeBatch(1);
       return true;
     }
     refused = true;
@@ -268,12 +261,11 @@ bool CatalogSpool::writeBatch(int limit) {
   {
     // One step under the lock: a flush that returns sees the state after it.
     std::lock_guard lk(mu_);
-    if (away_since_) cameBackLocked();
     done_seq_ = std::max(done_seq_, seqs.back());
     status_.pending -= static_cast<int64_t>(seqs.size());
     status_.written += ran;
     if (refused) ++status_.dropped;
-    if (catching_up_since_ && status_.pending == 0) caughtUpLocked();
+    wroteLocked();
   }
   if (refused) {
     const std::string op = ops[0].substr(0, 120);
@@ -338,8 +330,7 @@ void CatalogSpool::writeLatest() {
   {
     std::lock_guard lk(mu_);
     latest_done_ = std::max(latest_done_, generation);
-    if (away_since_) cameBackLocked();
-    if (catching_up_since_ && status_.pending == 0) caughtUpLocked();
+    wroteLocked();
   }
   cv_.notify_all();
 }
@@ -352,6 +343,11 @@ void CatalogSpool::wentAway(const std::string& why) {
   catching_up_since_.reset();
   status_.reachable = false;
   notices_.push_back(why + "; recording goes on, the catalog's writes kept in " + path_ + " until it is back");
+}
+
+void CatalogSpool::wroteLocked() {
+  if (away_since_) cameBackLocked();
+  if (catching_up_since_ && status_.pending == 0) caughtUpLocked();
 }
 
 void CatalogSpool::cameBackLocked() {

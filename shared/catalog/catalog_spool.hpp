@@ -101,8 +101,10 @@ class CatalogSpool {
   void apply(const std::string& op);
   void notice(std::string text);
   void wentAway(const std::string& why);
-  // Under mu_: the first write after an outage went through (the attempt
-  // began at attempt_ with attempt_pending_ writes kept); the spool emptied after it.
+  // Under mu_, after a write went through: the first after an outage (the
+  // attempt began at attempt_ with attempt_pending_ writes kept), and the
+  // spool emptied after one.
+  void wroteLocked();
   void cameBackLocked();
   void caughtUpLocked();
 
