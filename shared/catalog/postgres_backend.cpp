@@ -150,10 +150,11 @@ class PostgresBackend final : public SqlBackend {
   void check(PGresult* r, const std::string& what) {
     const auto st = r ? PQresultStatus(r) : PGRES_FATAL_ERROR;
     if (st == PGRES_COMMAND_OK || st == PGRES_TUPLES_OK) return;
-    const std::string why = what + ": " + firstLine(r ? PQresultErrorMessage(r) : PQerrorMessage(conn_.get()));
-    // The connection gone (the server stopped, the network cut): a later try may work.
-    if (PQstatus(conn_.get()) != CONNECTION_OK) failUnavailable(where_, why);
-    failPlain(why);
+    const std::string reason = firstLine(r ? PQresultErrorMessage(r) : PQerrorMessage(conn_.get()));
+    // The connection gone (the server stopped, the network cut): a later try
+    // may work, and which statement it cut short says nothing to the operator.
+    if (PQstatus(conn_.get()) != CONNECTION_OK) failUnavailable(where_, "connection lost: " + reason);
+    failPlain(what + ": " + reason);
   }
 
   void exec(const char* sql, const char* what) {
