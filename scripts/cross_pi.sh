@@ -8,7 +8,7 @@
 # 1. The host gets Debian's cross compiler (g++-aarch64-linux-gnu), qemu-user
 #    and mmdebstrap (scripts/setup.sh).
 # 2. An arm64 sysroot in build-arm64-sysroot/ (SYSROOT overrides): the arm64
-#    -dev packages of Debian 12 the robot needs, extracted by mmdebstrap (no
+#    -dev packages of packaging/robot-client/build-depends.txt, extracted by mmdebstrap (no
 #    maintainer scripts run). Not dpkg's multiarch on the host: the arm64 and
 #    amd64 -dev packages of OpenCV and yaml-cpp cannot be installed side by
 #    side (apt would remove the host's). Made again only when the package
@@ -38,13 +38,10 @@ step() { echo "cross_pi: $1 took $(( $(date +%s) - $2 )) s"; }
 bash scripts/setup.sh g++-aarch64-linux-gnu qemu-user mmdebstrap
 t_setup=$(date +%s); step "host packages" "$t0"
 
-SYSROOT_PACKAGES=(
-  libc6-dev libstdc++-12-dev
-  libboost-dev libprotobuf-dev libssl-dev libyaml-cpp-dev libeigen3-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev
-  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
-  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev libopencv-highgui-dev
-)
+# The robot's build packages: the one list scripts/setup.sh installs on the
+# host too; the unit test robot_build_packages checks that it names every
+# header and library the robot's targets use.
+mapfile -t SYSROOT_PACKAGES < <(grep '^[a-z]' packaging/robot-client/build-depends.txt)
 stamp="$SYSROOT/.inspect-packages"
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "${SYSROOT_PACKAGES[*]}" ]; then
   rm -rf "$SYSROOT"

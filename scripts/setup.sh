@@ -5,28 +5,24 @@
 #   scripts/setup.sh [PACKAGE...]
 #
 # PACKAGEs are installed too (scripts/cross_pi.sh adds its cross tools so).
+# The robot's build packages come from packaging/robot-client/build-depends.txt
+# (the one list, which the arm64 sysroot of scripts/cross_pi.sh is made of too).
 set -euo pipefail
+cd "$(dirname "$0")/.."
+mapfile -t ROBOT_BUILD_PACKAGES < <(grep '^[a-z]' packaging/robot-client/build-depends.txt)
 
 PACKAGES=(
   g++ cmake ninja-build pkg-config git ccache
   clang libclang-rt-14-dev
-  libssl-dev openssl
-  libboost-dev
-  libprotobuf-dev protobuf-compiler python3-protobuf
-  libyaml-cpp-dev
-  libeigen3-dev
-  libgtest-dev libgmock-dev
-  nlohmann-json3-dev
+  "${ROBOT_BUILD_PACKAGES[@]}"
+  openssl protobuf-compiler python3-protobuf
   libsqlite3-dev sqlite3
   libpq-dev postgresql
   libnlopt-cxx-dev
   libzstd-dev zlib1g-dev
   fuzzylite libfuzzylite-dev
   gnuplot-nox
-  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
-  ffmpeg
-  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev libopencv-highgui-dev
-  libopencv-objdetect-dev opencv-data
+  ffmpeg opencv-data
   gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-plugins-ugly gstreamer1.0-libav
   libgstreamer1.0-dev
   "$@"

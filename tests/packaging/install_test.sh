@@ -45,11 +45,37 @@ if [ ! -f "$CACHE" ] || [ "$(cat "$CACHE.deps" 2>/dev/null)" != "$deps" ]; then
 fi
 ROOT=$(mktemp -d "${TMPDIR:-/tmp}/inspect-pkgroot-XXXXXX")
 pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+# Every process whose root is the test's root (pc_server and robot_client run
+# there through chroot, under a subshell whose pid is not theirs), then the
+# ones started here: TERM, 5 s, KILL. Says what it stopped.
+stop_all() {
+  local p left=() names=()
+  for p in /proc/[0-9]*; do
+    [ "$(readlink "$p/root" 2>/dev/null)" = "$ROOT" ] && left+=("${p#/proc/}")
+  done
+  left+=("${pids[@]}")
+  for p in "${left[@]}"; do
+    kill -0 "$p" 2>/dev/null || continue
+    names+=("$(cat "/proc/$p/comm" 2>/dev/null || echo "$p")[$p]")
+    kill -TERM "$p" 2>/dev/null || true
+  done
+  for _ in $(seq 50); do
+    local alive=0
+    for p in "${left[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+    [ $alive = 0 ] && break
+    sleep 0.1
+  done
+  for p in "${left[@]}"; do kill -KILL "$p" 2>/dev/null && echo "install_test: $p did not stop in 5 s: killed"; done
   wait 2>/dev/null || true
+  pids=()
+  [ ${#names[@]} -eq 0 ] || echo "install_test: stopped ${names[*]}"
+}
+cleanup() {
+  stop_all
   for m in dev/pts dev proc; do umount "$ROOT/$m" 2>/dev/null || true; done
-  if [ -z "${KEEP_TEST_DIRS:-}" ]; then rm -rf "$ROOT"; else echo "install_test: kept $ROOT"; fi
+  if grep -q " $ROOT/" /proc/mounts; then
+    echo "install_test: $ROOT still has mounts ($(grep " $ROOT/" /proc/mounts | cut -d' ' -f2 | paste -sd' ')): not removed" >&2
+  elif [ -z "${KEEP_TEST_DIRS:-}" ]; then rm -rf "$ROOT"; else echo "install_test: kept $ROOT"; fi
 }
 trap cleanup EXIT
 tar -C "$ROOT" -xf "$CACHE"
@@ -118,9 +144,8 @@ if as_inspect sh -c 'timeout 60 /usr/bin/pc_server --attach /run/inspect/operato
 cat "$ROOT/tmp/drive.out"
 check "drive through the installed programs" test $drive = 0
 check "the service user made the runs and the catalog" test -f "$ROOT/var/lib/inspect/runs/catalog.sqlite"
-for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-wait 2>/dev/null || true
-pids=()
+stop_all
+check "nothing left running in the root" sh -c "! for p in /proc/[0-9]*; do [ \"\$(readlink \$p/root 2>/dev/null)\" = '$ROOT' ] && echo \$p; done | grep -q ."
 [ $fail = 0 ] || for f in pc_server.err robot_client.err mcu_sim.err dpkg-install.log; do
   echo "---- $f"; tail -20 "$ROOT/tmp/$f"; done
 
