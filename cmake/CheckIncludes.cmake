@@ -13,11 +13,21 @@
 #                 shared/robot/: the world does not know the robot's mind
 #   robot_client/ no sim/, pc_server/, experiments/, tests/ (the world file
 #                 of --map is shared/world)
-#   pc_server/    no robot_client/, experiments/, tests/; inside it the parts
-#                 the front ends stand on (link/, video/, scene/, recording/,
-#                 tuning/) include no front end nor the app: not console/,
-#                 operator/, foxglove/, app/ (their config structs live beside
-#                 them; text helpers are shared/util)
+#   pc_server/    no robot_client/, experiments/, tests/; inside it, floors
+#                 from the bottom (each includes only floors below it):
+#                 1. the parts (link/, video/, scene/, recording/, tuning/):
+#                    no console/, operator/, terminal/, foxglove/, app/ (their
+#                    config structs live beside them; text helpers are shared/util)
+#                 2. operator/, the operator service (OperatorService,
+#                    ControlArbiter, routes, command limits, StopFlag): no
+#                    front end (console/, terminal/, foxglove/) and no app/
+#                 3. the front ends: console/ (the commands' parser and
+#                    formatter) includes no terminal/, foxglove/, app/;
+#                    terminal/ (line editor, keyboard teleop, interactive
+#                    console, attach socket) and foxglove/ (the bridge) stand
+#                    on console/ and operator/, never on each other nor app/
+#                 4. app/ (main, options, config, the consoles' wiring):
+#                    included by nobody
 #   experiments/  no robot_client/; of tests/ only tests/support/paths.hpp,
 #                 udp_relay.hpp (the seeded lossy link of bench_video --loss) and
 #                 postgres_server.hpp (bench_catalog's own PostgreSQL server)
@@ -55,8 +65,12 @@ check_folder(sim "^(robot_client|pc_server|experiments|tests)/|^shared/robot/" "
 check_folder(robot_client "^(sim|pc_server|experiments|tests)/" "robot_client includes no other program (nor the simulator)")
 check_folder(pc_server "^(robot_client|experiments|tests)/" "pc_server includes no other program")
 foreach(part link video scene recording tuning)
-  check_folder(pc_server/${part} "^pc_server/(console|operator|foxglove|app)/" "pc_server/${part} is below the front ends: it includes no console/, operator/, foxglove/ or app/")
+  check_folder(pc_server/${part} "^pc_server/(console|operator|terminal|foxglove|app)/" "pc_server/${part} is below the operator service and the front ends: it includes no console/, operator/, terminal/, foxglove/ or app/")
 endforeach()
+check_folder(pc_server/operator "^pc_server/(console|terminal|foxglove|app)/" "the operator service is below the front ends: it includes no console/, terminal/, foxglove/ or app/")
+check_folder(pc_server/console "^pc_server/(terminal|foxglove|app)/" "the console's parser and formatter include no terminal/, foxglove/ or app/ (front ends stand on it)")
+check_folder(pc_server/terminal "^pc_server/(foxglove|app)/" "the terminal front end includes no foxglove/ nor app/")
+check_folder(pc_server/foxglove "^pc_server/(terminal|app)/" "the Foxglove bridge includes no terminal/ nor app/")
 check_folder(experiments "^robot_client/|^tests/(.*/)?[a-z_]+\\.hpp$" "an experiment includes no program's code (of tests/ only tests/support/paths.hpp, udp_relay.hpp, postgres_server.hpp)")
 
 # The allowed exception of the rule above.

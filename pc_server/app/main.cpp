@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "pc_server/app/cli_options.hpp"
-#include "pc_server/operator/operator_socket.hpp"
+#include "pc_server/terminal/operator_socket.hpp"
 #include "pc_server/app/server_app.hpp"
 #include "shared/util/startup_error.hpp"
 

@@ -273,8 +273,9 @@ bool Console::cmdRobots(const CommandArgs& a) {
   return true;
 }
 
-bool Console::cmdSelect(const CommandArgs& a) {
-  const std::string& robot = a.text("robot");
+bool Console::cmdSelect(const CommandArgs& a) { return select(a.text("robot")); }
+
+bool Console::select(const std::string& robot) {
   if (!net::validRobotId(robot)) return fail("select", "'" + robot + "' is not a valid robot id ([A-Za-z0-9_-]{1,64})");
   selected_ = robot;
   const auto snap = registry_.snapshot(selected_, clock_->nowNs());

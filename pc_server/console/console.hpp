@@ -17,9 +17,9 @@
 #include "pc_server/console/console_clock.hpp"
 #include "pc_server/operator/control_arbiter.hpp"
 #include "pc_server/operator/operator_service.hpp"
-#include "pc_server/operator/keyboard_teleop.hpp"
+#include "pc_server/console/teleop_mode.hpp"
 #include "pc_server/link/robot_registry.hpp"
-#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/operator/stop_flag.hpp"
 #include "shared/catalog/catalog.hpp"
 #include "shared/control/gain_set.hpp"
 
@@ -59,7 +59,7 @@ class Console {
     double drive_lease_s = 0.0;
   };
   /// Runs keyboard teleop on the selected robot until the operator leaves; false on failure.
-  using TeleopHandler = std::function<bool(KeyboardTeleop::Mode mode, const std::string& robot_id)>;
+  using TeleopHandler = std::function<bool(TeleopMode mode, const std::string& robot_id)>;
 
   /// Counts of a session, for the script summary and the exit status.
   struct Tally {
@@ -105,6 +105,10 @@ class Console {
   /// attaches mid-run does not replay the registry's buffer (up to
   /// kMaxPendingEvents old events); `alarms` shows what is in force.
   void eventsFromNow() { event_cursor_ = registry_.eventCursor(); }
+
+  /// `select <robot>` as a typed call (a Foxglove call names its robot so):
+  /// prints "selected robot1" (or why not, as `select`); false when the id is not valid.
+  bool select(const std::string& robot);
 
   bool quitRequested() const { return quit_; }
   const std::string& selected() const { return selected_; }

@@ -8,7 +8,7 @@
 // registry's WakeSignal: the console wakes when one arrives, not by polling.
 #include <cstdint>
 
-#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/operator/stop_flag.hpp"
 #include "pc_server/link/wake_signal.hpp"
 #include "shared/util/clock.hpp"
 

@@ -97,10 +97,13 @@ std::vector<Console::CommandDef> Console::motionCommands() {
      "  example: track circle 3.5 0.5\n"
      "  example: track line 4 0.3 pid\n",
      &Console::cmdTrack},
-    {"goto", {{number("x_m"), number("y_m"), opt(number("speed_m_s"))}}, "navigate to a point, going round obstacles",
+    {"goto", {{number("x_m"), number("y_m"), opt(number("speed_m_s")), opt(keyword("force"))}},
+     "navigate to a point, going round obstacles",
      "  The robot's navigation automaton (go-to-goal, avoid, boundary following) drives to (x, y)\n"
      "  in its odometry frame (origin and x axis = its pose when robot_client started) at up to\n"
      "  speed_m_s (default: the robot's, 0.5 m/s; at most 1). People slow it down (Eq 9).\n"
+     "  A goal outside the robot's site map (the box of its walls) is refused with the map's\n"
+     "  bounds; `force` sends it anyway.\n"
      "  Waits for the Ack; the robot acks again (COMPLETED) within 0.1 m of the goal and goes IDLE,\n"
      "  and the console prints 'robot1: goto completed'. stop, estop or teleop end it.\n"
      "  Telemetry: expect nav_mode, goal_dist, goal_index, goal_count, nav_switches.\n"

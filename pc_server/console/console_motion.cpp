@@ -47,7 +47,7 @@ bool Console::cmdDrive(const CommandArgs& a) {
 void Console::operatorPresent() { service_->renewTeleop(session_, drive_robot_, options_.drive_lease_s); }
 
 bool Console::cmdTeleop(const CommandArgs& a) {
-  KeyboardTeleop::Mode mode = KeyboardTeleop::Mode::kStep;
+  TeleopMode mode = TeleopMode::kStep;
   if (a.has("mode")) parseTeleopMode(a.text("mode"), mode);  // the table accepts only step and hold
   if (!teleop_handler_) return fail("teleop", "keyboard teleop needs an interactive terminal (scripts use drive)");
   const auto robot = connectedRobot("teleop");
@@ -80,7 +80,7 @@ bool Console::cmdTrack(const CommandArgs& a) {
 
 bool Console::cmdGoto(const CommandArgs& a) {
   return report(service_->goTo(session_, selected_, *a.number("x_m"), *a.number("y_m"), a.number("speed_m_s"),
-                               clock_->nowNs()),
+                               clock_->nowNs(), a.has("force")),
                 true);
 }
 

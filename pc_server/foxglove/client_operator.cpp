@@ -50,7 +50,7 @@ void ClientOperator::run(const std::string& robot, const std::string& line, cons
   (void)console_->background();  // the session's selection and event cursor, current
   out_.str("");
   bool ok = true;
-  if (!robot.empty()) ok = console_->execute("select " + robot, 0);
+  if (!robot.empty()) ok = console_->select(robot);
   if (ok && !line.empty()) ok = console_->execute(line, 0);
   std::string text = out_.str();
   while (!text.empty() && text.back() == '\n') text.pop_back();

@@ -49,7 +49,7 @@ class ClientOperator : public std::enable_shared_from_this<ClientOperator> {
 
   uint64_t session() const { return session_; }
   const std::string& name() const { return name_; }
-  /// Queues `line` (after "select <robot>" when robot is not empty) on the
+  /// Queues `line` (after Console::select(robot) when robot is not empty) on the
   /// pool; `done` runs on a pool thread with the line's output. False when
   /// kMaxQueued lines of this client wait already, or the client has ended.
   bool post(const std::string& robot, const std::string& line, Done done);

@@ -251,17 +251,19 @@ void FoxgloveBridge::deadman() {
   });
 }
 
-void FoxgloveBridge::stopRobot(const std::string& robot) {
-  v1::Command stop;
-  stop.mutable_stop();
-  if (sink_.sendCommand(robot, stop) == 0) sink_.clearTeleop(robot);
+void FoxgloveBridge::stopRobot(const std::string& robot, uint64_t session) {
+  // Through the service like every other way of moving a robot (a stop needs
+  // no control); its Ack is not waited for. A robot that is not connected
+  // keeps no set-point to re-send.
+  const Issued issued = service_.stop(session, robot, monoNowNs());
+  if (const auto* r = std::get_if<CallResult>(&issued); r && !r->ok()) service_.clearTeleop(robot);
 }
 
 bool FoxgloveBridge::stopIfHeld(const std::string& robot, uint64_t session) {
   // A robot another session has taken over since is that session's to stop, not ours.
   const auto h = control_.holder(robot);
   if (!h || h->session != session) return false;
-  stopRobot(robot);
+  stopRobot(robot, session);
   return true;
 }
 
@@ -290,7 +292,7 @@ void FoxgloveBridge::onClientClose(uint64_t client) {
   if (c.op) c.op->end();
 }
 
-void FoxgloveBridge::onSubscribe(uint64_t, uint32_t channel) {
+void FoxgloveBridge::onSubscribe(uint64_t client, uint32_t channel) {
   // A new video subscriber needs a keyframe to start from: ask the robot (at most once a second).
   std::string robot;
   {
@@ -304,9 +306,11 @@ void FoxgloveBridge::onSubscribe(uint64_t, uint32_t channel) {
     }
   }
   if (robot.empty()) return;
-  v1::Command c;
-  c.mutable_video()->set_keyframe(true);
-  sink_.sendCommand(robot, std::move(c));
+  // The camera's settings need no control; the Ack is not waited for.
+  const auto op = operatorOf(client);
+  VideoRequest keyframe;
+  keyframe.what = VideoRequest::What::kKeyframe;
+  (void)service_.video(op ? op->session() : 0, robot, keyframe, monoNowNs());
 }
 
 std::shared_ptr<ClientOperator> FoxgloveBridge::operatorOf(uint64_t client) const {
@@ -394,7 +398,7 @@ void FoxgloveBridge::teleop(uint64_t client, const std::string& topic_robot, std
     it->second.teleop_robot = robot;
     it->second.last_teleop = SteadyClock::now();
   }
-  if (!previous.empty() && previous != robot) stopRobot(previous);
+  if (!previous.empty() && previous != robot) stopRobot(previous, op->session());
   if (taken_now) server_.status(client, StatusLevel::kInfo, robot + ": controlled by " + op->name());
 }
 

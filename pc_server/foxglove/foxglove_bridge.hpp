@@ -111,7 +111,7 @@ class FoxgloveBridge : public WsServer::Handler {
   std::string robotOfTopic(const std::string& topic) const;
   /// The client's operator session (null once it has gone).
   std::shared_ptr<ClientOperator> operatorOf(uint64_t client) const;
-  void stopRobot(const std::string& robot);
+  void stopRobot(const std::string& robot, uint64_t session);
   /// A typed service call through the operator service; the answer is sent when it settles.
   void callService(uint64_t client, const ClientOperator& op, uint32_t service_id, uint32_t call_id,
                    const ServiceRequest& req);

@@ -1,5 +1,8 @@
 #include "pc_server/operator/operator_service.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <cmath>
 
 #include "pc_server/operator/command_limits.hpp"
@@ -96,13 +99,40 @@ Issued OperatorService::resume(uint64_t session, const std::string& robot, int64
   return send(session, robot, "resume", std::move(c), now_ns);
 }
 
+std::optional<std::string> OperatorService::outsideSiteMap(const std::string& robot, double x_m, double y_m) const {
+  if (!site_maps_) return std::nullopt;
+  const auto entry = site_maps_->get(robot);
+  if (!entry.map || entry.map->walls.empty()) return std::nullopt;
+  const scene::SiteMap& m = *entry.map;
+  // The walls in the robot's odometry frame: its origin and x axis are the
+  // map's start pose.
+  const double c = std::cos(m.start_theta_rad), s = std::sin(m.start_theta_rad);
+  double lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
+  for (const auto& w : m.walls)
+    for (const auto& p : {w.a, w.b}) {
+      const double dx = p.x - m.start_x_m, dy = p.y - m.start_y_m;
+      const double ox = c * dx + s * dy, oy = -s * dx + c * dy;
+      lo_x = std::min(lo_x, ox);
+      hi_x = std::max(hi_x, ox);
+      lo_y = std::min(lo_y, oy);
+      hi_y = std::max(hi_y, oy);
+    }
+  if (x_m >= lo_x && x_m <= hi_x && y_m >= lo_y && y_m <= hi_y) return std::nullopt;
+  return "(" + fmtShort(x_m) + ", " + fmtShort(y_m) + ") is outside the site map " + m.name + ": its walls span x [" +
+         fmtShort(lo_x) + ", " + fmtShort(hi_x) + "], y [" + fmtShort(lo_y) + ", " + fmtShort(hi_y) +
+         "] m in the robot's odometry frame; `goto " + fmtShort(x_m) + " " + fmtShort(y_m) +
+         " force` sends it anyway";
+}
+
 Issued OperatorService::goTo(uint64_t session, const std::string& robot, double x_m, double y_m,
-                             std::optional<double> speed_m_s, int64_t now_ns) {
+                             std::optional<double> speed_m_s, int64_t now_ns, bool force) {
   if (!(std::fabs(x_m) <= 1000) || !(std::fabs(y_m) <= 1000))
     return invalid("goto", robot, "x and y must be in [-1000, 1000] m");
   if (speed_m_s && (!(*speed_m_s > 0) || *speed_m_s > kMaxCommandSpeed_m_s))
     return invalid("goto", robot,
                    "speed " + fmtShort(*speed_m_s) + " m/s is outside (0, " + fmtShort(kMaxCommandSpeed_m_s) + "]");
+  if (!force)
+    if (auto why = outsideSiteMap(robot, x_m, y_m)) return invalid("goto", robot, *why);
   v1::Command c;
   auto* g = c.mutable_go_to();
   auto* p = g->add_points();

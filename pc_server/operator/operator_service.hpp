@@ -112,8 +112,10 @@ class OperatorService {
   Issued estop(uint64_t session, const std::string& robot, int64_t now_ns);
   // Need the robot's control (taken when free).
   Issued resume(uint64_t session, const std::string& robot, int64_t now_ns);
+  /// A goal outside the robot's site map (the box of its walls, in the
+  /// robot's odometry frame) is refused with the map's bounds, unless forced.
   Issued goTo(uint64_t session, const std::string& robot, double x_m, double y_m, std::optional<double> speed_m_s,
-              int64_t now_ns);
+              int64_t now_ns, bool force = false);
   Issued track(uint64_t session, const std::string& robot, const TrackRequest& t, int64_t now_ns);
   Issued ptz(uint64_t session, const std::string& robot, const PtzRequest& p, int64_t now_ns);
   /// The camera stream's settings (no control needed: they move nothing).
@@ -195,6 +197,8 @@ class OperatorService {
   /// send() with a teleop set-point's lease (teleop commands go to CommandSink::setTeleop).
   Issued dispatch(uint64_t session, const std::string& robot, const std::string& action, v1::Command cmd,
                   double lease_s, int64_t now_ns);
+  /// Why (x, y) in the robot's odometry frame is outside its site map; nullopt when inside or no map is known.
+  std::optional<std::string> outsideSiteMap(const std::string& robot, double x_m, double y_m) const;
   /// The robot when named and connected; otherwise the kInvalid result.
   std::optional<CallResult> checkConnected(const std::string& action, const std::string& robot, int64_t now_ns) const;
   static CallResult invalid(const std::string& action, const std::string& robot, std::string reason);

@@ -11,7 +11,7 @@
 #include <map>
 
 #include "pc_server/console/console_clock.hpp"
-#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/operator/stop_flag.hpp"
 #include "shared/util/clock.hpp"
 
 namespace inspect::test {

@@ -17,7 +17,7 @@
 #include <limits>
 
 #include "pc_server/console/console.hpp"
-#include "pc_server/operator/line_reader.hpp"
+#include "pc_server/terminal/line_reader.hpp"
 #include "pc_server/operator/route_file.hpp"
 #include "pc_server/console/status_line.hpp"
 #include "shared/util/clock.hpp"
@@ -509,8 +509,8 @@ TEST_F(ConsoleTest, GotoSyntaxErrorsNameTheProblem) {
     const char* line;
     const char* message;
   };
-  for (const Case& c : {Case{"goto 1", "goto: needs two or three numbers: goto <x_m> <y_m> [speed_m_s]\n"},
-                        Case{"goto 1 2 3 4", "goto: needs two or three numbers: goto <x_m> <y_m> [speed_m_s]\n"},
+  for (const Case& c : {Case{"goto 1", "goto: syntax: goto <x_m> <y_m> [speed_m_s] [force]\n"},
+                        Case{"goto 1 2 3 4", "goto: syntax: goto <x_m> <y_m> [speed_m_s] [force]\n"},
                         Case{"goto a 1", "goto: 'a' is not a number\n"},
                         Case{"goto 1 nan", "goto: 'nan' is not a number\n"},
                         Case{"goto 1 1 2", "goto: speed 2 m/s is outside (0, 1]\n"},

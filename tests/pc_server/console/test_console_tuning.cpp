@@ -9,7 +9,7 @@
 #include "pc_server/link/command_sink.hpp"
 #include "pc_server/console/console.hpp"
 #include "pc_server/link/robot_registry.hpp"
-#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/operator/stop_flag.hpp"
 #include "shared/robot/robot_core.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/net/gains_proto.hpp"

@@ -332,3 +332,24 @@ TEST_F(OperatorServiceTest, AnySessionAcknowledgesAlarmsByNumberOrAll) {
   EXPECT_EQ(rest.acked[0].first.number, 1);
   EXPECT_TRUE(sink_.sent.empty()) << "acknowledging sends the robot nothing";
 }
+
+TEST_F(OperatorServiceTest, AGoalOutsideTheSiteMapIsRefusedWithItsBoundsUnlessForced) {
+  scene::SiteMaps maps;
+  maps.setDefault(inspect::test::srcPath("config/worlds/gas_lab.yaml"));  // walls 10 x 6 m, start (1.2, 1.5)
+  service_.setRunContext(nullptr, &maps);
+  const Issued outside = service_.goTo(alice_, "robot1", 9.0, 9.0, std::nullopt, now_);
+  EXPECT_EQ(done(outside).outcome, CallOutcome::kInvalid);
+  EXPECT_EQ(done(outside).reason,
+            "(9, 9) is outside the site map gas_lab: its walls span x [-1.2, 8.8], y [-1.5, 4.5] m in the robot's "
+            "odometry frame; `goto 9 9 force` sends it anyway");
+  EXPECT_TRUE(sink_.sent.empty()) << "nothing sent";
+  const Issued inside = service_.goTo(alice_, "robot1", 8.0, 4.0, std::nullopt, now_);
+  EXPECT_EQ(pending(inside).action, "goto");
+  const Issued forced = service_.goTo(alice_, "robot1", 9.0, 9.0, std::nullopt, now_, true);
+  EXPECT_EQ(pending(forced).action, "goto");
+  ASSERT_EQ(sink_.sent.size(), 2u);
+  EXPECT_DOUBLE_EQ(sink_.sent[1].second.go_to().points(0).y_m(), 9.0);
+  // No map for the robot: nothing to check against.
+  service_.setRunContext(nullptr, nullptr);
+  EXPECT_EQ(pending(service_.goTo(alice_, "robot1", 50.0, 50.0, std::nullopt, now_)).action, "goto");
+}

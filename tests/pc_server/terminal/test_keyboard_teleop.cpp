@@ -1,8 +1,8 @@
 // Keyboard teleop: step gauge, clamping, the hold-mode deadman, key decoding.
 #include <gtest/gtest.h>
 
-#include "pc_server/operator/key_decoder.hpp"
-#include "pc_server/operator/keyboard_teleop.hpp"
+#include "pc_server/terminal/key_decoder.hpp"
+#include "pc_server/terminal/keyboard_teleop.hpp"
 
 using namespace inspect::server;
 using Key = KeyboardTeleop::Key;

@@ -1,4 +1,4 @@
-#include "pc_server/operator/terminal.hpp"
+#include "pc_server/terminal/terminal.hpp"
 
 #include <sys/ioctl.h>
 #include <unistd.h>

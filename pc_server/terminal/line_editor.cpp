@@ -1,4 +1,4 @@
-#include "pc_server/operator/line_editor.hpp"
+#include "pc_server/terminal/line_editor.hpp"
 
 #include <algorithm>
 #include <utility>

@@ -1,4 +1,4 @@
-#include "pc_server/console/console_runner.hpp"
+#include "pc_server/app/console_runner.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -6,8 +6,8 @@
 #include <iostream>
 
 #include "pc_server/app/cli_options.hpp"
-#include "pc_server/operator/interactive_console.hpp"
-#include "pc_server/operator/line_reader.hpp"
+#include "pc_server/terminal/interactive_console.hpp"
+#include "pc_server/terminal/line_reader.hpp"
 #include "pc_server/console/text_util.hpp"
 
 namespace inspect::server {

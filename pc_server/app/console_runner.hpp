@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "pc_server/console/console.hpp"
-#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/operator/stop_flag.hpp"
 
 namespace inspect::server {
 

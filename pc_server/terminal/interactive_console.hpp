@@ -7,10 +7,10 @@
 #include <string>
 
 #include "pc_server/console/console.hpp"
-#include "pc_server/operator/line_editor.hpp"
-#include "pc_server/operator/line_reader.hpp"
-#include "pc_server/app/stop_flag.hpp"
-#include "pc_server/operator/terminal.hpp"
+#include "pc_server/terminal/line_editor.hpp"
+#include "pc_server/terminal/line_reader.hpp"
+#include "pc_server/operator/stop_flag.hpp"
+#include "pc_server/terminal/terminal.hpp"
 
 namespace inspect::server {
 
@@ -22,7 +22,7 @@ class InteractiveConsole {
 
  private:
   /// Keyboard teleop of `robot_id` until q/Esc, disconnect or stop (the Console's TeleopHandler).
-  bool teleop(KeyboardTeleop::Mode mode, const std::string& robot_id);
+  bool teleop(TeleopMode mode, const std::string& robot_id);
   /// Redraws the status line when its period is due (or `force`).
   void refreshStatus(bool force);
   std::string statusText() const;

@@ -4,7 +4,7 @@
 #include <cstddef>
 #include <string>
 
-#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/operator/stop_flag.hpp"
 
 namespace inspect::server {
 

@@ -1,8 +1,9 @@
-#include "pc_server/operator/interactive_console.hpp"
+#include "pc_server/terminal/interactive_console.hpp"
 
 #include <iostream>
 
-#include "pc_server/operator/key_decoder.hpp"
+#include "pc_server/terminal/key_decoder.hpp"
+#include "pc_server/terminal/keyboard_teleop.hpp"
 #include "pc_server/console/status_line.hpp"
 #include "shared/util/clock.hpp"
 
@@ -70,7 +71,7 @@ LineReader::Result InteractiveConsole::nextLine(std::string& line) {
 void InteractiveConsole::run() {
   const bool tty = term_.isTty();
   if (tty) {
-    console_.setTeleopHandler([this](KeyboardTeleop::Mode m, const std::string& r) { return teleop(m, r); });
+    console_.setTeleopHandler([this](TeleopMode m, const std::string& r) { return teleop(m, r); });
     term_.enableStatusLine();
     term_.enterRawMode();  // keys to the line editor
     console_.setAlarmStyle(true);
@@ -104,18 +105,21 @@ void InteractiveConsole::run() {
   // term_ restores the scroll region and the terminal mode when destroyed.
 }
 
-bool InteractiveConsole::teleop(KeyboardTeleop::Mode mode, const std::string& robot_id) {
+bool InteractiveConsole::teleop(TeleopMode mode, const std::string& robot_id) {
   const auto& opt = console_.options();
   KeyboardTeleop::Params params;
   params.max_v_m_s = opt.max_v_m_s;
   params.max_w_rad_s = opt.max_w_rad_s;
   KeyboardTeleop kt(mode, params);
   KeyDecoder decoder;
-  CommandSink& sink = console_.sink();
+  // Every set-point and the stop go through the operator service: its ranges
+  // and the one-controlling-operator rule hold for the keyboard too.
+  OperatorService& service = console_.service();
+  const uint64_t session = console_.session();
   RobotRegistry& registry = console_.registry();
 
-  std::cout << "teleop " << (mode == KeyboardTeleop::Mode::kStep ? "step" : "hold") << " on " << robot_id << ": "
-            << (mode == KeyboardTeleop::Mode::kStep ? "w/s or Up/Down: v -+0.05 m/s, a/d or Left/Right: w +-0.1 rad/s"
+  std::cout << "teleop " << (mode == TeleopMode::kStep ? "step" : "hold") << " on " << robot_id << ": "
+            << (mode == TeleopMode::kStep ? "w/s or Up/Down: v -+0.05 m/s, a/d or Left/Right: w +-0.1 rad/s"
                                                     : "hold w/s/a/d or arrows to drive (release stops)")
             << "; space: zero; q/Esc: leave\n";
   const bool was_raw = term_.rawMode();  // the line editor's mode: given back as found
@@ -129,8 +133,15 @@ bool InteractiveConsole::teleop(KeyboardTeleop::Mode mode, const std::string& ro
     std::cout.flush();
   };
   auto apply = [&] {
-    last_id = sink.setTeleop(robot_id, kt.v(), kt.w(), 0.0);  // the keyboard's own deadman (hold mode)
-    note = last_id == 0 ? "  (not connected)" : "";
+    // Lease 0: the keyboard's own deadman (hold mode) zeroes the set-point.
+    const Issued issued = service.teleop(session, robot_id, kt.v(), kt.w(), 0.0, monoNowNs());
+    if (const auto* r = std::get_if<CallResult>(&issued)) {
+      last_id = 0;
+      note = "  (" + r->reason + ")";
+    } else {
+      last_id = std::get<PendingCall>(issued).command_id;
+      note = "";
+    }
   };
   gauge();
   bool ok = true;
@@ -176,10 +187,8 @@ bool InteractiveConsole::teleop(KeyboardTeleop::Mode mode, const std::string& ro
     refreshStatus(false);
   }
   // Leaving teleop zeroes the robot at once (Stop also ends the re-send).
-  v1::Command stop;
-  stop.mutable_stop();
-  const bool sent = sink.sendCommand(robot_id, stop) != 0;
-  if (!sent) sink.clearTeleop(robot_id);
+  const bool sent = std::holds_alternative<PendingCall>(service.stop(session, robot_id, monoNowNs()));
+  if (!sent) service.clearTeleop(robot_id);
   if (was_raw) term_.showCursor(true);
   else term_.leaveRawMode();
   std::cout << "\r\x1b[K" << "teleop: left" << (sent ? ", stop sent to " + robot_id : "") << "\n";

@@ -1,4 +1,4 @@
-#include "pc_server/operator/line_reader.hpp"
+#include "pc_server/terminal/line_reader.hpp"
 
 #include <poll.h>
 #include <unistd.h>

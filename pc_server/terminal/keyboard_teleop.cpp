@@ -1,4 +1,4 @@
-#include "pc_server/operator/keyboard_teleop.hpp"
+#include "pc_server/terminal/keyboard_teleop.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -89,13 +89,6 @@ bool KeyboardTeleop::tick(double t_s) {
 std::string KeyboardTeleop::gauge() const {
   return "v " + bar(v(), p_.max_v_m_s) + " " + fmtSigned(v()) + " m/s  w " + bar(w(), p_.max_w_rad_s) + " " +
          fmtSigned(w()) + " rad/s";
-}
-
-bool parseTeleopMode(const std::string& word, KeyboardTeleop::Mode& mode) {
-  if (word == "step") mode = KeyboardTeleop::Mode::kStep;
-  else if (word == "hold") mode = KeyboardTeleop::Mode::kHold;
-  else return false;
-  return true;
 }
 
 }  // namespace inspect::server

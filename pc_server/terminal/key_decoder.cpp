@@ -1,4 +1,4 @@
-#include "pc_server/operator/key_decoder.hpp"
+#include "pc_server/terminal/key_decoder.hpp"
 
 namespace inspect::server {
 

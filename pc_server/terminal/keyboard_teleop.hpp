@@ -5,11 +5,13 @@
 // hold: a key drives at a fixed speed while its auto-repeats keep arriving (deadman).
 #include <string>
 
+#include "pc_server/console/teleop_mode.hpp"
+
 namespace inspect::server {
 
 class KeyboardTeleop {
  public:
-  enum class Mode { kStep, kHold };
+  using Mode = TeleopMode;  // the console's `teleop step|hold`
   enum class Key { kForward, kBack, kLeft, kRight, kZero, kLeave, kOther };
 
   struct Params {
@@ -58,8 +60,5 @@ class KeyboardTeleop {
   double last_key_s_ = 0;
   bool repeat_seen_ = false;
 };
-
-/// Parses a teleop mode word ("step", "hold").
-bool parseTeleopMode(const std::string& word, KeyboardTeleop::Mode& mode);
 
 }  // namespace inspect::server

@@ -1,4 +1,4 @@
-#include "pc_server/app/stop_flag.hpp"
+#include "pc_server/operator/stop_flag.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "pc_server/operator/operator_socket.hpp"
+#include "pc_server/terminal/operator_socket.hpp"
 
 #include <poll.h>
 #include <pwd.h>
@@ -14,7 +14,7 @@
 #include <iostream>
 #include <streambuf>
 
-#include "pc_server/operator/line_reader.hpp"
+#include "pc_server/terminal/line_reader.hpp"
 #include "shared/util/startup_error.hpp"
 #include "shared/util/log.hpp"
 

@@ -1,9 +1,9 @@
 // The console's input line on a raw terminal: editing, history and Tab
 // completion, fed byte by byte as the terminal sends them
-// (pc_server/operator/line_editor.hpp).
+// (pc_server/terminal/line_editor.hpp).
 #include <gtest/gtest.h>
 
-#include "pc_server/operator/line_editor.hpp"
+#include "pc_server/terminal/line_editor.hpp"
 
 using namespace inspect::server;
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "pc_server/operator/keyboard_teleop.hpp"
+#include "pc_server/terminal/keyboard_teleop.hpp"
 
 namespace inspect::server {
 
