@@ -46,6 +46,9 @@ if command -v ccache >/dev/null; then
   # same source in another clone is a hit (the debug info then names the
   # first clone's folder, which only a debugger would notice).
   export CCACHE_BASEDIR=$ROOT CCACHE_NOHASHDIR=1
+  # What ccache needs to cache a unit compiled with a precompiled header
+  # (cmake/InspectPch.cmake): the PCH is hashed, not its macros' text or times.
+  export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
   # This build's own counters (the cache's totals are shared by every build).
   mkdir -p "$DIR"
   export CCACHE_STATSLOG=$ROOT/$DIR/ccache-stats.log

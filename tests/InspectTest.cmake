@@ -44,6 +44,8 @@ set(INSPECT_TEST_COMPILE_OPTIONS ${INSPECT_TEST_OPT})
 if(INSPECT_FUZZ)
   list(APPEND INSPECT_TEST_COMPILE_OPTIONS -fno-sanitize=fuzzer-no-link)
 endif()
+# Their precompiled header, made with these options (cmake/InspectPch.cmake).
+inspect_test_pch_target()
 
 # Paths to the source tree and the programs, for every test program
 # (tests/support/paths.hpp); only paths.cpp sees the absolute paths.
