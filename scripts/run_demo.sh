@@ -5,7 +5,7 @@
 # recorded gas inspection round, alarms, report), then prints what happened.
 #
 #   scripts/run_demo.sh [--interactive|--batch] [--port N] [--foxglove-port N] [--tuning] [--out DIR]
-#                       [--client-config FILE]
+#                       [--client-config FILE] [--rate F]
 #
 # --tuning runs the fuzzy-PID tuning job instead (scripts/demo/tuning.console
 # on config/worlds/tuning_floor.yaml, whose robot has worn, slower motors):
@@ -28,6 +28,9 @@
 # video there (default: a new folder under $TMPDIR); the demo's test reads them.
 # --client-config FILE gives robot_client other settings than config/client.yaml
 # (the demo's test: a sensor timeout for a shared test host, docs/testing.md).
+# --rate F runs the simulated world F times faster than real time (mcu_sim
+# --rate; the robot's loop runs on the MCU's clock, so it controls the same):
+# the demo's test takes 2 to check the same round in less time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${BUILD_DIR:-build}/bin
@@ -37,6 +40,7 @@ MODE=auto
 JOB=gas
 OUT=
 CLIENT_CONFIG=config/client.yaml
+RATE=
 while [ $# -gt 0 ]; do
   case "$1" in
     --interactive) MODE=interactive ;;
@@ -47,7 +51,8 @@ while [ $# -gt 0 ]; do
     --out) OUT=${2:?--out needs a folder}; shift ;;
     --client-config)  # relative to where the script was called from
       CLIENT_CONFIG=${2:?--client-config needs a file}; [ "${CLIENT_CONFIG#/}" != "$CLIENT_CONFIG" ] || CLIENT_CONFIG=$OLDPWD/$CLIENT_CONFIG; shift ;;
-    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
+    --rate) RATE=${2:?--rate needs a factor}; shift ;;
+    -h|--help) sed -n '2,33p' "$0"; exit 0 ;;
     *) echo "run_demo: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -76,6 +81,7 @@ if [ "$JOB" = tuning ]; then
 else
   WORLD=config/worlds/gas_lab.yaml; SCRIPT=scripts/demo/gas_inspection.console; SIM_ARGS=(--people-wait-motion)
 fi
+if [ -n "$RATE" ]; then SIM_ARGS+=(--rate "$RATE"); fi
 # The real-time loops make themselves SCHED_FIFO once started when this user
 # may (root, CAP_SYS_NICE; else a warning in their logs): the simulated MCU
 # at 20, above the robot's control loop (realtime_priority: 10 in
