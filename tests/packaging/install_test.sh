@@ -138,11 +138,18 @@ stop
 wait 1
 expect v ~ 0 0.02 within 2
 expect x ~ 0.6 0.1
+quit
 SCRIPT
-if as_inspect sh -c 'timeout 60 /usr/bin/pc_server --attach /run/inspect/operator.sock < /tmp/drive.console' \
-     > "$ROOT/tmp/drive.out" 2>&1; then drive=0; else drive=1; fi
+# The script through a pipe that stays open while it runs: an attached
+# console's `drive` is leased, and the attach client's keep-alives (only
+# while its input is open) say the operator is there through `wait 2`. An
+# attached session's failed expect does not change the attach client's exit
+# status, so the output is checked: all four expects held.
+if as_inspect sh -c '(cat /tmp/drive.console; sleep 12) | timeout 60 /usr/bin/pc_server --attach /run/inspect/operator.sock' \
+     > "$ROOT/tmp/drive.out" 2>&1 && ! grep -q "EXPECT FAILED" "$ROOT/tmp/drive.out" &&
+   [ "$(grep -c '^expect ok' "$ROOT/tmp/drive.out")" = 4 ]; then drive=0; else drive=1; fi
 cat "$ROOT/tmp/drive.out"
-check "drive through the installed programs" test $drive = 0
+check "drive through the installed programs (4 expects held)" test $drive = 0
 check "the service user made the runs and the catalog" test -f "$ROOT/var/lib/inspect/runs/catalog.sqlite"
 stop_all
 check "nothing left running in the root" sh -c "! for p in /proc/[0-9]*; do [ \"\$(readlink \$p/root 2>/dev/null)\" = '$ROOT' ] && echo \$p; done | grep -q ."
