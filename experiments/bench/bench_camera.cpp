@@ -95,6 +95,61 @@ sim::CameraScene sceneAt(const sim::World& world, int k, int n) {
   return s;
 }
 
+/// Every case at every size: the camera view plain and with noise and blur,
+/// the synthetic source, the frame slot's hand-off; --png's pictures.
+std::vector<Case> runCases(const sim::World& world, const config::RobotConfig& robot, const std::vector<cv::Size>& sizes,
+                           int frames, const std::vector<sim::CameraScene>& scenes, const std::string& png_dir,
+                           std::vector<std::string>& pngs) {
+  const std::string slot_path = "/dev/shm/bench_camera-" + std::to_string(::getpid()) + ".slot";
+  std::vector<Case> cases;
+  for (const auto& sz : sizes) {
+    const std::string tag = std::to_string(sz.width) + "x" + std::to_string(sz.height);
+    sim::CameraView view(world, robot.camera, sz.width, sz.height);
+    cv::Mat frame;
+    cases.push_back(timeFrames("camera view " + tag, sz.width, sz.height, frames, [&](int k) {
+      view.render(scenes[static_cast<std::size_t>(k % frames)], 1000000ull + 33333ull * k, static_cast<uint32_t>(k),
+                  frame);
+    }));
+    // As bench_people draws it: sensor noise (3 grey levels) and motion blur (8 ms exposure).
+    sim::CameraViewStyle real;
+    real.noise_sigma = 3.0;
+    real.exposure_ms = 8.0;
+    sim::CameraView real_view(world, robot.camera, sz.width, sz.height, real);
+    cv::Mat real_frame;
+    cases.push_back(timeFrames("camera view, noise + blur " + tag, sz.width, sz.height, frames, [&](int k) {
+      real_view.render(scenes[static_cast<std::size_t>(k % frames)], 1000000ull + 33333ull * k,
+                       static_cast<uint32_t>(k), real_frame);
+    }));
+    video::SyntheticSource synthetic(sz.width, sz.height);
+    cv::Mat syn;
+    cases.push_back(timeFrames("synthetic source " + tag, sz.width, sz.height, frames, [&](int k) {
+      synthetic.read(syn, 1000000ull + 33333ull * k, static_cast<uint32_t>(k));
+    }));
+    try {
+      video::FrameSlotWriter writer(slot_path, sz.width, sz.height, 30.0);
+      video::FrameSlotReader reader(slot_path);
+      cv::Mat back(sz.height, sz.width, CV_8UC3);
+      uint64_t seq = 0;
+      cases.push_back(timeFrames("frame slot write + read " + tag, sz.width, sz.height, frames, [&](int k) {
+        writer.write(frame.data, frame.step, 1000000ull + 33333ull * k, static_cast<uint32_t>(k));
+        if (const auto f = reader.readNewer(seq, back.data, back.step, std::chrono::milliseconds(100))) seq = f->seq;
+      }));
+    } catch (const video::VideoError& e) {
+      std::fprintf(stderr, "bench_camera: frame slot: %s (case left out)\n", e.what());
+    }
+    if (!png_dir.empty()) {
+      for (int q = 0; q < 4; ++q) {
+        const int k = q * frames / 4;
+        view.render(scenes[static_cast<std::size_t>(k)], 1000000ull + 33333ull * k, static_cast<uint32_t>(k), frame);
+        const std::string file = png_dir + "/camera_" + tag + "_" + std::to_string(q) + ".png";
+        if (cv::imwrite(file, frame)) pngs.push_back(file);
+      }
+    }
+  }
+
+  return cases;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -143,53 +198,8 @@ int main(int argc, char** argv) {
   for (int k = 0; k < frames; ++k) scenes.push_back(sceneAt(world, k, frames));
   if (!png_dir.empty()) std::filesystem::create_directories(png_dir);
 
-  const std::string slot_path = "/dev/shm/bench_camera-" + std::to_string(::getpid()) + ".slot";
-  std::vector<Case> cases;
   std::vector<std::string> pngs;
-  for (const auto& sz : sizes) {
-    const std::string tag = std::to_string(sz.width) + "x" + std::to_string(sz.height);
-    sim::CameraView view(world, robot.camera, sz.width, sz.height);
-    cv::Mat frame;
-    cases.push_back(timeFrames("camera view " + tag, sz.width, sz.height, frames, [&](int k) {
-      view.render(scenes[static_cast<std::size_t>(k % frames)], 1000000ull + 33333ull * k, static_cast<uint32_t>(k),
-                  frame);
-    }));
-    // As bench_people draws it: sensor noise (3 grey levels) and motion blur (8 ms exposure).
-    sim::CameraViewStyle real;
-    real.noise_sigma = 3.0;
-    real.exposure_ms = 8.0;
-    sim::CameraView real_view(world, robot.camera, sz.width, sz.height, real);
-    cv::Mat real_frame;
-    cases.push_back(timeFrames("camera view, noise + blur " + tag, sz.width, sz.height, frames, [&](int k) {
-      real_view.render(scenes[static_cast<std::size_t>(k % frames)], 1000000ull + 33333ull * k,
-                       static_cast<uint32_t>(k), real_frame);
-    }));
-    video::SyntheticSource synthetic(sz.width, sz.height);
-    cv::Mat syn;
-    cases.push_back(timeFrames("synthetic source " + tag, sz.width, sz.height, frames, [&](int k) {
-      synthetic.read(syn, 1000000ull + 33333ull * k, static_cast<uint32_t>(k));
-    }));
-    try {
-      video::FrameSlotWriter writer(slot_path, sz.width, sz.height, 30.0);
-      video::FrameSlotReader reader(slot_path);
-      cv::Mat back(sz.height, sz.width, CV_8UC3);
-      uint64_t seq = 0;
-      cases.push_back(timeFrames("frame slot write + read " + tag, sz.width, sz.height, frames, [&](int k) {
-        writer.write(frame.data, frame.step, 1000000ull + 33333ull * k, static_cast<uint32_t>(k));
-        if (const auto f = reader.readNewer(seq, back.data, back.step, std::chrono::milliseconds(100))) seq = f->seq;
-      }));
-    } catch (const video::VideoError& e) {
-      std::fprintf(stderr, "bench_camera: frame slot: %s (case left out)\n", e.what());
-    }
-    if (!png_dir.empty()) {
-      for (int q = 0; q < 4; ++q) {
-        const int k = q * frames / 4;
-        view.render(scenes[static_cast<std::size_t>(k)], 1000000ull + 33333ull * k, static_cast<uint32_t>(k), frame);
-        const std::string file = png_dir + "/camera_" + tag + "_" + std::to_string(q) + ".png";
-        if (cv::imwrite(file, frame)) pngs.push_back(file);
-      }
-    }
-  }
+  const std::vector<Case> cases = runCases(world, robot, sizes, frames, scenes, png_dir, pngs);
 
   // Table.
   std::size_t obstacle_edges = 0;

@@ -74,6 +74,129 @@ nlohmann::ordered_json numberOrNull(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
 }
 
+struct LoopCase {
+  std::string name;
+  control::WheelControl wc;
+  std::shared_ptr<control::FuzzyGainScheduler> sched;
+};
+
+struct LoopTiming {
+  std::string name;
+  double sim_s = 0;
+  double wall_median_s = 0;
+  double wall_min_s = 0;
+  long ticks = 0;
+};
+
+/// (2) The closed-loop circle experiment (the track_experiment defaults, no
+/// samples kept) with the PID and the fuzzy-PID on either scheduler.
+std::vector<LoopTiming> timeClosedLoops(const config::RobotConfig& robot, const config::ControlConfig& ctl,
+                                        const std::shared_ptr<control::FuzzyGainScheduler>& lookup,
+                                        const std::shared_ptr<control::FuzzyGainScheduler>& direct, int reps) {
+  const std::vector<LoopCase> cases{{"circle, PID", control::WheelControl::kPid, nullptr},
+                                    {"circle, fuzzy-PID (lookup)", control::WheelControl::kFuzzyPid, lookup},
+                                    {"circle, fuzzy-PID (direct)", control::WheelControl::kFuzzyPid, direct}};
+  std::vector<LoopTiming> loops;
+  double checksum = 0;  // keeps the runs observable
+  for (const auto& c : cases) {
+    sim::ClosedLoopConfig cfg;
+    cfg.robot = robot;
+    cfg.tracker = ctl.tracker;
+    cfg.tracker.wheel_control = c.wc;
+    auto once = [&] { return sim::runClosedLoop(cfg, control::makeCircle({0, 0, 0}, 3.5, 0.5), c.sched, false); };
+    const auto warm = once();
+    std::vector<double> wall;
+    for (int r = 0; r < reps; ++r) {
+      const auto t0 = Clock::now();
+      const auto res = once();
+      wall.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      checksum += res.metrics.max_pos_err_m;
+    }
+    std::sort(wall.begin(), wall.end());
+    volatile double sink = checksum;
+    (void)sink;
+    loops.push_back({c.name, warm.metrics.duration_s, wall[wall.size() / 2], wall.front(),
+                     std::lround(warm.metrics.duration_s / cfg.control_dt_s)});
+  }
+  return loops;
+}
+
+/// (1)'s figures: the scheduler's timings and how far the methods differ.
+struct SchedulerFigures {
+  std::string fis_shown;
+  std::size_t rules = 0;
+  int reps = 0;
+  std::vector<Timing> sched;
+  double direct_ns = 0, fl_ns = 0, lookup_err = 0, fl_err = 0;
+  std::string fl_name;
+};
+
+void printTables(const SchedulerFigures& figures, const std::vector<LoopTiming>& loops) {
+  const auto& [fis_shown, rules, reps, sched, direct_ns, fl_ns, lookup_err, fl_err, fl_name] = figures;
+  std::printf("bench_control: %s (%zu rules), %d repetitions, median\n\n", fis_shown.c_str(), rules,
+              reps);
+  std::printf("Fuzzy-PID gain scheduler (Eq 15), one call = scale e/ec, infer kpx/kix/kdx, form kp/ki/kd\n");
+  std::printf("%-56s %10s %10s %12s %14s\n", "method", "ns/call", "min ns", "vs direct", "vs fuzzylite");
+  for (const auto& t : sched) {
+    std::printf("%-56s %10.1f %10.1f %11.2fx", t.name.c_str(), t.median, t.min, direct_ns / t.median);
+    if (std::isfinite(fl_ns))
+      std::printf(" %13.2fx\n", fl_ns / t.median);
+    else
+      std::printf(" %14s\n", "-");
+  }
+  std::printf("'vs X' = X's time / this time (how many times faster than X).\n");
+  std::printf("max |gain difference| lookup vs direct: %.4g; ", lookup_err);
+  if (std::isfinite(fl_err))
+    std::printf("fuzzylite vs direct: %.4g (centroid sampling: 101 points vs fuzzylite's 100)\n", fl_err);
+  else
+    std::printf("%s\n", fl_name.c_str());
+
+  std::printf("\nClosed loop, circle r 3.5 m at 0.5 m/s, control dt 0.01 s, plant dt 0.001 s, noise on\n");
+  std::printf("%-34s %10s %12s %12s %14s %12s\n", "run", "sim s", "wall ms", "min wall ms", "sim s/wall s",
+              "us/tick");
+  for (const auto& l : loops)
+    std::printf("%-34s %10.2f %12.3f %12.3f %14.0f %12.3f\n", l.name.c_str(), l.sim_s, l.wall_median_s * 1e3,
+                l.wall_min_s * 1e3, l.sim_s / l.wall_median_s, l.wall_median_s * 1e6 / static_cast<double>(l.ticks));
+  std::printf("us/tick = wall time per 0.01 s control tick, including 10 plant steps and the noise model.\n");
+
+}
+
+/// The same figures as JSON (--json); false (printed why) when the file cannot be written.
+bool writeJson(const std::string& json_path, const SchedulerFigures& figures, const std::vector<LoopTiming>& loops) {
+  const auto& [fis_shown, rules, reps, sched, direct_ns, fl_ns, lookup_err, fl_err, fl_name] = figures;
+  nlohmann::ordered_json j;
+  j["fis"] = fis_shown;
+  j["rules"] = rules;
+  j["repetitions"] = reps;
+  auto& js = j["scheduler"];
+  js = nlohmann::ordered_json::array();
+  for (const auto& t : sched)
+    js.push_back({{"method", t.name},
+                  {"ns_per_call_median", t.median},
+                  {"ns_per_call_min", t.min},
+                  {"calls_per_repetition", t.calls_per_rep},
+                  {"speedup_vs_direct", direct_ns / t.median},
+                  {"speedup_vs_fuzzylite", numberOrNull(fl_ns / t.median)}});
+  j["max_gain_diff_lookup_vs_direct"] = lookup_err;
+  j["max_gain_diff_fuzzylite_vs_direct"] = numberOrNull(fl_err);
+  auto& jl = j["closed_loop"];
+  jl = nlohmann::ordered_json::array();
+  for (const auto& l : loops)
+    jl.push_back({{"run", l.name},
+                  {"simulated_s", l.sim_s},
+                  {"wall_s_median", l.wall_median_s},
+                  {"wall_s_min", l.wall_min_s},
+                  {"simulated_s_per_wall_s", l.sim_s / l.wall_median_s},
+                  {"us_per_control_tick", l.wall_median_s * 1e6 / static_cast<double>(l.ticks)}});
+  std::ofstream f(json_path);
+  f << j.dump(2) << "\n";
+  if (!f) {
+    std::fprintf(stderr, "bench_control: cannot write %s\n", json_path.c_str());
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -182,103 +305,9 @@ int main(int argc, char** argv) {
   const double direct_ns = sched[0].median;
   const double fl_ns = sched.size() > 2 ? sched[2].median : std::nan("");
 
-  // (2) Closed-loop circle experiment (the track_experiment defaults, no samples kept).
-  struct LoopCase {
-    std::string name;
-    control::WheelControl wc;
-    std::shared_ptr<control::FuzzyGainScheduler> sched;
-  };
-  const std::vector<LoopCase> cases{{"circle, PID", control::WheelControl::kPid, nullptr},
-                                    {"circle, fuzzy-PID (lookup)", control::WheelControl::kFuzzyPid, lookup},
-                                    {"circle, fuzzy-PID (direct)", control::WheelControl::kFuzzyPid, direct}};
-  struct LoopTiming {
-    std::string name;
-    double sim_s = 0;
-    double wall_median_s = 0;
-    double wall_min_s = 0;
-    long ticks = 0;
-  };
-  std::vector<LoopTiming> loops;
-  double checksum = 0;  // keeps the runs observable
-  for (const auto& c : cases) {
-    sim::ClosedLoopConfig cfg;
-    cfg.robot = robot;
-    cfg.tracker = ctl.tracker;
-    cfg.tracker.wheel_control = c.wc;
-    auto once = [&] { return sim::runClosedLoop(cfg, control::makeCircle({0, 0, 0}, 3.5, 0.5), c.sched, false); };
-    const auto warm = once();
-    std::vector<double> wall;
-    for (int r = 0; r < reps; ++r) {
-      const auto t0 = Clock::now();
-      const auto res = once();
-      wall.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
-      checksum += res.metrics.max_pos_err_m;
-    }
-    std::sort(wall.begin(), wall.end());
-    volatile double sink = checksum;
-    (void)sink;
-    loops.push_back({c.name, warm.metrics.duration_s, wall[wall.size() / 2], wall.front(),
-                     std::lround(warm.metrics.duration_s / cfg.control_dt_s)});
-  }
-
-  // Table.
-  std::printf("bench_control: %s (%zu rules), %d repetitions, median\n\n", fis_shown.c_str(), fis.rules.size(),
-              reps);
-  std::printf("Fuzzy-PID gain scheduler (Eq 15), one call = scale e/ec, infer kpx/kix/kdx, form kp/ki/kd\n");
-  std::printf("%-56s %10s %10s %12s %14s\n", "method", "ns/call", "min ns", "vs direct", "vs fuzzylite");
-  for (const auto& t : sched) {
-    std::printf("%-56s %10.1f %10.1f %11.2fx", t.name.c_str(), t.median, t.min, direct_ns / t.median);
-    if (std::isfinite(fl_ns))
-      std::printf(" %13.2fx\n", fl_ns / t.median);
-    else
-      std::printf(" %14s\n", "-");
-  }
-  std::printf("'vs X' = X's time / this time (how many times faster than X).\n");
-  std::printf("max |gain difference| lookup vs direct: %.4g; ", lookup_err);
-  if (std::isfinite(fl_err))
-    std::printf("fuzzylite vs direct: %.4g (centroid sampling: 101 points vs fuzzylite's 100)\n", fl_err);
-  else
-    std::printf("%s\n", fl_name.c_str());
-
-  std::printf("\nClosed loop, circle r 3.5 m at 0.5 m/s, control dt 0.01 s, plant dt 0.001 s, noise on\n");
-  std::printf("%-34s %10s %12s %12s %14s %12s\n", "run", "sim s", "wall ms", "min wall ms", "sim s/wall s",
-              "us/tick");
-  for (const auto& l : loops)
-    std::printf("%-34s %10.2f %12.3f %12.3f %14.0f %12.3f\n", l.name.c_str(), l.sim_s, l.wall_median_s * 1e3,
-                l.wall_min_s * 1e3, l.sim_s / l.wall_median_s, l.wall_median_s * 1e6 / static_cast<double>(l.ticks));
-  std::printf("us/tick = wall time per 0.01 s control tick, including 10 plant steps and the noise model.\n");
-
-  if (!json_path.empty()) {
-    nlohmann::ordered_json j;
-    j["fis"] = fis_shown;
-    j["rules"] = fis.rules.size();
-    j["repetitions"] = reps;
-    auto& js = j["scheduler"];
-    js = nlohmann::ordered_json::array();
-    for (const auto& t : sched)
-      js.push_back({{"method", t.name},
-                    {"ns_per_call_median", t.median},
-                    {"ns_per_call_min", t.min},
-                    {"calls_per_repetition", t.calls_per_rep},
-                    {"speedup_vs_direct", direct_ns / t.median},
-                    {"speedup_vs_fuzzylite", numberOrNull(fl_ns / t.median)}});
-    j["max_gain_diff_lookup_vs_direct"] = lookup_err;
-    j["max_gain_diff_fuzzylite_vs_direct"] = numberOrNull(fl_err);
-    auto& jl = j["closed_loop"];
-    jl = nlohmann::ordered_json::array();
-    for (const auto& l : loops)
-      jl.push_back({{"run", l.name},
-                    {"simulated_s", l.sim_s},
-                    {"wall_s_median", l.wall_median_s},
-                    {"wall_s_min", l.wall_min_s},
-                    {"simulated_s_per_wall_s", l.sim_s / l.wall_median_s},
-                    {"us_per_control_tick", l.wall_median_s * 1e6 / static_cast<double>(l.ticks)}});
-    std::ofstream f(json_path);
-    f << j.dump(2) << "\n";
-    if (!f) {
-      std::fprintf(stderr, "bench_control: cannot write %s\n", json_path.c_str());
-      return 1;
-    }
-  }
+  const std::vector<LoopTiming> loops = timeClosedLoops(robot, ctl, lookup, direct, reps);
+  const SchedulerFigures figures{fis_shown, fis.rules.size(), reps, sched, direct_ns, fl_ns, lookup_err, fl_err, fl_name};
+  printTables(figures, loops);
+  if (!json_path.empty() && !writeJson(json_path, figures, loops)) return 1;
   return 0;
 }

@@ -160,6 +160,87 @@ struct Case {
   uint64_t slow_dropped = 0, slow_queued_kib = 0;
 };
 
+/// One case: its clients connected and subscribed, then `seconds` (20 s for
+/// the client that never reads, to fill its queue) of telemetry and video;
+/// the readers' latencies, the link's call times, the slow client's drops.
+void measureCase(Case& c, uint16_t port, server::foxglove::FoxgloveBridge& bridge, double seconds, bool quick,
+                 std::mutex& call_mu, std::vector<double>& call_us) {
+  std::vector<std::unique_ptr<Client>> clients;
+  for (int i = 0; i < c.clients; ++i) clients.push_back(std::make_unique<Client>(port, true));
+  std::unique_ptr<Client> slow;
+  if (c.slow) slow = std::make_unique<Client>(port, false);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (std::chrono::steady_clock::now() < deadline) {
+    bool all = !slow || slow->subscribed();
+    for (const auto& cl : clients) all = all && cl->subscribed();
+    if (all) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // warm: connections settled
+  for (const auto& cl : clients) cl->reset();
+  {
+    std::lock_guard lk(call_mu);
+    call_us.clear();
+  }
+  // The client that never reads fills its queue (and the kernel's buffers, a few MB) in ~20 s.
+  const double run_s = c.slow && !quick ? std::max(seconds, 20.0) : seconds;
+  std::this_thread::sleep_for(std::chrono::duration<double>(run_s));
+  std::vector<double> lat;
+  uint64_t tel = 0;
+  for (const auto& cl : clients) {
+    const auto l = cl->latenciesMs();
+    lat.insert(lat.end(), l.begin(), l.end());
+    tel += cl->telemetry();
+  }
+  c.p50 = pct(lat, 50);
+  c.p99 = pct(lat, 99);
+  c.max = lat.empty() ? 0 : *std::max_element(lat.begin(), lat.end());
+  c.rate_hz = static_cast<double>(tel) / c.clients / run_s;
+  {
+    std::lock_guard lk(call_mu);
+    c.call_p50_us = pct(call_us, 50);
+    c.call_p99_us = pct(call_us, 99);
+    c.call_max_us = call_us.empty() ? 0 : *std::max_element(call_us.begin(), call_us.end());
+  }
+  if (c.slow)
+    for (const auto& info : bridge.clients())
+      if (info.counters.dropped_data + info.counters.dropped_video + info.counters.skipped_video > c.slow_dropped) {
+        c.slow_dropped = info.counters.dropped_data + info.counters.dropped_video + info.counters.skipped_video;
+        c.slow_queued_kib = info.queued_bytes / 1024;
+      }
+  clients.clear();
+  slow.reset();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the server lets the connections go
+}
+
+/// The table, and the same figures as JSON (--json).
+void report(const std::vector<Case>& cases, double seconds, const std::string& json_path) {
+  const double ref = cases[0].p50 > 0 ? cases[0].p50 : 1;
+  std::printf("bench_foxglove: telemetry 50 Hz + camera 30 fps (8 KB, 40 KB keyframes) through the bridge, %.1f s per case\n\n",
+              seconds);
+  std::printf("%-34s %9s %9s %9s %8s %10s %12s %12s %10s %10s\n", "case", "p50 ms", "p99 ms", "max ms", "vs 1", "tel Hz",
+              "call p99 us", "call max us", "slow drops", "slow KiB");
+  for (const auto& c : cases)
+    std::printf("%-34s %9.3f %9.3f %9.3f %7.2fx %10.1f %12.1f %12.1f %10llu %10llu\n", c.name.c_str(), c.p50, c.p99,
+                c.max, c.p50 / ref, c.rate_hz, c.call_p99_us, c.call_max_us,
+                static_cast<unsigned long long>(c.slow_dropped), static_cast<unsigned long long>(c.slow_queued_kib));
+  std::printf("\nlatency: the link's call into the bridge -> the client has read the message (all reading clients).\n"
+              "vs 1 = p50 / the 1-client p50. tel Hz = telemetry per reading client per second (50 sent).\n"
+              "call = how long the link's call into the bridge took (serialize + queue; never waits for a client).\n"
+              "slow = the client that never reads: messages dropped for it, and its queue at the end (bounded:\n"
+              "512 KiB data + 1 MiB video in this benchmark; the server's defaults are 2 + 4 MiB).\n");
+  if (!json_path.empty()) {
+    Json j{{"seconds", seconds}, {"cases", Json::array()}};
+    for (const auto& c : cases)
+      j["cases"].push_back({{"name", c.name}, {"clients", c.clients}, {"slow_client", c.slow}, {"p50_ms", c.p50},
+                            {"p99_ms", c.p99}, {"max_ms", c.max}, {"p50_vs_1_client", c.p50 / ref},
+                            {"telemetry_hz_per_client", c.rate_hz}, {"call_p50_us", c.call_p50_us},
+                            {"call_p99_us", c.call_p99_us}, {"call_max_us", c.call_max_us},
+                            {"slow_client_dropped", c.slow_dropped}, {"slow_client_queued_kib", c.slow_queued_kib}});
+    std::ofstream(json_path) << j.dump(2) << "\n";
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -243,54 +324,7 @@ int main(int argc, char** argv) {
   });
 
   std::vector<Case> cases{{"1 client", 1, false}, {"10 clients", 10, false}, {"10 clients + 1 that never reads", 10, true}};
-  for (auto& c : cases) {
-    std::vector<std::unique_ptr<Client>> clients;
-    for (int i = 0; i < c.clients; ++i) clients.push_back(std::make_unique<Client>(port, true));
-    std::unique_ptr<Client> slow;
-    if (c.slow) slow = std::make_unique<Client>(port, false);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-    while (std::chrono::steady_clock::now() < deadline) {
-      bool all = !slow || slow->subscribed();
-      for (const auto& cl : clients) all = all && cl->subscribed();
-      if (all) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));  // warm: connections settled
-    for (const auto& cl : clients) cl->reset();
-    {
-      std::lock_guard lk(call_mu);
-      call_us.clear();
-    }
-    // The client that never reads fills its queue (and the kernel's buffers, a few MB) in ~20 s.
-    const double run_s = c.slow && !quick ? std::max(seconds, 20.0) : seconds;
-    std::this_thread::sleep_for(std::chrono::duration<double>(run_s));
-    std::vector<double> lat;
-    uint64_t tel = 0;
-    for (const auto& cl : clients) {
-      const auto l = cl->latenciesMs();
-      lat.insert(lat.end(), l.begin(), l.end());
-      tel += cl->telemetry();
-    }
-    c.p50 = pct(lat, 50);
-    c.p99 = pct(lat, 99);
-    c.max = lat.empty() ? 0 : *std::max_element(lat.begin(), lat.end());
-    c.rate_hz = static_cast<double>(tel) / c.clients / run_s;
-    {
-      std::lock_guard lk(call_mu);
-      c.call_p50_us = pct(call_us, 50);
-      c.call_p99_us = pct(call_us, 99);
-      c.call_max_us = call_us.empty() ? 0 : *std::max_element(call_us.begin(), call_us.end());
-    }
-    if (c.slow)
-      for (const auto& info : bridge.clients())
-        if (info.counters.dropped_data + info.counters.dropped_video + info.counters.skipped_video > c.slow_dropped) {
-          c.slow_dropped = info.counters.dropped_data + info.counters.dropped_video + info.counters.skipped_video;
-          c.slow_queued_kib = info.queued_bytes / 1024;
-        }
-    clients.clear();
-    slow.reset();
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the server lets the connections go
-  }
+  for (auto& c : cases) measureCase(c, port, bridge, seconds, quick, call_mu, call_us);
   feeding = false;
   link.join();
   camera.join();
@@ -299,29 +333,6 @@ int main(int argc, char** argv) {
   ioc.stop();
   for (auto& t : io) t.join();
 
-  const double ref = cases[0].p50 > 0 ? cases[0].p50 : 1;
-  std::printf("bench_foxglove: telemetry 50 Hz + camera 30 fps (8 KB, 40 KB keyframes) through the bridge, %.1f s per case\n\n",
-              seconds);
-  std::printf("%-34s %9s %9s %9s %8s %10s %12s %12s %10s %10s\n", "case", "p50 ms", "p99 ms", "max ms", "vs 1", "tel Hz",
-              "call p99 us", "call max us", "slow drops", "slow KiB");
-  for (const auto& c : cases)
-    std::printf("%-34s %9.3f %9.3f %9.3f %7.2fx %10.1f %12.1f %12.1f %10llu %10llu\n", c.name.c_str(), c.p50, c.p99,
-                c.max, c.p50 / ref, c.rate_hz, c.call_p99_us, c.call_max_us,
-                static_cast<unsigned long long>(c.slow_dropped), static_cast<unsigned long long>(c.slow_queued_kib));
-  std::printf("\nlatency: the link's call into the bridge -> the client has read the message (all reading clients).\n"
-              "vs 1 = p50 / the 1-client p50. tel Hz = telemetry per reading client per second (50 sent).\n"
-              "call = how long the link's call into the bridge took (serialize + queue; never waits for a client).\n"
-              "slow = the client that never reads: messages dropped for it, and its queue at the end (bounded:\n"
-              "512 KiB data + 1 MiB video in this benchmark; the server's defaults are 2 + 4 MiB).\n");
-  if (!json_path.empty()) {
-    Json j{{"seconds", seconds}, {"cases", Json::array()}};
-    for (const auto& c : cases)
-      j["cases"].push_back({{"name", c.name}, {"clients", c.clients}, {"slow_client", c.slow}, {"p50_ms", c.p50},
-                            {"p99_ms", c.p99}, {"max_ms", c.max}, {"p50_vs_1_client", c.p50 / ref},
-                            {"telemetry_hz_per_client", c.rate_hz}, {"call_p50_us", c.call_p50_us},
-                            {"call_p99_us", c.call_p99_us}, {"call_max_us", c.call_max_us},
-                            {"slow_client_dropped", c.slow_dropped}, {"slow_client_queued_kib", c.slow_queued_kib}});
-    std::ofstream(json_path) << j.dump(2) << "\n";
-  }
+  report(cases, seconds, json_path);
   return 0;
 }

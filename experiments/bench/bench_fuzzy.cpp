@@ -64,6 +64,72 @@ Result timeIt(const std::string& name, long calls, int reps, const std::function
   return Result{name, per_call[per_call.size() / 2], per_call.front(), calls};
 }
 
+/// What the table and the JSON report besides the timings.
+struct Figures {
+  std::string fis_path;
+  std::size_t inputs = 0, outputs = 0, rules = 0;
+  int reps = 0;
+  double engine_ns = 0, fl_ns = 0;  // the engine's and fuzzylite's median ns per call (NaN: not built in)
+  std::size_t lookup_points = 0;
+  double surface_error = 0, max_diff_fl = 0;
+};
+
+void printTable(const Figures& f, const std::vector<Result>& results) {
+  const auto& fis_path = f.fis_path;
+  const std::size_t n_in = f.inputs, n_out = f.outputs;
+  const int reps = f.reps;
+  const double engine_ns = f.engine_ns, fl_ns = f.fl_ns, surface_error = f.surface_error, max_diff_fl = f.max_diff_fl;
+  std::printf("bench_fuzzy: %s (%zu inputs, %zu outputs, %zu rules), %d repetitions, median of per-call times\n\n",
+              fis_path.c_str(), n_in, n_out, f.rules, reps);
+  std::printf("%-36s %12s %12s %12s %14s\n", "method", "ns/call", "min ns/call", "vs engine", "vs fuzzylite");
+  for (const auto& r : results) {
+    std::printf("%-36s %12.1f %12.1f %11.2fx", r.name.c_str(), r.median_ns, r.min_ns, engine_ns / r.median_ns);
+    if (std::isfinite(fl_ns)) {
+      std::printf(" %13.2fx\n", fl_ns / r.median_ns);
+    } else {
+      std::printf(" %14s\n", "-");
+    }
+  }
+  std::printf("\n'vs X' = how many times faster than X (X's time / this time).\n");
+  std::printf("lookup surface max |interpolation error| vs direct: %.4g\n", surface_error);
+  if (std::isfinite(max_diff_fl)) {
+    std::printf("max |engine - fuzzylite| on the bench inputs: %.4g (sampling: 101 points vs 100 midpoints)\n", max_diff_fl);
+  } else {
+    std::printf("fuzzylite: not built in (install libfuzzylite-dev and re-run cmake)\n");
+  }
+}
+
+/// The figures as JSON (--json); false (printed why) when the file cannot be written.
+bool writeJson(const std::string& json_path, const Figures& f, const std::vector<Result>& results) {
+  const auto& fis_path = f.fis_path;
+  const int reps = f.reps;
+  const double engine_ns = f.engine_ns, fl_ns = f.fl_ns, surface_error = f.surface_error, max_diff_fl = f.max_diff_fl;
+  std::ofstream js(json_path);
+  if (!js) {
+    std::fprintf(stderr, "bench_fuzzy: cannot write %s\n", json_path.c_str());
+    return false;
+  }
+  auto num = [](double v) {
+    if (!std::isfinite(v)) return std::string("null");
+    char b[64];
+    std::snprintf(b, sizeof b, "%.6g", v);
+    return std::string(b);
+  };
+  js << "{\n  \"fis\": \"" << fis_path << "\",\n  \"repetitions\": " << reps << ",\n  \"results\": [\n";
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const auto& r = results[i];
+    js << "    {\"method\": \"" << r.name << "\", \"ns_per_call_median\": " << num(r.median_ns)
+       << ", \"ns_per_call_min\": " << num(r.min_ns) << ", \"calls_per_repetition\": " << r.calls_per_rep
+       << ", \"speedup_vs_engine\": " << num(engine_ns / r.median_ns)
+       << ", \"speedup_vs_fuzzylite\": " << num(fl_ns / r.median_ns) << "}" << (i + 1 < results.size() ? "," : "")
+       << "\n";
+  }
+  js << "  ],\n  \"lookup_points_per_input\": " << f.lookup_points
+     << ",\n  \"lookup_max_interpolation_error\": " << num(surface_error)
+     << ",\n  \"max_abs_diff_engine_vs_fuzzylite\": " << num(max_diff_fl) << "\n}\n";
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -164,49 +230,10 @@ int main(int argc, char** argv) {
 
   const double engine_ns = results[0].median_ns;
   const double fl_ns = results.size() > 2 ? results[2].median_ns : std::nan("");
-  std::printf("bench_fuzzy: %s (%zu inputs, %zu outputs, %zu rules), %d repetitions, median of per-call times\n\n",
-              fis_path.c_str(), n_in, n_out, fis.rules.size(), reps);
-  std::printf("%-36s %12s %12s %12s %14s\n", "method", "ns/call", "min ns/call", "vs engine", "vs fuzzylite");
-  for (const auto& r : results) {
-    std::printf("%-36s %12.1f %12.1f %11.2fx", r.name.c_str(), r.median_ns, r.min_ns, engine_ns / r.median_ns);
-    if (std::isfinite(fl_ns)) {
-      std::printf(" %13.2fx\n", fl_ns / r.median_ns);
-    } else {
-      std::printf(" %14s\n", "-");
-    }
-  }
-  std::printf("\n'vs X' = how many times faster than X (X's time / this time).\n");
-  std::printf("lookup surface max |interpolation error| vs direct: %.4g\n", surface_error);
-  if (std::isfinite(max_diff_fl)) {
-    std::printf("max |engine - fuzzylite| on the bench inputs: %.4g (sampling: 101 points vs 100 midpoints)\n", max_diff_fl);
-  } else {
-    std::printf("fuzzylite: not built in (install libfuzzylite-dev and re-run cmake)\n");
-  }
+  const Figures figures{fis_path, n_in, n_out, fis.rules.size(), reps, engine_ns, fl_ns, surface->pointsPerInput(),
+                        surface_error, max_diff_fl};
+  printTable(figures, results);
 
-  if (!json_path.empty()) {
-    std::ofstream js(json_path);
-    if (!js) {
-      std::fprintf(stderr, "bench_fuzzy: cannot write %s\n", json_path.c_str());
-      return 2;
-    }
-    auto num = [](double v) {
-      if (!std::isfinite(v)) return std::string("null");
-      char b[64];
-      std::snprintf(b, sizeof b, "%.6g", v);
-      return std::string(b);
-    };
-    js << "{\n  \"fis\": \"" << fis_path << "\",\n  \"repetitions\": " << reps << ",\n  \"results\": [\n";
-    for (std::size_t i = 0; i < results.size(); ++i) {
-      const auto& r = results[i];
-      js << "    {\"method\": \"" << r.name << "\", \"ns_per_call_median\": " << num(r.median_ns)
-         << ", \"ns_per_call_min\": " << num(r.min_ns) << ", \"calls_per_repetition\": " << r.calls_per_rep
-         << ", \"speedup_vs_engine\": " << num(engine_ns / r.median_ns)
-         << ", \"speedup_vs_fuzzylite\": " << num(fl_ns / r.median_ns) << "}" << (i + 1 < results.size() ? "," : "")
-         << "\n";
-    }
-    js << "  ],\n  \"lookup_points_per_input\": " << surface->pointsPerInput()
-       << ",\n  \"lookup_max_interpolation_error\": " << num(surface_error)
-       << ",\n  \"max_abs_diff_engine_vs_fuzzylite\": " << num(max_diff_fl) << "\n}\n";
-  }
+  if (!json_path.empty() && !writeJson(json_path, figures, results)) return 2;
   return 0;
 }

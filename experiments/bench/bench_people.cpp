@@ -40,10 +40,12 @@
 #include "shared/world/world.hpp"
 #include "sim/camera_view.hpp"
 #include "tests/support/paths.hpp"
+#include "experiments/bench/bench_people_figures.hpp"
 
 namespace {
 
 using namespace inspect;
+using namespace inspect::bench_people;
 using Clock = std::chrono::steady_clock;
 using geometry::Vec2;
 constexpr double kPi = 3.14159265358979323846;
@@ -162,59 +164,9 @@ double iou(const cv::Rect& a, const cv::Rect& b) {
   return un > 0 ? i / un : 0.0;
 }
 
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
-}
 
-// Recall in bins of one quantity.
-struct Bins {
-  std::string name;
-  std::vector<double> edges;  // bin i: [edges[i], edges[i+1])
-  std::vector<std::string> labels;
-  std::vector<int> found, total;
-  void init() {
-    found.assign(labels.size(), 0);
-    total.assign(labels.size(), 0);
-  }
-  void add(double v, bool hit) {
-    for (std::size_t i = 0; i + 1 < edges.size(); ++i)
-      if (v >= edges[i] && v < edges[i + 1]) {
-        ++total[i];
-        if (hit) ++found[i];
-        return;
-      }
-  }
-};
 
-struct Case {
-  std::string detector, settings;
-  int width = 0, height = 0, frames = 0;
-  int truths = 0, found = 0, boxes = 0, false_boxes = 0;
-  std::vector<double> bearing_err_deg, range_err_pct, range_signed_pct, ms;
-  double cpu_ms = 0;
-  Bins by_distance{"distance m", {1, 2, 3, 4, 6, 8, 11}, {"1-2", "2-3", "3-4", "4-6", "6-8", "8-10"}, {}, {}};
-  Bins by_bearing{"|bearing| deg", {0, 10, 20, 40}, {"0-10", "10-20", "20-33"}, {}, {}};
-  Bins by_visible{"visible", {0.3, 0.6, 0.9, 1.01}, {"30-60%", "60-90%", "90-100%"}, {}, {}};
-  // The arena's detector model is calibrated from these two (sim/detector_model).
-  Bins by_distance_clear{"distance m (90-100% visible)", {1, 2, 3, 4, 6, 8, 11}, {"1-2", "2-3", "3-4", "4-6", "6-8", "8-10"}, {}, {}};
-  Bins by_distance_part{"distance m (30-90% visible)", {1, 2, 3, 4, 6, 8, 11}, {"1-2", "2-3", "3-4", "4-6", "6-8", "8-10"}, {}, {}};
-  Bins by_view{"view", {0, 45, 135, 181}, {"front", "side", "back"}, {}, {}};
-  Bins by_motion{"motion", {0, 0.1, 10}, {"standing", "walking"}, {}, {}};
-  std::vector<Bins*> all() {
-    return {&by_distance, &by_bearing, &by_visible, &by_view, &by_motion, &by_distance_clear, &by_distance_part};
-  }
-  double recall() const { return truths ? static_cast<double>(found) / truths : NAN; }
-  double precision() const { return boxes ? static_cast<double>(boxes - false_boxes) / boxes : NAN; }
-};
 
-struct VideoCase {
-  std::string detector;
-  int width = 0, height = 0, frames = 0;
-  double boxes_per_frame = 0, frames_with_box_pct = 0;
-  std::vector<double> ms;
-};
 
 void drawBoxes(cv::Mat& pic, const std::vector<sim::PersonTruth>* truth, const std::vector<perception::PersonBox>& found) {
   if (truth)
@@ -223,75 +175,66 @@ void drawBoxes(cv::Mat& pic, const std::vector<sim::PersonTruth>* truth, const s
   for (const auto& d : found) cv::rectangle(pic, d.box, cv::Scalar(0, 0, 255), 2);
 }
 
-nlohmann::ordered_json numberOrNull(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr; }
 
-std::string cell(double v, const char* fmt) {
-  if (!std::isfinite(v)) return "-";
-  char b[32];
-  std::snprintf(b, sizeof b, fmt, v);
-  return b;
-}
 
-}  // namespace
 
-int main(int argc, char** argv) {
-  std::vector<cv::Size> sizes{{320, 240}, {640, 480}};
-  std::vector<std::string> wanted;
-  std::string json_path, png_dir, video_path;
+/// The command line, with --quick's and the footage's defaults applied.
+Options parseOptions(int argc, char** argv) {
+  Options o;
   bool video_given = false, quick = false, frames_given = false, sizes_given = false;
-  int frames = 300, video_frames = 120, threads = 1;
-  uint64_t seed = 1;
-  double noise = 3.0, exposure_ms = 8.0, tilt_deg = 0.0;
   cli::readOrExit("bench_people", argc, argv, [&](cli::ArgReader& a) {
     if (a.isHelp()) {
       std::fputs(kUsage, stdout);
       std::exit(0);
     } else if (a.is("--frames")) {
-      frames = static_cast<int>(a.integer(1, 100000));
+      o.frames = static_cast<int>(a.integer(1, 100000));
       frames_given = true;
     } else if (a.is("--sizes")) {
-      sizes.clear();
-      for (const auto& [w, h] : a.pictureSizes()) sizes.emplace_back(w, h);
+      o.sizes.clear();
+      for (const auto& [w, h] : a.pictureSizes()) o.sizes.emplace_back(w, h);
       sizes_given = true;
     } else if (a.is("--detectors")) {
-      wanted = a.list();
+      o.wanted = a.list();
     } else if (a.is("--seed")) {
-      seed = a.unsignedInteger(0xFFFFFFFFull);
+      o.seed = a.unsignedInteger(0xFFFFFFFFull);
     } else if (a.is("--noise")) {
-      noise = a.number(0, 50);
+      o.noise = a.number(0, 50);
     } else if (a.is("--exposure-ms")) {
-      exposure_ms = a.number(0, 100);
+      o.exposure_ms = a.number(0, 100);
     } else if (a.is("--tilt-deg")) {
-      tilt_deg = a.number(-30, 30);
+      o.tilt_deg = a.number(-30, 30);
     } else if (a.is("--video")) {
-      video_path = a.text();
+      o.video_path = a.text();
       video_given = true;
     } else if (a.is("--video-frames")) {
-      video_frames = static_cast<int>(a.integer(0, 100000));
+      o.video_frames = static_cast<int>(a.integer(0, 100000));
     } else if (a.is("--threads")) {
-      threads = static_cast<int>(a.integer(1, 64));
+      o.threads = static_cast<int>(a.integer(1, 64));
     } else if (a.is("--png")) {
-      png_dir = a.path();
+      o.png_dir = a.path();
     } else if (a.is("--json")) {
-      json_path = a.path();
+      o.json_path = a.path();
     } else if (a.is("--quick")) {
       quick = true;
     } else {
       a.unknown();
     }
   });
-  // One thread, as the robot gives it (OpenCV's HOG and cascades otherwise spread over every core).
-  cv::setNumThreads(threads);
   if (quick) {
-    if (!frames_given) frames = 24;
-    if (!sizes_given) sizes = {{320, 240}};
-    if (wanted.empty()) wanted = {"hog", "haar-full"};
-    if (!video_given) video_frames = 0;
+    if (!frames_given) o.frames = 24;
+    if (!sizes_given) o.sizes = {{320, 240}};
+    if (o.wanted.empty()) o.wanted = {"hog", "haar-full"};
+    if (!video_given) o.video_frames = 0;
   }
   const std::string kVtest = "/usr/share/doc/opencv-doc/examples/data/vtest.avi";
-  if (!video_given && std::filesystem::exists(kVtest)) video_path = kVtest;
+  if (!video_given && std::filesystem::exists(kVtest)) o.video_path = kVtest;
+  return o;
+}
 
-  // NAME or NAME:key=value:... (thr, step, up, group) to try other settings of one detector.
+/// The detectors asked for: NAME or NAME:key=value:... (thr, step, up, group)
+/// to try other settings of one; every one when none is named. nullopt
+/// (printed why) on a name or setting that is not known.
+std::optional<std::vector<DetectorSpec>> detectorSpecs(const std::vector<std::string>& wanted) {
   std::vector<DetectorSpec> specs;
   if (wanted.empty()) specs = catalog();
   for (const auto& w : wanted) {
@@ -301,7 +244,7 @@ int main(int argc, char** argv) {
     if (it == cat.end()) {
       std::fprintf(stderr, "bench_people: --detectors: '%s' is not one of hog, hog-fast, hog-x2, daimler, haar-full, haar-upper\n",
                    base.c_str());
-      return 2;
+      return std::nullopt;
     }
     DetectorSpec d = *it;
     d.name = w;
@@ -316,7 +259,7 @@ int main(int argc, char** argv) {
           (key != "thr" && key != "step" && key != "up" && key != "group")) {
         std::fprintf(stderr, "bench_people: --detectors: '%s' in '%s' is not thr=, step=, up= or group= with a number\n",
                      kv.c_str(), w.c_str());
-        return 2;
+        return std::nullopt;
       }
       if (key == "thr") d.opt.hit_threshold = v;
       if (key == "step") d.opt.scale_step = v;
@@ -326,33 +269,78 @@ int main(int argc, char** argv) {
     }
     specs.push_back(d);
   }
+  return specs;
+}
 
-  std::vector<sim::World> worlds;
-  config::RobotConfig robot;
-  try {
-    for (const char* name : {"warehouse", "narrow_aisle", "gas_lab", "square_room"})
-      worlds.push_back(sim::loadWorldFile(test::srcPath(std::string("config/worlds/") + name + ".yaml")));
-    robot = config::loadRobotConfigFile(test::srcPath("config/robot.yaml"));
-  } catch (const config::ConfigError& e) {
-    std::fprintf(stderr, "bench_people: %s\n", e.what());
-    return 2;
+/// One picture's boxes against its truth: greedy matching, strongest box
+/// first (IoU >= 0.3; upper-body boxes against the figure's top 35 %), the
+/// bearing and range errors of the matches, and the recall bins.
+void scoreFrame(Case& c, const std::vector<perception::PersonBox>& found, const std::vector<sim::PersonTruth>& truth,
+                const Frame& fr, const perception::CameraPose& cam) {
+  std::vector<std::size_t> order(found.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return found[a].score > found[b].score; });
+  std::vector<bool> taken(truth.size(), false);
+  for (const std::size_t i : order) {
+    const auto& d = found[i];
+    ++c.boxes;
+    double best = 0.3;
+    int who = -1;
+    for (std::size_t t = 0; t < truth.size(); ++t) {
+      if (taken[t] || truth[t].box.empty()) continue;
+      cv::Rect ref = truth[t].box;
+      if (d.upper_body) ref.height = std::max(1, static_cast<int>(std::lround(0.35 * truth[t].full_box.height)));
+      const double o = iou(d.box, ref);
+      if (o >= best) {
+        best = o;
+        who = static_cast<int>(t);
+      }
+    }
+    if (who < 0) {
+      ++c.false_boxes;
+      continue;
+    }
+    taken[static_cast<std::size_t>(who)] = true;
+    const auto& t = truth[static_cast<std::size_t>(who)];
+    if (t.visible < 0.3) continue;  // neither found nor false
+    // What the robot computes (shared/perception/camera_geometry), against the camera model's truth.
+    const perception::Sighting seen = perception::sightingOf(d.box, cam);
+    c.bearing_err_deg.push_back(std::abs(std::remainder(seen.bearing_rad - t.bearing_rad, 2 * kPi)) * kDeg);
+    if (!d.upper_body && t.feet_in_view && seen.range_m) {
+      c.range_err_pct.push_back(100.0 * std::abs(*seen.range_m - t.distance_m) / t.distance_m);
+      c.range_signed_pct.push_back(100.0 * (*seen.range_m - t.distance_m) / t.distance_m);
+    }
   }
-  std::mt19937_64 rng(seed);
-  std::vector<Frame> scenes;
-  for (int k = 0; k < frames; ++k) {
-    scenes.push_back(makeScene(worlds, robot.camera, rng, k));
-    scenes.back().scene.tilt_rad = tilt_deg / kDeg;
+  for (std::size_t t = 0; t < truth.size(); ++t) {
+    const auto& p = truth[t];
+    if (p.visible < 0.3 || p.box.empty()) continue;
+    ++c.truths;
+    if (taken[t]) ++c.found;
+    const bool hit = taken[t];
+    c.by_distance.add(p.distance_m, hit);
+    c.by_bearing.add(std::abs(p.bearing_rad) * kDeg, hit);
+    c.by_visible.add(p.visible, hit);
+    c.by_view.add(std::abs(p.view_rad) * kDeg, hit);
+    double speed = 0;
+    for (const auto& q : fr.scene.people)
+      if (q.index == p.index) speed = q.speed_m_s;
+    c.by_motion.add(speed, hit);
+    (p.visible >= 0.9 ? c.by_distance_clear : c.by_distance_part).add(p.distance_m, hit);
   }
-  if (!png_dir.empty()) std::filesystem::create_directories(png_dir);
+}
 
+/// The simulated pictures: every detector at every size it takes, scored
+/// against the camera model's truth. Annotated pictures of the first
+/// detector go to --png.
+std::vector<Case> runSynthetic(const Options& o, const std::vector<DetectorSpec>& specs,
+                               const std::vector<sim::World>& worlds, const config::RobotConfig& robot,
+                               const std::vector<Frame>& scenes, std::vector<std::string>& pngs) {
   sim::CameraViewStyle style;
-  style.look_seed = static_cast<uint32_t>(seed);
-  style.noise_sigma = noise;
-  style.exposure_ms = exposure_ms;
-
+  style.look_seed = static_cast<uint32_t>(o.seed);
+  style.noise_sigma = o.noise;
+  style.exposure_ms = o.exposure_ms;
   std::vector<Case> cases;
-  std::vector<std::string> pngs;
-  for (const auto& sz : sizes) {
+  for (const auto& sz : o.sizes) {
     // One view per world at this size.
     std::vector<sim::CameraView> views;
     for (const auto& w : worlds) views.emplace_back(w, robot.camera, sz.width, sz.height, style);
@@ -374,7 +362,7 @@ int main(int argc, char** argv) {
       for (auto* b : c.all()) b->init();
       cv::Mat pic;
       double cpu = 0;
-      for (int k = 0; k < frames; ++k) {
+      for (int k = 0; k < o.frames; ++k) {
         const Frame& fr = scenes[static_cast<std::size_t>(k)];
         auto& view = views[static_cast<std::size_t>(k) % worlds.size()];
         view.render(fr.scene, 1000000ull + 33333ull * static_cast<uint64_t>(k), static_cast<uint32_t>(k), pic);
@@ -385,68 +373,17 @@ int main(int argc, char** argv) {
         cpu += util::threadCpuMs() - cpu0;
         c.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         ++c.frames;
-        // Greedy matching, strongest box first.
-        std::vector<std::size_t> order(found.size());
-        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-        std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return found[a].score > found[b].score; });
-        std::vector<bool> taken(truth.size(), false);
         perception::CameraPose cam;
         cam.width = sz.width;
         cam.height = sz.height;
         cam.mount = robot.camera;
         cam.tilt_rad = fr.scene.tilt_rad;
-        for (const std::size_t i : order) {
-          const auto& d = found[i];
-          ++c.boxes;
-          double best = 0.3;
-          int who = -1;
-          for (std::size_t t = 0; t < truth.size(); ++t) {
-            if (taken[t] || truth[t].box.empty()) continue;
-            cv::Rect ref = truth[t].box;
-            if (d.upper_body) ref.height = std::max(1, static_cast<int>(std::lround(0.35 * truth[t].full_box.height)));
-            const double o = iou(d.box, ref);
-            if (o >= best) {
-              best = o;
-              who = static_cast<int>(t);
-            }
-          }
-          if (who < 0) {
-            ++c.false_boxes;
-            continue;
-          }
-          taken[static_cast<std::size_t>(who)] = true;
-          const auto& t = truth[static_cast<std::size_t>(who)];
-          if (t.visible < 0.3) continue;  // neither found nor false
-          // What the robot computes (shared/perception/camera_geometry), against the camera model's truth.
-          const perception::Sighting seen = perception::sightingOf(d.box, cam);
-          c.bearing_err_deg.push_back(std::abs(std::remainder(seen.bearing_rad - t.bearing_rad, 2 * kPi)) * kDeg);
-          if (!d.upper_body && t.feet_in_view && seen.range_m)
-          {
-            c.range_err_pct.push_back(100.0 * std::abs(*seen.range_m - t.distance_m) / t.distance_m);
-            c.range_signed_pct.push_back(100.0 * (*seen.range_m - t.distance_m) / t.distance_m);
-          }
-        }
-        for (std::size_t t = 0; t < truth.size(); ++t) {
-          const auto& p = truth[t];
-          if (p.visible < 0.3 || p.box.empty()) continue;
-          ++c.truths;
-          if (taken[t]) ++c.found;
-          const bool hit = taken[t];
-          c.by_distance.add(p.distance_m, hit);
-          c.by_bearing.add(std::abs(p.bearing_rad) * kDeg, hit);
-          c.by_visible.add(p.visible, hit);
-          c.by_view.add(std::abs(p.view_rad) * kDeg, hit);
-          double speed = 0;
-          for (const auto& q : fr.scene.people)
-            if (q.index == p.index) speed = q.speed_m_s;
-          c.by_motion.add(speed, hit);
-          (p.visible >= 0.9 ? c.by_distance_clear : c.by_distance_part).add(p.distance_m, hit);
-        }
-        if (!png_dir.empty() && (k % std::max(1, frames / 4)) == 0 && &spec == &specs.front()) {
+        scoreFrame(c, found, truth, fr, cam);
+        if (!o.png_dir.empty() && (k % std::max(1, o.frames / 4)) == 0 && &spec == &specs.front()) {
           cv::Mat shown = pic.clone();
           drawBoxes(shown, &truth, found);
-          const std::string file = png_dir + "/people_" + std::to_string(sz.width) + "x" + std::to_string(sz.height) +
-                                   "_" + spec.name + "_" + std::to_string(k) + ".png";
+          const std::string file = o.png_dir + "/people_" + std::to_string(sz.width) + "x" +
+                                   std::to_string(sz.height) + "_" + spec.name + "_" + std::to_string(k) + ".png";
           if (cv::imwrite(file, shown)) pngs.push_back(file);
         }
       }
@@ -454,170 +391,98 @@ int main(int argc, char** argv) {
       cases.push_back(std::move(c));
     }
   }
+  return cases;
+}
 
-  // Real footage: no truth, detections per frame.
+/// Real footage (no truth): boxes per frame at full and half size. nullopt
+/// (printed why) when no frame of the file can be read.
+std::optional<std::vector<VideoCase>> runFootage(const Options& o, const std::vector<DetectorSpec>& specs,
+                                                 std::vector<std::string>& pngs) {
   std::vector<VideoCase> vcases;
-  if (!video_path.empty() && video_frames > 0) {
-    cv::VideoCapture cap(video_path);
-    std::vector<cv::Mat> clip;
-    cv::Mat m;
-    while (static_cast<int>(clip.size()) < video_frames && cap.read(m)) clip.push_back(m.clone());
-    if (clip.empty()) {
-      std::fprintf(stderr, "bench_people: --video %s: no frame could be read\n", video_path.c_str());
-      return 1;
-    }
-    for (const double scale : {1.0, 0.5}) {
-      for (const auto& spec : specs) {
-        if (spec.name == "hog-x2" && scale == 1.0) continue;
-        std::optional<perception::PeopleDetector> det;
-        try {
-          det.emplace(spec.opt);
-        } catch (const std::exception&) {
-          continue;
+  if (o.video_path.empty() || o.video_frames <= 0) return vcases;
+  cv::VideoCapture cap(o.video_path);
+  std::vector<cv::Mat> clip;
+  cv::Mat m;
+  while (static_cast<int>(clip.size()) < o.video_frames && cap.read(m)) clip.push_back(m.clone());
+  if (clip.empty()) {
+    std::fprintf(stderr, "bench_people: --video %s: no frame could be read\n", o.video_path.c_str());
+    return std::nullopt;
+  }
+  for (const double scale : {1.0, 0.5}) {
+    for (const auto& spec : specs) {
+      if (spec.name == "hog-x2" && scale == 1.0) continue;
+      std::optional<perception::PeopleDetector> det;
+      try {
+        det.emplace(spec.opt);
+      } catch (const std::exception&) {
+        continue;
+      }
+      VideoCase v;
+      v.detector = spec.name;
+      int with_box = 0;
+      uint64_t boxes = 0;
+      for (std::size_t i = 0; i < clip.size(); ++i) {
+        cv::Mat in;
+        if (scale != 1.0)
+          cv::resize(clip[i], in, cv::Size(), scale, scale, cv::INTER_AREA);
+        else
+          in = clip[i];
+        v.width = in.cols;
+        v.height = in.rows;
+        const auto t0 = Clock::now();
+        const auto found = det->detect(in);
+        v.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+        boxes += found.size();
+        if (!found.empty()) ++with_box;
+        if (!o.png_dir.empty() && (i == 0 || i == clip.size() / 2)) {
+          cv::Mat shown = in.clone();
+          drawBoxes(shown, nullptr, found);
+          const std::string file = o.png_dir + "/vtest_" + std::to_string(in.cols) + "_" + spec.name + "_" +
+                                   std::to_string(i) + ".png";
+          if (cv::imwrite(file, shown)) pngs.push_back(file);
         }
-        VideoCase v;
-        v.detector = spec.name;
-        int with_box = 0;
-        uint64_t boxes = 0;
-        for (std::size_t i = 0; i < clip.size(); ++i) {
-          cv::Mat in;
-          if (scale != 1.0)
-            cv::resize(clip[i], in, cv::Size(), scale, scale, cv::INTER_AREA);
-          else
-            in = clip[i];
-          v.width = in.cols;
-          v.height = in.rows;
-          const auto t0 = Clock::now();
-          const auto found = det->detect(in);
-          v.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-          boxes += found.size();
-          if (!found.empty()) ++with_box;
-          if (!png_dir.empty() && (i == 0 || i == clip.size() / 2)) {
-            cv::Mat shown = in.clone();
-            drawBoxes(shown, nullptr, found);
-            const std::string file = png_dir + "/vtest_" + std::to_string(in.cols) + "_" + spec.name + "_" +
-                                     std::to_string(i) + ".png";
-            if (cv::imwrite(file, shown)) pngs.push_back(file);
-          }
-        }
-        v.frames = static_cast<int>(clip.size());
-        v.boxes_per_frame = static_cast<double>(boxes) / v.frames;
-        v.frames_with_box_pct = 100.0 * with_box / v.frames;
-        vcases.push_back(std::move(v));
       }
+      v.frames = static_cast<int>(clip.size());
+      v.boxes_per_frame = static_cast<double>(boxes) / v.frames;
+      v.frames_with_box_pct = 100.0 * with_box / v.frames;
+      vcases.push_back(std::move(v));
     }
   }
+  return vcases;
+}
 
-  // Tables.
-  std::printf("bench_people: %d pictures per case, seed %llu, noise %.1f grey levels, exposure %.0f ms; worlds warehouse,\n"
-              "narrow_aisle, gas_lab, square_room; camera %.0f deg wide at %.2f m, tilt %+.0f deg; OpenCV threads %d\n\n",
-              frames, static_cast<unsigned long long>(seed), noise, exposure_ms, robot.camera.hfov_deg, robot.camera.z_m,
-              tilt_deg, threads);
-  std::printf("| size | detector | people | recall | precision | false / picture | bearing err p50 / p90 deg | "
-              "range err p50 / p90 %% | ms p50 / p90 | CPU ms |\n|---|---|---|---|---|---|---|---|---|---|\n");
-  for (const auto& c : cases)
-    std::printf("| %dx%d | %s | %d | %s | %s | %s | %s / %s | %s / %s | %s / %s | %.1f |\n", c.width, c.height,
-                c.detector.c_str(), c.truths, cell(100 * c.recall(), "%.1f %%").c_str(),
-                cell(100 * c.precision(), "%.1f %%").c_str(),
-                cell(static_cast<double>(c.false_boxes) / std::max(1, c.frames), "%.3f").c_str(),
-                cell(quantile(c.bearing_err_deg, 0.5), "%.2f").c_str(), cell(quantile(c.bearing_err_deg, 0.9), "%.2f").c_str(),
-                cell(quantile(c.range_err_pct, 0.5), "%.1f").c_str(), cell(quantile(c.range_err_pct, 0.9), "%.1f").c_str(),
-                cell(quantile(c.ms, 0.5), "%.1f").c_str(), cell(quantile(c.ms, 0.9), "%.1f").c_str(), c.cpu_ms);
-  if (!cases.empty()) {
-    Case& first = cases.front();
-    for (std::size_t b = 0; b < first.all().size(); ++b) {
-      const Bins& head = *first.all()[b];
-      std::printf("\nrecall by %s (found / people)\n| size | detector |", head.name.c_str());
-      for (const auto& l : head.labels) std::printf(" %s |", l.c_str());
-      std::printf("\n|---|---|");
-      for (std::size_t i = 0; i < head.labels.size(); ++i) std::printf("---|");
-      std::printf("\n");
-      for (auto& c : cases) {
-        const Bins& bn = *c.all()[b];
-        std::printf("| %dx%d | %s |", c.width, c.height, c.detector.c_str());
-        for (std::size_t i = 0; i < bn.labels.size(); ++i)
-          std::printf(" %s (%d/%d) |", cell(bn.total[i] ? 100.0 * bn.found[i] / bn.total[i] : NAN, "%.0f %%").c_str(),
-                      bn.found[i], bn.total[i]);
-        std::printf("\n");
-      }
-    }
-  }
-  std::printf("\nrange from the foot row, signed (long > 0): p10 / p50 / p90 %%\n| size | detector | p10 | p50 | p90 |\n"
-              "|---|---|---|---|---|\n");
-  for (const auto& c : cases)
-    std::printf("| %dx%d | %s | %s | %s | %s |\n", c.width, c.height, c.detector.c_str(),
-                cell(quantile(c.range_signed_pct, 0.1), "%+.1f").c_str(),
-                cell(quantile(c.range_signed_pct, 0.5), "%+.1f").c_str(),
-                cell(quantile(c.range_signed_pct, 0.9), "%+.1f").c_str());
-  if (!vcases.empty()) {
-    std::printf("\nreal footage: %s (%d frames; no truth: boxes per frame, frames with a box)\n"
-                "| size | detector | boxes / frame | frames with a box | ms p50 / p90 |\n|---|---|---|---|---|\n",
-                video_path.c_str(), vcases.front().frames);
-    for (const auto& v : vcases)
-      std::printf("| %dx%d | %s | %.2f | %.1f %% | %.1f / %.1f |\n", v.width, v.height, v.detector.c_str(), v.boxes_per_frame,
-                  v.frames_with_box_pct, quantile(v.ms, 0.5), quantile(v.ms, 0.9));
-  }
-  std::printf("\nrecall = people found / people at least 30 %% visible (IoU >= 0.3 with the figure's box; upper-body\n"
-              "boxes against its top 35 %%). bearing err: box centre column through the intrinsics against the\n"
-              "body axis. range err: the box's bottom row as the feet on a flat floor (lens height, horizon)\n"
-              "against the true distance, where the feet are in the picture.\n");
-  for (const auto& p : pngs) std::printf("picture: %s\n", p.c_str());
+}  // namespace
 
-  if (!json_path.empty()) {
-    nlohmann::ordered_json j;
-    j["pictures_per_case"] = frames;
-    j["seed"] = seed;
-    j["noise_sigma"] = noise;
-    j["exposure_ms"] = exposure_ms;
-    j["tilt_deg"] = tilt_deg;
-    j["opencv_threads"] = threads;
-    auto& jc = j["cases"];
-    jc = nlohmann::ordered_json::array();
-    for (auto& c : cases) {
-      nlohmann::ordered_json o{{"size", std::to_string(c.width) + "x" + std::to_string(c.height)},
-                               {"detector", c.detector},
-                               {"settings", c.settings},
-                               {"people", c.truths},
-                               {"found", c.found},
-                               {"boxes", c.boxes},
-                               {"false_boxes", c.false_boxes},
-                               {"recall", numberOrNull(c.recall())},
-                               {"precision", numberOrNull(c.precision())},
-                               {"false_per_picture", static_cast<double>(c.false_boxes) / std::max(1, c.frames)},
-                               {"bearing_err_deg_p50", numberOrNull(quantile(c.bearing_err_deg, 0.5))},
-                               {"bearing_err_deg_p90", numberOrNull(quantile(c.bearing_err_deg, 0.9))},
-                               {"range_err_pct_p50", numberOrNull(quantile(c.range_err_pct, 0.5))},
-                               {"range_err_pct_p90", numberOrNull(quantile(c.range_err_pct, 0.9))},
-                               {"range_signed_pct_p10", numberOrNull(quantile(c.range_signed_pct, 0.1))},
-                               {"range_signed_pct_p50", numberOrNull(quantile(c.range_signed_pct, 0.5))},
-                               {"range_signed_pct_p90", numberOrNull(quantile(c.range_signed_pct, 0.9))},
-                               {"ms_p50", numberOrNull(quantile(c.ms, 0.5))},
-                               {"ms_p90", numberOrNull(quantile(c.ms, 0.9))},
-                               {"cpu_ms", c.cpu_ms}};
-      for (auto* b : c.all()) {
-        auto& jb = o["recall_by_" + b->name];
-        for (std::size_t i = 0; i < b->labels.size(); ++i)
-          jb[b->labels[i]] = {{"found", b->found[i]}, {"people", b->total[i]}};
-      }
-      jc.push_back(std::move(o));
-    }
-    auto& jv = j["video"];
-    jv = nlohmann::ordered_json::array();
-    for (const auto& v : vcases)
-      jv.push_back({{"file", video_path},
-                    {"size", std::to_string(v.width) + "x" + std::to_string(v.height)},
-                    {"detector", v.detector},
-                    {"frames", v.frames},
-                    {"boxes_per_frame", v.boxes_per_frame},
-                    {"frames_with_box_pct", v.frames_with_box_pct},
-                    {"ms_p50", numberOrNull(quantile(v.ms, 0.5))},
-                    {"ms_p90", numberOrNull(quantile(v.ms, 0.9))}});
-    std::ofstream out(json_path);
-    out << j.dump(2) << "\n";
-    if (!out) {
-      std::fprintf(stderr, "bench_people: cannot write %s\n", json_path.c_str());
-      return 1;
-    }
+int main(int argc, char** argv) {
+  const Options o = parseOptions(argc, argv);
+  // One thread, as the robot gives it (OpenCV's HOG and cascades otherwise spread over every core).
+  cv::setNumThreads(o.threads);
+  const auto specs = detectorSpecs(o.wanted);
+  if (!specs) return 2;
+
+  std::vector<sim::World> worlds;
+  config::RobotConfig robot;
+  try {
+    for (const char* name : {"warehouse", "narrow_aisle", "gas_lab", "square_room"})
+      worlds.push_back(sim::loadWorldFile(test::srcPath(std::string("config/worlds/") + name + ".yaml")));
+    robot = config::loadRobotConfigFile(test::srcPath("config/robot.yaml"));
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "bench_people: %s\n", e.what());
+    return 2;
   }
+  std::mt19937_64 rng(o.seed);
+  std::vector<Frame> scenes;
+  for (int k = 0; k < o.frames; ++k) {
+    scenes.push_back(makeScene(worlds, robot.camera, rng, k));
+    scenes.back().scene.tilt_rad = o.tilt_deg / kDeg;
+  }
+  if (!o.png_dir.empty()) std::filesystem::create_directories(o.png_dir);
+
+  std::vector<std::string> pngs;
+  std::vector<Case> cases = runSynthetic(o, *specs, worlds, robot, scenes, pngs);
+  const auto vcases = runFootage(o, *specs, pngs);
+  if (!vcases) return 1;
+  printTables(o, robot, cases, *vcases, pngs);
+  if (!o.json_path.empty() && !writeJson(o, cases, *vcases)) return 1;
   return 0;
 }

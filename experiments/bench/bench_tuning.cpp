@@ -87,6 +87,83 @@ nlohmann::ordered_json gainsJson(const control::GainSet& g) {
   return j;
 }
 
+/// Throughput and the tuning runs, for people.
+void printTables(const tuning::TuneSetup& setup, const std::string& plant_name, int hw, const std::vector<Rate>& rates,
+                 const std::vector<Tuning>& tunings, int evals, int threads) {
+  std::printf("bench_tuning: %s, plant %s, %d variation(s) x %d seed(s) = %d runs per evaluation, %d hardware threads\n\n",
+              setup.reference.describe().c_str(), plant_name.c_str(), setup.plant_variations, setup.seeds,
+              setup.plant_variations * setup.seeds, hw);
+  std::printf("Throughput (evaluations of the paper's gains, fuzzy-PID, lookup surface)\n");
+  std::printf("%-10s %10s %10s %10s %12s %12s %10s\n", "threads", "evals", "wall s", "cpu s", "runs/s", "evals/s",
+              "speed-up");
+  for (const auto& r : rates)
+    std::printf("%-10d %10d %10.3f %10.3f %12.1f %12.2f %9.2fx\n", r.threads, r.evals, r.wall_s, r.cpu_s, r.runsPerS(),
+                r.evalsPerS(), r.runsPerS() / rates.front().runsPerS());
+  std::printf("cpu s = CPU time of the process over all threads: on an idle machine wall ~ cpu / threads.\n");
+  std::printf("\nTuning from the paper's gains, %d evaluations max, %d thread(s), global share %.2f\n", evals, threads,
+              setup.global_fraction);
+  std::printf("%-28s %8s %10s %10s %12s %12s %12s\n", "algorithm", "evals", "wall s", "cpu s", "initial cost",
+              "best cost", "improvement");
+  for (const auto& t : tunings) {
+    const auto& r = t.result;
+    std::printf("%-28s %8d %10.2f %10.2f %12.3f %12.3f %11.1f%%\n", t.algorithm.c_str(), r.evals, r.wall_s, t.cpu_s,
+                r.initial_eval.cost, r.best_eval.cost, 100.0 * (1.0 - r.best_eval.cost / r.initial_eval.cost));
+  }
+  const auto& best = std::min_element(tunings.begin(), tunings.end(), [](const Tuning& a, const Tuning& b) {
+                       return a.result.best_eval.cost < b.result.best_eval.cost;
+                     })->result;
+  std::printf("best gains (%s):", best.algorithm.c_str());
+  for (const char* name : control::kGainNames) std::printf(" %s %.4g", name, control::gainValue(best.best, name));
+  std::printf("\nnominal run with them: max pos %.4f m, max ang %.4f rad, conv pos %.2f s, conv ang %.2f s "
+              "(paper gains: %.4f m, %.4f rad, %.2f s, %.2f s)\n",
+              best.best_eval.nominal.max_pos_err_m, best.best_eval.nominal.max_ang_err_rad,
+              best.best_eval.nominal.converge_pos_s, best.best_eval.nominal.converge_ang_s,
+              best.initial_eval.nominal.max_pos_err_m, best.initial_eval.nominal.max_ang_err_rad,
+              best.initial_eval.nominal.converge_pos_s, best.initial_eval.nominal.converge_ang_s);
+}
+
+/// The same figures as JSON (--json); false (printed why) when the file cannot be written.
+bool writeJson(const std::string& json_path, const tuning::TuneSetup& setup, const std::string& plant_name, int hw, const std::vector<Rate>& rates,
+                 const std::vector<Tuning>& tunings, int evals, int threads) {
+  nlohmann::ordered_json j;
+  j["reference"] = setup.reference.describe();
+  j["plant"] = plant_name;
+  j["plant_variations"] = setup.plant_variations;
+  j["seeds"] = setup.seeds;
+  j["runs_per_evaluation"] = setup.plant_variations * setup.seeds;
+  j["hardware_threads"] = hw;
+  auto& jr = j["throughput"];
+  jr = nlohmann::ordered_json::array();
+  for (const auto& r : rates)
+    jr.push_back({{"threads", r.threads},
+                  {"evaluations", r.evals},
+                  {"wall_s", r.wall_s},
+                  {"cpu_s", r.cpu_s},
+                  {"runs_per_s", r.runsPerS()},
+                  {"evaluations_per_s", r.evalsPerS()},
+                  {"speedup", r.runsPerS() / rates.front().runsPerS()}});
+  auto& jt = j["tuning"];
+  jt = nlohmann::ordered_json::array();
+  for (const auto& t : tunings)
+    jt.push_back({{"algorithm", t.algorithm},
+                  {"max_evals", evals},
+                  {"threads", threads},
+                  {"evaluations", t.result.evals},
+                  {"wall_s", t.result.wall_s},
+                  {"cpu_s", t.cpu_s},
+                  {"initial_cost", t.result.initial_eval.cost},
+                  {"best_cost", t.result.best_eval.cost},
+                  {"improvement", 1.0 - t.result.best_eval.cost / t.result.initial_eval.cost},
+                  {"best_gains", gainsJson(t.result.best)}});
+  std::ofstream f(json_path);
+  f << j.dump(2) << "\n";
+  if (!f) {
+    std::fprintf(stderr, "bench_tuning: cannot write %s\n", json_path.c_str());
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -186,74 +263,7 @@ int main(int argc, char** argv) {
   }
 
   const int hw = static_cast<int>(std::thread::hardware_concurrency());
-  std::printf("bench_tuning: %s, plant %s, %d variation(s) x %d seed(s) = %d runs per evaluation, %d hardware threads\n\n",
-              setup.reference.describe().c_str(), plant_name.c_str(), setup.plant_variations, setup.seeds,
-              setup.plant_variations * setup.seeds, hw);
-  std::printf("Throughput (evaluations of the paper's gains, fuzzy-PID, lookup surface)\n");
-  std::printf("%-10s %10s %10s %10s %12s %12s %10s\n", "threads", "evals", "wall s", "cpu s", "runs/s", "evals/s",
-              "speed-up");
-  for (const auto& r : rates)
-    std::printf("%-10d %10d %10.3f %10.3f %12.1f %12.2f %9.2fx\n", r.threads, r.evals, r.wall_s, r.cpu_s, r.runsPerS(),
-                r.evalsPerS(), r.runsPerS() / rates.front().runsPerS());
-  std::printf("cpu s = CPU time of the process over all threads: on an idle machine wall ~ cpu / threads.\n");
-  std::printf("\nTuning from the paper's gains, %d evaluations max, %d thread(s), global share %.2f\n", evals, threads,
-              setup.global_fraction);
-  std::printf("%-28s %8s %10s %10s %12s %12s %12s\n", "algorithm", "evals", "wall s", "cpu s", "initial cost",
-              "best cost", "improvement");
-  for (const auto& t : tunings) {
-    const auto& r = t.result;
-    std::printf("%-28s %8d %10.2f %10.2f %12.3f %12.3f %11.1f%%\n", t.algorithm.c_str(), r.evals, r.wall_s, t.cpu_s,
-                r.initial_eval.cost, r.best_eval.cost, 100.0 * (1.0 - r.best_eval.cost / r.initial_eval.cost));
-  }
-  const auto& best = std::min_element(tunings.begin(), tunings.end(), [](const Tuning& a, const Tuning& b) {
-                       return a.result.best_eval.cost < b.result.best_eval.cost;
-                     })->result;
-  std::printf("best gains (%s):", best.algorithm.c_str());
-  for (const char* name : control::kGainNames) std::printf(" %s %.4g", name, control::gainValue(best.best, name));
-  std::printf("\nnominal run with them: max pos %.4f m, max ang %.4f rad, conv pos %.2f s, conv ang %.2f s "
-              "(paper gains: %.4f m, %.4f rad, %.2f s, %.2f s)\n",
-              best.best_eval.nominal.max_pos_err_m, best.best_eval.nominal.max_ang_err_rad,
-              best.best_eval.nominal.converge_pos_s, best.best_eval.nominal.converge_ang_s,
-              best.initial_eval.nominal.max_pos_err_m, best.initial_eval.nominal.max_ang_err_rad,
-              best.initial_eval.nominal.converge_pos_s, best.initial_eval.nominal.converge_ang_s);
-
-  if (!json_path.empty()) {
-    nlohmann::ordered_json j;
-    j["reference"] = setup.reference.describe();
-    j["plant"] = plant_name;
-    j["plant_variations"] = setup.plant_variations;
-    j["seeds"] = setup.seeds;
-    j["runs_per_evaluation"] = setup.plant_variations * setup.seeds;
-    j["hardware_threads"] = hw;
-    auto& jr = j["throughput"];
-    jr = nlohmann::ordered_json::array();
-    for (const auto& r : rates)
-      jr.push_back({{"threads", r.threads},
-                    {"evaluations", r.evals},
-                    {"wall_s", r.wall_s},
-                    {"cpu_s", r.cpu_s},
-                    {"runs_per_s", r.runsPerS()},
-                    {"evaluations_per_s", r.evalsPerS()},
-                    {"speedup", r.runsPerS() / rates.front().runsPerS()}});
-    auto& jt = j["tuning"];
-    jt = nlohmann::ordered_json::array();
-    for (const auto& t : tunings)
-      jt.push_back({{"algorithm", t.algorithm},
-                    {"max_evals", evals},
-                    {"threads", threads},
-                    {"evaluations", t.result.evals},
-                    {"wall_s", t.result.wall_s},
-                    {"cpu_s", t.cpu_s},
-                    {"initial_cost", t.result.initial_eval.cost},
-                    {"best_cost", t.result.best_eval.cost},
-                    {"improvement", 1.0 - t.result.best_eval.cost / t.result.initial_eval.cost},
-                    {"best_gains", gainsJson(t.result.best)}});
-    std::ofstream f(json_path);
-    f << j.dump(2) << "\n";
-    if (!f) {
-      std::fprintf(stderr, "bench_tuning: cannot write %s\n", json_path.c_str());
-      return 1;
-    }
-  }
+  printTables(setup, plant_name, hw, rates, tunings, evals, threads);
+  if (!json_path.empty() && !writeJson(json_path, setup, plant_name, hw, rates, tunings, evals, threads)) return 1;
   return 0;
 }

@@ -81,6 +81,174 @@ struct TruthPattern {
   }
 };
 
+/// The scenario's task as the robot's command (id 1).
+v1::Command taskCommand(const ScenarioSpec& spec) {
+  v1::Command cmd;
+  cmd.set_id(1);
+  switch (spec.task.kind) {
+    case ScenarioTask::Kind::kLine: {
+      auto* t = cmd.mutable_track();
+      t->mutable_line()->set_length_m(spec.task.length_m);
+      t->mutable_line()->set_speed_m_s(spec.task.speed_m_s);
+      t->set_controller(spec.task.controller);
+      break;
+    }
+    case ScenarioTask::Kind::kCircle: {
+      auto* t = cmd.mutable_track();
+      t->mutable_circle()->set_radius_m(spec.task.radius_m);
+      t->mutable_circle()->set_speed_m_s(spec.task.speed_m_s);
+      t->mutable_circle()->set_laps(spec.task.laps);
+      t->set_controller(spec.task.controller);
+      break;
+    }
+    case ScenarioTask::Kind::kGoTo: {
+      auto* g = cmd.mutable_go_to();
+      for (const auto& [x, y] : spec.task.points_m) {
+        auto* p = g->add_points();
+        p->set_x_m(x);
+        p->set_y_m(y);
+      }
+      g->set_speed_m_s(spec.task.speed_m_s);
+      g->set_name(spec.name);
+      break;
+    }
+  }
+  return cmd;
+}
+
+/// What the simulation's truth says tick by tick (docs/scenarios.md): path,
+/// speed, stop and slowest point, jerk, the nearest person and the zones,
+/// the true against the reported pattern; and the series when kept.
+struct TruthTally {
+  explicit TruthTally(const behavior::AwarenessConfig& acfg, const control::Pose2& start)
+      : truth{behavior::PatternClassifier(acfg.pattern)}, last_pose(start) {}
+  TruthPattern truth;
+  std::array<uint64_t, 5> pattern_counts{};
+  uint64_t pattern_ticks = 0, pattern_hits = 0;
+  bool moved = false;
+  control::Pose2 last_pose;
+  double jerk_v[3] = {0, 0, 0};
+  int jerk_n = 0;
+  double next_jerk_t = 0.0;
+  std::map<std::size_t, std::size_t> person_index;  // crowd index -> people_paths index
+  double next_person_t = 0.0;
+  behavior::Pattern last_pattern = behavior::Pattern::kNone;
+
+  /// One tick at `t` (after the core's): into run's metrics (and series).
+  void tick(ScenarioRun& run, const Simulation& sim, const behavior::HumanAwareness& awareness,
+            const ScenarioContext& ctx, const RunOptions& opt, double avoid_m, double t);
+};
+
+void TruthTally::tick(ScenarioRun& run, const Simulation& sim, const behavior::HumanAwareness& awareness,
+                      const ScenarioContext& ctx, const RunOptions& opt, double avoid_m, double t) {
+  RunMetrics& m = run.metrics;
+  const double body = ctx.robot.geometry.body_radius_m;
+  const auto& crowd = sim.pedestrians();
+  const auto& st = sim.state();
+  m.path_length_m += std::hypot(st.pose.x_m - last_pose.x_m, st.pose.y_m - last_pose.y_m);
+  last_pose = st.pose;
+  const double v = 0.5 * ctx.robot.geometry.wheel_radius_m * (st.wheel.left_rad_s + st.wheel.right_rad_s);
+  if (std::abs(v) > kMovingSpeed_m_s) moved = true;
+  if (moved && m.stop_s < 0 && m.detect_s >= 0 && std::abs(v) < kStopSpeed_m_s) m.stop_s = t;
+  if (moved && m.detect_s >= 0 && !m.completed && (m.slowest_m_s < 0 || std::abs(v) < m.slowest_m_s)) {
+    m.slowest_m_s = std::abs(v);
+    m.slowest_s = t;
+  }
+  if (t >= next_jerk_t) {  // speed every 0.1 s -> acceleration -> jerk
+    next_jerk_t += kJerkSample_s;
+    jerk_v[0] = jerk_v[1];
+    jerk_v[1] = jerk_v[2];
+    jerk_v[2] = v;
+    if (++jerk_n >= 3) {
+      const double j = (jerk_v[2] - 2 * jerk_v[1] + jerk_v[0]) / (kJerkSample_s * kJerkSample_s);
+      if (t > kJerkSkip_s) m.max_jerk_m_s3 = std::max(m.max_jerk_m_s3, std::abs(j));
+    }
+  }
+  const behavior::Agent* nearest = nullptr;
+  double nearest_m = -1, nearest_gap = -1;
+  for (std::size_t i = 0; i < crowd.size(); ++i) {
+    if (!crowd.present(i)) continue;
+    const auto& a = crowd.agent(i);
+    const double d = std::hypot(a.position_m.x() - st.pose.x_m, a.position_m.y() - st.pose.y_m);
+    if (nearest_m < 0 || d < nearest_m) {
+      nearest_m = d;
+      nearest_gap = d - body - a.radius_m;
+      nearest = &a;
+    }
+    if (opt.keep_series && t >= next_person_t) {
+      auto it = person_index.find(i);
+      if (it == person_index.end()) {
+        it = person_index.emplace(i, run.people_paths.size()).first;
+        run.people_paths.push_back({std::string(crowd.script(i).id), {}, {}, {}});
+      }
+      auto& pp = run.people_paths[it->second];
+      pp.t_s.push_back(t);
+      pp.x_m.push_back(a.position_m.x());
+      pp.y_m.push_back(a.position_m.y());
+    }
+  }
+  if (opt.keep_series && t >= next_person_t) next_person_t += 0.1;
+  if (nearest) {
+    if (m.min_person_m < 0 || nearest_m < m.min_person_m) m.min_person_m = nearest_m;
+    if (m.min_gap_m < 0 || nearest_gap < m.min_gap_m) m.min_gap_m = nearest_gap;
+    if (nearest_m < kIntimate_m) m.intimate_s += 0.01;
+    if (nearest_m < kPersonal_m) m.personal_s += 0.01;
+    if (m.enter_avoidance_s < 0 && nearest_m < avoid_m) m.enter_avoidance_s = t;
+  }
+  const behavior::Pattern tp = truth.step(st.pose, nearest && nearest_m < avoid_m ? nearest : nullptr, 0.01);
+  const auto& a = awareness.last();
+  if (a.person && m.detect_s < 0) m.detect_s = t;
+  m.min_speed_factor = std::min(m.min_speed_factor, a.speed_factor);
+  if (a.pattern != last_pattern) {
+    ++m.pattern_switches;
+    last_pattern = a.pattern;
+  }
+  if (nearest && nearest_m < avoid_m && inSomeCone(ctx.robot.ultrasonic, st.pose, *nearest)) {
+    m.visible_s += 0.01;
+    if (!a.person) m.missed_s += 0.01;
+  }
+  if (nearest && nearest_m < avoid_m && a.person) {
+    ++pattern_ticks;
+    pattern_hits += a.pattern == tp ? 1 : 0;
+    ++pattern_counts[static_cast<std::size_t>(a.pattern)];
+  }
+  if (opt.keep_series)
+    run.series.push_back({t, st.pose.x_m, st.pose.y_m, st.pose.theta_rad, v, nearest_m,
+                          a.person ? a.distance_m : -1.0, a.speed_factor, static_cast<int>(a.pattern),
+                          static_cast<int>(tp)});
+
+}
+
+/// The run's last figures: duration, the automaton's switches, contacts,
+/// pattern accuracy and the dominant pattern, false tracks, and why it failed.
+void finishMetrics(ScenarioRun& run, const TruthTally& tally, const Simulation& sim, robot::RobotCore& core,
+                   const behavior::HumanAwareness& awareness, const ScenarioSpec& spec) {
+  RunMetrics& m = run.metrics;
+  m.duration_s = sim.timeS();
+  {
+    v1::Telemetry tl;  // the navigation automaton's switches (kept after COMPLETED)
+    core.fillTelemetry(tl, m.duration_s);
+    m.mode_switches += tl.nav_switches();
+  }
+  m.person_collisions = sim.personCollisions();
+  m.wall_collisions = sim.collisions();
+  if (tally.pattern_ticks > 0) m.pattern_accuracy = static_cast<double>(tally.pattern_hits) / static_cast<double>(tally.pattern_ticks);
+  uint64_t best = 0;
+  for (std::size_t i = 1; i < tally.pattern_counts.size(); ++i)
+    if (tally.pattern_counts[i] > best) {
+      best = tally.pattern_counts[i];
+      m.dominant_pattern = std::string(behavior::toString(static_cast<behavior::Pattern>(i)));
+    }
+  if (m.dominant_pattern.empty()) m.dominant_pattern = "none";
+  m.false_tracks = awareness.tracker().counters().tracks_unconfirmed_dropped;
+  if (m.failure.empty()) {
+    if (!m.completed) m.failure = "not completed within " + std::to_string(static_cast<int>(spec.time_limit_s)) + " s";
+    else if (m.person_collisions > 0) m.failure = std::to_string(m.person_collisions) + " collision(s) with people";
+    else if (m.wall_collisions > 0) m.failure = std::to_string(m.wall_collisions) + " collision(s) with walls";
+  }
+  m.success = m.failure.empty();
+}
+
 }  // namespace
 
 std::string ScenarioTask::describe() const {
@@ -172,52 +340,12 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
     sim.receive(f.span());
   };
 
-  v1::Command cmd;
-  cmd.set_id(1);
-  switch (spec.task.kind) {
-    case ScenarioTask::Kind::kLine: {
-      auto* t = cmd.mutable_track();
-      t->mutable_line()->set_length_m(spec.task.length_m);
-      t->mutable_line()->set_speed_m_s(spec.task.speed_m_s);
-      t->set_controller(spec.task.controller);
-      break;
-    }
-    case ScenarioTask::Kind::kCircle: {
-      auto* t = cmd.mutable_track();
-      t->mutable_circle()->set_radius_m(spec.task.radius_m);
-      t->mutable_circle()->set_speed_m_s(spec.task.speed_m_s);
-      t->mutable_circle()->set_laps(spec.task.laps);
-      t->set_controller(spec.task.controller);
-      break;
-    }
-    case ScenarioTask::Kind::kGoTo: {
-      auto* g = cmd.mutable_go_to();
-      for (const auto& [x, y] : spec.task.points_m) {
-        auto* p = g->add_points();
-        p->set_x_m(x);
-        p->set_y_m(y);
-      }
-      g->set_speed_m_s(spec.task.speed_m_s);
-      g->set_name(spec.name);
-      break;
-    }
-  }
+  const v1::Command cmd = taskCommand(spec);
 
-  const double body = ctx.robot.geometry.body_radius_m;
   const double avoid_m = acfg.speed.max_avoidance_m;
-  const auto& crowd = sim.pedestrians();
-  TruthPattern truth{behavior::PatternClassifier(acfg.pattern)};
-  std::array<uint64_t, 5> pattern_counts{};
-  uint64_t pattern_ticks = 0, pattern_hits = 0;
-  bool sent = false, moved = false;
+  TruthTally tally(acfg, sim.state().pose);
+  bool sent = false;
   double cmd_time = -1;
-  control::Pose2 last_pose = sim.state().pose;
-  double jerk_v[3] = {0, 0, 0};
-  int jerk_n = 0;
-  double next_jerk_t = 0.0;
-  std::map<std::size_t, std::size_t> person_index;  // crowd index -> people_paths index
-  double next_person_t = 0.0;
-  behavior::Pattern last_pattern = behavior::Pattern::kNone;
   const uint64_t limit_ms = static_cast<uint64_t>(spec.time_limit_s * 1000.0);
 
   for (uint64_t t_ms = Simulation::kFramePeriod_ms; t_ms <= limit_ms; t_ms += Simulation::kFramePeriod_ms) {
@@ -252,80 +380,7 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
         m.time_to_goal_s = t - cmd_time;
       }
 
-    // --- ground truth ---
-    const auto& st = sim.state();
-    m.path_length_m += std::hypot(st.pose.x_m - last_pose.x_m, st.pose.y_m - last_pose.y_m);
-    last_pose = st.pose;
-    const double v = 0.5 * ctx.robot.geometry.wheel_radius_m * (st.wheel.left_rad_s + st.wheel.right_rad_s);
-    if (std::abs(v) > kMovingSpeed_m_s) moved = true;
-    if (moved && m.stop_s < 0 && m.detect_s >= 0 && std::abs(v) < kStopSpeed_m_s) m.stop_s = t;
-    if (moved && m.detect_s >= 0 && !m.completed && (m.slowest_m_s < 0 || std::abs(v) < m.slowest_m_s)) {
-      m.slowest_m_s = std::abs(v);
-      m.slowest_s = t;
-    }
-    if (t >= next_jerk_t) {  // speed every 0.1 s -> acceleration -> jerk
-      next_jerk_t += kJerkSample_s;
-      jerk_v[0] = jerk_v[1];
-      jerk_v[1] = jerk_v[2];
-      jerk_v[2] = v;
-      if (++jerk_n >= 3) {
-        const double j = (jerk_v[2] - 2 * jerk_v[1] + jerk_v[0]) / (kJerkSample_s * kJerkSample_s);
-        if (t > kJerkSkip_s) m.max_jerk_m_s3 = std::max(m.max_jerk_m_s3, std::abs(j));
-      }
-    }
-    const behavior::Agent* nearest = nullptr;
-    double nearest_m = -1, nearest_gap = -1;
-    for (std::size_t i = 0; i < crowd.size(); ++i) {
-      if (!crowd.present(i)) continue;
-      const auto& a = crowd.agent(i);
-      const double d = std::hypot(a.position_m.x() - st.pose.x_m, a.position_m.y() - st.pose.y_m);
-      if (nearest_m < 0 || d < nearest_m) {
-        nearest_m = d;
-        nearest_gap = d - body - a.radius_m;
-        nearest = &a;
-      }
-      if (opt.keep_series && t >= next_person_t) {
-        auto it = person_index.find(i);
-        if (it == person_index.end()) {
-          it = person_index.emplace(i, run.people_paths.size()).first;
-          run.people_paths.push_back({std::string(crowd.script(i).id), {}, {}, {}});
-        }
-        auto& pp = run.people_paths[it->second];
-        pp.t_s.push_back(t);
-        pp.x_m.push_back(a.position_m.x());
-        pp.y_m.push_back(a.position_m.y());
-      }
-    }
-    if (opt.keep_series && t >= next_person_t) next_person_t += 0.1;
-    if (nearest) {
-      if (m.min_person_m < 0 || nearest_m < m.min_person_m) m.min_person_m = nearest_m;
-      if (m.min_gap_m < 0 || nearest_gap < m.min_gap_m) m.min_gap_m = nearest_gap;
-      if (nearest_m < kIntimate_m) m.intimate_s += 0.01;
-      if (nearest_m < kPersonal_m) m.personal_s += 0.01;
-      if (m.enter_avoidance_s < 0 && nearest_m < avoid_m) m.enter_avoidance_s = t;
-    }
-    const behavior::Pattern tp = truth.step(st.pose, nearest && nearest_m < avoid_m ? nearest : nullptr, 0.01);
-    const auto& a = aw->last();
-    if (a.person && m.detect_s < 0) m.detect_s = t;
-    m.min_speed_factor = std::min(m.min_speed_factor, a.speed_factor);
-    if (a.pattern != last_pattern) {
-      ++m.pattern_switches;
-      last_pattern = a.pattern;
-    }
-    if (nearest && nearest_m < avoid_m && inSomeCone(ctx.robot.ultrasonic, st.pose, *nearest)) {
-      m.visible_s += 0.01;
-      if (!a.person) m.missed_s += 0.01;
-    }
-    if (nearest && nearest_m < avoid_m && a.person) {
-      ++pattern_ticks;
-      pattern_hits += a.pattern == tp ? 1 : 0;
-      ++pattern_counts[static_cast<std::size_t>(a.pattern)];
-    }
-    if (opt.keep_series)
-      run.series.push_back({t, st.pose.x_m, st.pose.y_m, st.pose.theta_rad, v, nearest_m,
-                            a.person ? a.distance_m : -1.0, a.speed_factor, static_cast<int>(a.pattern),
-                            static_cast<int>(tp)});
-
+    tally.tick(run, sim, *aw, ctx, opt, avoid_m, t);
     if (opt.observer) opt.observer->afterTick(sim, *aw, t);
     if (m.completed) break;
     if (core.mode() == v1::FAILSAFE || core.mode() == v1::ESTOP) {
@@ -333,29 +388,7 @@ ScenarioRun runScenario(const ScenarioSpec& spec, const ScenarioContext& ctx, co
       break;
     }
   }
-  m.duration_s = sim.timeS();
-  {
-    v1::Telemetry tl;  // the navigation automaton's switches (kept after COMPLETED)
-    core.fillTelemetry(tl, m.duration_s);
-    m.mode_switches += tl.nav_switches();
-  }
-  m.person_collisions = sim.personCollisions();
-  m.wall_collisions = sim.collisions();
-  if (pattern_ticks > 0) m.pattern_accuracy = static_cast<double>(pattern_hits) / static_cast<double>(pattern_ticks);
-  uint64_t best = 0;
-  for (std::size_t i = 1; i < pattern_counts.size(); ++i)
-    if (pattern_counts[i] > best) {
-      best = pattern_counts[i];
-      m.dominant_pattern = std::string(behavior::toString(static_cast<behavior::Pattern>(i)));
-    }
-  if (m.dominant_pattern.empty()) m.dominant_pattern = "none";
-  m.false_tracks = aw->tracker().counters().tracks_unconfirmed_dropped;
-  if (m.failure.empty()) {
-    if (!m.completed) m.failure = "not completed within " + std::to_string(static_cast<int>(spec.time_limit_s)) + " s";
-    else if (m.person_collisions > 0) m.failure = std::to_string(m.person_collisions) + " collision(s) with people";
-    else if (m.wall_collisions > 0) m.failure = std::to_string(m.wall_collisions) + " collision(s) with walls";
-  }
-  m.success = m.failure.empty();
+  finishMetrics(run, tally, sim, core, *aw, spec);
   return run;
 }
 

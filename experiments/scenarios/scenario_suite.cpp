@@ -233,6 +233,132 @@ void printTable(const sim::ScenarioSpec& s, const std::vector<sim::ScenarioRun>&
       std::printf("  %s: %s\n", behavior::toString(r->policy), r->metrics.failure.c_str());
 }
 
+/// Each scenario once without people (the reference) and once per policy,
+/// with a progress line; the runs per scenario, the reference last.
+std::vector<std::vector<sim::ScenarioRun>> runSuite(const Options& o, const std::vector<sim::ScenarioSpec>& suite,
+                                                    const sim::ScenarioContext& ctx, double& wall_s,
+                                                    double& sim_seconds) {
+  const bool tty = ::isatty(2);
+  const std::size_t total = suite.size() * (o.policies.size() + 1);
+  std::size_t done = 0;
+  const auto wall0 = std::chrono::steady_clock::now();
+  std::vector<std::vector<sim::ScenarioRun>> all;
+  for (const auto& s : suite) {
+    std::vector<sim::ScenarioRun> runs;
+    progress(done, total, s.name + " without people", tty);
+    CameraObserver ref_camera(s, ctx, o.camera, o.seed);
+    sim::RunOptions ref_opt{behavior::SpeedPolicy::kFuzzy, false, o.seed, false, &ref_camera};
+    const sim::ScenarioRun ref = sim::runScenario(s, ctx, ref_opt);
+    sim_seconds += ref.metrics.duration_s;
+    ++done;
+    for (const auto p : o.policies) {
+      progress(done, total, s.name + " " + behavior::toString(p), tty);
+      CameraObserver camera(s, ctx, o.camera, o.seed);
+      sim::ScenarioRun r = sim::runScenario(s, ctx, {p, true, o.seed, !o.plots.empty(), &camera});
+      if (r.metrics.time_to_goal_s >= 0 && ref.metrics.time_to_goal_s >= 0)
+        r.metrics.time_lost_s = r.metrics.time_to_goal_s - ref.metrics.time_to_goal_s;
+      sim_seconds += r.metrics.duration_s;
+      runs.push_back(std::move(r));
+      ++done;
+    }
+    runs.push_back(ref);
+    all.push_back(std::move(runs));
+  }
+  progress(done, total, "done", tty);
+  std::fflush(stderr);
+  wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return all;
+
+}
+
+/// The paper's timings next to ours (fuzzy strategy).
+void printTimings(const std::vector<sim::ScenarioSpec>& suite, const std::vector<std::vector<sim::ScenarioRun>>& all) {
+  std::printf("\n== timings vs the paper (fuzzy strategy; seconds from the start)\n");
+  std::printf("%-16s %-30s %8s %8s\n", "scenario", "event", "ours", "paper");
+  for (std::size_t i = 0; i < suite.size(); ++i) {
+    const auto& s = suite[i];
+    const sim::RunMetrics* m = nullptr;
+    for (const auto& r : all[i])
+      if (r.people && r.policy == behavior::SpeedPolicy::kFuzzy) m = &r.metrics;
+    if (!m || (!s.paper.detect_s && !s.paper.enter_avoidance_s && !s.paper.stop_s && !s.paper.slowest_s)) continue;
+    auto line = [&](const char* ev, double ours, const std::optional<double>& paper) {
+      if (paper) std::printf("%-16s %-30s %8s %8.1f\n", s.name.c_str(), ev, fmt(ours).c_str(), *paper);
+    };
+    line("first detection", m->detect_s, s.paper.detect_s);
+    line("enters max avoidance distance", m->enter_avoidance_s, s.paper.enter_avoidance_s);
+    line("speed zero (< 0.02 m/s)", m->stop_s, s.paper.stop_s);
+    line("lowest speed", m->slowest_s, s.paper.slowest_s);
+  }
+
+}
+
+/// Successes and collisions per policy; whether every fuzzy-strategy run succeeded.
+bool printSummary(const std::vector<sim::ScenarioSpec>& suite, const std::vector<std::vector<sim::ScenarioRun>>& all,
+                  double wall_s, double sim_seconds) {
+  int fuzzy_runs = 0, fuzzy_ok = 0;
+  std::map<behavior::SpeedPolicy, std::pair<int, int>> per_policy;  // successes, collisions
+  for (const auto& runs : all)
+    for (const auto& r : runs) {
+      if (!r.people) continue;
+      auto& pp = per_policy[r.policy];
+      pp.first += r.metrics.success ? 1 : 0;
+      pp.second += static_cast<int>(r.metrics.person_collisions + r.metrics.wall_collisions);
+      if (r.policy == behavior::SpeedPolicy::kFuzzy) {
+        ++fuzzy_runs;
+        fuzzy_ok += r.metrics.success ? 1 : 0;
+      }
+    }
+  std::printf("\n== summary (%zu scenarios, %.0f s of sim time in %.1f s wall, %.0fx real time)\n", suite.size(),
+              sim_seconds, wall_s, wall_s > 0 ? sim_seconds / wall_s : 0.0);
+  for (const auto& [p, sc] : per_policy)
+    std::printf("%-16s success %d/%zu, collisions %d\n", behavior::toString(p), sc.first, suite.size(), sc.second);
+
+  return fuzzy_ok == fuzzy_runs;
+}
+
+void writePlots(const Options& o, const std::vector<sim::ScenarioSpec>& suite,
+                const std::vector<std::vector<sim::ScenarioRun>>& all) {
+  std::error_code ec;
+  std::filesystem::create_directories(o.plots, ec);
+  if (ec) std::fprintf(stderr, "scenario_suite: cannot create %s: %s\n", o.plots.c_str(), ec.message().c_str());
+  for (std::size_t i = 0; i < suite.size(); ++i) {
+    const std::string err = sim::plotScenario(o.plots, suite[i], all[i]);
+    if (!err.empty()) std::fprintf(stderr, "scenario_suite: plot %s: %s\n", suite[i].name.c_str(), err.c_str());
+  }
+  std::printf("plots: %s/<scenario>.png\n", o.plots.c_str());
+}
+
+/// The figures as JSON (--json); false (printed why) when the file cannot be written.
+bool writeJson(const Options& o, const std::vector<sim::ScenarioSpec>& suite,
+               const std::vector<std::vector<sim::ScenarioRun>>& all, double wall_s, double sim_seconds) {
+  nlohmann::ordered_json j;
+  j["suite"] = o.suite;
+  j["seed"] = o.seed;
+  j["wall_s"] = wall_s;
+  j["sim_s"] = sim_seconds;
+  auto& js = j["scenarios"] = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < suite.size(); ++i) {
+    const auto& s = suite[i];
+    nlohmann::ordered_json e{{"name", s.name}, {"world", s.world.name}, {"task", s.task.describe()},
+                             {"expect_pattern", std::string(behavior::toString(s.expect_pattern))}};
+    e["paper"] = {{"detect_s", s.paper.detect_s ? nlohmann::ordered_json(*s.paper.detect_s) : nullptr},
+                  {"enter_avoidance_s", s.paper.enter_avoidance_s ? nlohmann::ordered_json(*s.paper.enter_avoidance_s) : nullptr},
+                  {"stop_s", s.paper.stop_s ? nlohmann::ordered_json(*s.paper.stop_s) : nullptr},
+                  {"slowest_s", s.paper.slowest_s ? nlohmann::ordered_json(*s.paper.slowest_s) : nullptr}};
+    for (const auto& r : all[i])
+      e["runs"][r.people ? behavior::toString(r.policy) : "reference_no_people"] = toJson(r.metrics);
+    js.push_back(std::move(e));
+  }
+  std::ofstream f(o.json);
+  f << j.dump(2) << "\n";
+  if (!f) {
+    std::fprintf(stderr, "scenario_suite: cannot write %s\n", o.json.c_str());
+    return false;
+  }
+  std::printf("json: %s\n", o.json.c_str());
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -260,111 +386,12 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  const bool tty = ::isatty(2);
-  const std::size_t total = suite.size() * (o.policies.size() + 1);
-  std::size_t done = 0;
-  const auto wall0 = std::chrono::steady_clock::now();
-  std::vector<std::vector<sim::ScenarioRun>> all;
-  double sim_seconds = 0;
-  for (const auto& s : suite) {
-    std::vector<sim::ScenarioRun> runs;
-    progress(done, total, s.name + " without people", tty);
-    CameraObserver ref_camera(s, ctx, o.camera, o.seed);
-    sim::RunOptions ref_opt{behavior::SpeedPolicy::kFuzzy, false, o.seed, false, &ref_camera};
-    const sim::ScenarioRun ref = sim::runScenario(s, ctx, ref_opt);
-    sim_seconds += ref.metrics.duration_s;
-    ++done;
-    for (const auto p : o.policies) {
-      progress(done, total, s.name + " " + behavior::toString(p), tty);
-      CameraObserver camera(s, ctx, o.camera, o.seed);
-      sim::ScenarioRun r = sim::runScenario(s, ctx, {p, true, o.seed, !o.plots.empty(), &camera});
-      if (r.metrics.time_to_goal_s >= 0 && ref.metrics.time_to_goal_s >= 0)
-        r.metrics.time_lost_s = r.metrics.time_to_goal_s - ref.metrics.time_to_goal_s;
-      sim_seconds += r.metrics.duration_s;
-      runs.push_back(std::move(r));
-      ++done;
-    }
-    runs.push_back(ref);
-    all.push_back(std::move(runs));
-  }
-  progress(done, total, "done", tty);
-  std::fflush(stderr);
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-
+  double wall_s = 0, sim_seconds = 0;
+  const auto all = runSuite(o, suite, ctx, wall_s, sim_seconds);
   for (std::size_t i = 0; i < suite.size(); ++i) printTable(suite[i], all[i]);
-
-  // The paper's timings next to ours (fuzzy strategy).
-  std::printf("\n== timings vs the paper (fuzzy strategy; seconds from the start)\n");
-  std::printf("%-16s %-30s %8s %8s\n", "scenario", "event", "ours", "paper");
-  for (std::size_t i = 0; i < suite.size(); ++i) {
-    const auto& s = suite[i];
-    const sim::RunMetrics* m = nullptr;
-    for (const auto& r : all[i])
-      if (r.people && r.policy == behavior::SpeedPolicy::kFuzzy) m = &r.metrics;
-    if (!m || (!s.paper.detect_s && !s.paper.enter_avoidance_s && !s.paper.stop_s && !s.paper.slowest_s)) continue;
-    auto line = [&](const char* ev, double ours, const std::optional<double>& paper) {
-      if (paper) std::printf("%-16s %-30s %8s %8.1f\n", s.name.c_str(), ev, fmt(ours).c_str(), *paper);
-    };
-    line("first detection", m->detect_s, s.paper.detect_s);
-    line("enters max avoidance distance", m->enter_avoidance_s, s.paper.enter_avoidance_s);
-    line("speed zero (< 0.02 m/s)", m->stop_s, s.paper.stop_s);
-    line("lowest speed", m->slowest_s, s.paper.slowest_s);
-  }
-
-  int fuzzy_runs = 0, fuzzy_ok = 0;
-  std::map<behavior::SpeedPolicy, std::pair<int, int>> per_policy;  // successes, collisions
-  for (const auto& runs : all)
-    for (const auto& r : runs) {
-      if (!r.people) continue;
-      auto& pp = per_policy[r.policy];
-      pp.first += r.metrics.success ? 1 : 0;
-      pp.second += static_cast<int>(r.metrics.person_collisions + r.metrics.wall_collisions);
-      if (r.policy == behavior::SpeedPolicy::kFuzzy) {
-        ++fuzzy_runs;
-        fuzzy_ok += r.metrics.success ? 1 : 0;
-      }
-    }
-  std::printf("\n== summary (%zu scenarios, %.0f s of sim time in %.1f s wall, %.0fx real time)\n", suite.size(),
-              sim_seconds, wall_s, wall_s > 0 ? sim_seconds / wall_s : 0.0);
-  for (const auto& [p, sc] : per_policy)
-    std::printf("%-16s success %d/%zu, collisions %d\n", behavior::toString(p), sc.first, suite.size(), sc.second);
-
-  if (!o.plots.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.plots, ec);
-    if (ec) std::fprintf(stderr, "scenario_suite: cannot create %s: %s\n", o.plots.c_str(), ec.message().c_str());
-    for (std::size_t i = 0; i < suite.size(); ++i) {
-      const std::string err = sim::plotScenario(o.plots, suite[i], all[i]);
-      if (!err.empty()) std::fprintf(stderr, "scenario_suite: plot %s: %s\n", suite[i].name.c_str(), err.c_str());
-    }
-    std::printf("plots: %s/<scenario>.png\n", o.plots.c_str());
-  }
-  if (!o.json.empty()) {
-    nlohmann::ordered_json j;
-    j["suite"] = o.suite;
-    j["seed"] = o.seed;
-    j["wall_s"] = wall_s;
-    j["sim_s"] = sim_seconds;
-    auto& js = j["scenarios"] = nlohmann::ordered_json::array();
-    for (std::size_t i = 0; i < suite.size(); ++i) {
-      const auto& s = suite[i];
-      nlohmann::ordered_json e{{"name", s.name}, {"world", s.world.name}, {"task", s.task.describe()},
-                               {"expect_pattern", std::string(behavior::toString(s.expect_pattern))}};
-      e["paper"] = {{"detect_s", s.paper.detect_s ? nlohmann::ordered_json(*s.paper.detect_s) : nullptr},
-                    {"enter_avoidance_s", s.paper.enter_avoidance_s ? nlohmann::ordered_json(*s.paper.enter_avoidance_s) : nullptr},
-                    {"stop_s", s.paper.stop_s ? nlohmann::ordered_json(*s.paper.stop_s) : nullptr},
-                    {"slowest_s", s.paper.slowest_s ? nlohmann::ordered_json(*s.paper.slowest_s) : nullptr}};
-      for (const auto& r : all[i])
-        e["runs"][r.people ? behavior::toString(r.policy) : "reference_no_people"] = toJson(r.metrics);
-      js.push_back(std::move(e));
-    }
-    std::ofstream f(o.json);
-    f << j.dump(2) << "\n";
-    if (!f) {
-      std::fprintf(stderr, "scenario_suite: cannot write %s\n", o.json.c_str());
-      return 2;
-    }
-    std::printf("json: %s\n", o.json.c_str());
-  }
-  return fuzzy_ok == fuzzy_runs ? 0 : 1;
+  printTimings(suite, all);
+  const bool fuzzy_all_ok = printSummary(suite, all, wall_s, sim_seconds);
+  if (!o.plots.empty()) writePlots(o, suite, all);
+  if (!o.json.empty() && !writeJson(o, suite, all, wall_s, sim_seconds)) return 2;
+  return fuzzy_all_ok ? 0 : 1;
 }
