@@ -185,6 +185,23 @@ function(inspect_gtests program)
     return()
   endif()
   _inspect_test_properties(props)
+  if(A_LABELS STREQUAL "unit")
+    # One ctest test per gtest suite (cmake/GTestSuites.cmake says why); the
+    # suites of a program's second call (another FILTER) are named <suite>_2.
+    get_property(calls GLOBAL PROPERTY INSPECT_SUITE_CALLS_${program})
+    math(EXPR calls "${calls} + 1")
+    set_property(GLOBAL PROPERTY INSPECT_SUITE_CALLS_${program} ${calls})
+    set(ctest_file ${CMAKE_CURRENT_BINARY_DIR}/${program}_suites_${calls}.cmake)
+    list(REMOVE_AT props 0 1)  # TIMEOUT <s>: the script's, by the suite's size
+    list(PREPEND props LABELS unit)
+    add_custom_command(TARGET ${program} POST_BUILD
+      COMMAND ${CMAKE_COMMAND} -D PROGRAM=$<TARGET_FILE:${program}> -D CTEST_FILE=${ctest_file}
+              -D "EMULATOR=${CMAKE_CROSSCOMPILING_EMULATOR}" -D "FILTER=${A_FILTER}" -D SUFFIX=$<$<VERSION_GREATER:${calls},1>:_${calls}> -D WORKING_DIR=${CMAKE_CURRENT_BINARY_DIR} -D TIMEOUT=${A_TIMEOUT}
+              "-DPROPERTIES=${props}" -P ${PROJECT_SOURCE_DIR}/cmake/GTestSuites.cmake
+      BYPRODUCTS ${ctest_file} VERBATIM)
+    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${ctest_file})
+    return()
+  endif()
   set(filter)
   if(A_FILTER)
     set(filter TEST_FILTER "${A_FILTER}")

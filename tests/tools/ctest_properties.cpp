@@ -1,6 +1,8 @@
 // ctest_properties: reads `ctest --show-only=json-v1` on stdin and checks that
 // every test has a TIMEOUT and exactly one kind label (unit, stack, bench,
-// long, fuzz or sanitize: its phase in scripts/test.sh, tests/InspectTest.cmake);
+// long, fuzz or sanitize: its phase in scripts/test.sh, tests/InspectTest.cmake),
+// and a name no other test has (a unit test is named after its gtest suite:
+// two programs with a suite of the same name would run only one of them);
 // otherwise a test could hang CI or silently never run. Prints what is wrong;
 // exit status 1 when anything is.
 #include <cstdio>
@@ -22,9 +24,11 @@ int main() {
   }
   const std::set<std::string> kinds = {"unit", "stack", "bench", "package", "long", "fuzz", "sanitize"};
   int bad = 0, n = 0;
+  std::set<std::string> names;
   for (const auto& t : j.value("tests", nlohmann::json::array())) {
     ++n;
     const std::string name = t.value("name", "?");
+    if (!names.insert(name).second) std::printf("%s: two tests of this name\n", name.c_str()), ++bad;
     double timeout = 0;
     int found = 0;
     for (const auto& p : t.value("properties", nlohmann::json::array())) {
