@@ -155,7 +155,6 @@ std::vector<Word> wordsOf(const std::string& line) {
   return out;
 }
 
-
 std::string countWord(std::size_t n) {
   static const char* kWords[] = {"no", "one", "two", "three", "four", "five", "six"};
   return n < 7 ? kWords[n] : std::to_string(n);

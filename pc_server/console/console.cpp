@@ -1,23 +1,23 @@
+// The Console's core: a line parsed against the command table of the
+// registered families, its handler run; between commands the robot events,
+// control notes, catalog notices and completed runs; the waits and answers
+// every family shares (console.hpp, "For the command families").
 #include "pc_server/console/console.hpp"
 
-#include "shared/net/robot_id.hpp"
-
-#include <chrono>
 #include <cmath>
-#include <map>
-#include <cstdio>
 #include <variant>
 
-#include "pc_server/console/expect_check.hpp"
-#include "pc_server/link/hello_check.hpp"
-#include "pc_server/operator/route_file.hpp"
+#include "pc_server/console/gas_commands.hpp"
+#include "pc_server/console/motion_commands.hpp"
+#include "pc_server/console/run_commands.hpp"
+#include "pc_server/console/script_commands.hpp"
+#include "pc_server/console/session_commands.hpp"
 #include "pc_server/console/status_line.hpp"
 #include "pc_server/console/text_util.hpp"
-#include "pc_server/recording/fleet_presence.hpp"
+#include "pc_server/console/tuning_commands.hpp"
 #include "pc_server/recording/recorder.hpp"
-#include "pc_server/video/video_hub.hpp"
-#include "shared/config/config_node.hpp"
-#include "shared/util/clock.hpp"
+#include "shared/catalog/catalog.hpp"
+#include "shared/net/robot_id.hpp"
 
 namespace inspect::server {
 
@@ -36,6 +36,23 @@ Console::Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, 
 Console::Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop, Options options)
     : registry_(registry), sink_(sink), out_(out), stop_(stop), options_(options) {
   setSession(nullptr, 0);
+  // The command families, in the order help lists them.
+  families_.push_back(std::make_unique<SessionCommands>(*this));
+  families_.push_back(std::make_unique<MotionCommands>(*this));
+  families_.push_back(std::make_unique<GasCommands>(*this));
+  auto tuning = std::make_unique<TuningCommands>(*this);
+  tuning_ = tuning.get();
+  families_.push_back(std::move(tuning));
+  families_.push_back(std::make_unique<RunCommands>(*this));
+  families_.push_back(std::make_unique<ScriptCommands>(*this));
+  for (const auto& family : families_)
+    for (auto& c : family->commands()) table_.push_back(std::move(c));
+}
+
+Console::~Console() = default;
+
+void Console::setTuningPaths(std::string robot_config, std::string control_config, std::string dir) {
+  tuning_->setPaths(std::move(robot_config), std::move(control_config), std::move(dir));
 }
 
 void Console::setSession(ControlArbiter* arbiter, uint64_t session) {
@@ -72,7 +89,7 @@ bool Console::execute(const std::string& raw_line, int line_no) {
     return true;
   }
   ++tally_.commands;
-  const CommandDef* c = findCommand(name == "?" ? "help" : name);
+  const ConsoleCommand* c = findCommand(name == "?" ? "help" : name);
   if (!c) {
     out_ << "unknown command '" << name << "' (try 'help')\n";
     ++tally_.errors;
@@ -85,7 +102,7 @@ bool Console::execute(const std::string& raw_line, int line_no) {
   args.line_no = line_no;
   bool ok = false;
   try {
-    ok = (this->*(c->run))(args);
+    ok = c->run(args);
   } catch (const catalog::CatalogUnavailable& e) {  // runs, run, report... while a shared catalog is away
     const auto st = recorder_ ? recorder_->catalogStatus() : catalog::SpoolStatus{};
     ok = fail(c->name, std::string(e.what()) + " (recording goes on; " + std::to_string(st.pending) +
@@ -162,27 +179,6 @@ bool Console::mayMove(const std::string& robot, const std::string& cmd) {
   return false;
 }
 
-bool Console::cmdControl(const CommandArgs& a) {
-  if (!control_) return fail("control", "this console has no sessions (no control arbiter)");
-  if (a.form == 0) {
-    out_ << "this session: " << control_->sessionName(session_) << "\n";
-    const auto holders = control_->holders();
-    for (const auto& snap : registry_.snapshots(clock_->nowNs())) {
-      const auto it = holders.find(snap.id);
-      out_ << "  " << snap.id << (snap.connected ? "" : " (not connected)") << ": "
-           << (it == holders.end() ? std::string("free")
-                                   : it->second.name + (it->second.session == session_ ? " <- this session" : ""))
-           << "\n";
-    }
-    return true;
-  }
-  const auto r = a.has("release") ? service_->releaseControl(session_, selected_)
-                                  : service_->takeControl(session_, selected_, a.has("force"), clock_->nowNs());
-  if (!r.ok()) return fail("control", r.reason);
-  out_ << r.robot << ": " << r.reason << "\n";
-  return true;
-}
-
 std::optional<std::string> Console::connectedRobot(const std::string& cmd) {
   if (selected_.empty()) {
     fail(cmd, "no robot selected");
@@ -194,6 +190,12 @@ std::optional<std::string> Console::connectedRobot(const std::string& cmd) {
     return std::nullopt;
   }
   return selected_;
+}
+
+void Console::operatorPresent() { service_->renewTeleop(session_, drive_robot_, options_.drive_lease_s); }
+
+bool Console::sendAndReport(const std::string& name, v1::Command cmd, bool runs) {
+  return report(service_->send(session_, selected_, name, std::move(cmd), clock_->nowNs()), runs);
 }
 
 CallResult Console::await(const PendingCall& pending) {
@@ -235,46 +237,6 @@ bool Console::report(const Issued& issued, bool runs) {
   return true;
 }
 
-bool Console::cmdHelp(const CommandArgs& a) {
-  if (!a.has("command")) {
-    out_ << helpText();
-    return true;
-  }
-  const std::string text = helpText(a.text("command"));
-  if (text.empty()) return fail("help", "unknown command '" + a.text("command") + "'");
-  out_ << text;
-  return true;
-}
-
-bool Console::cmdRobots(const CommandArgs& a) {
-  if (a.has("--fleet")) {
-    if (!recorder_) return fail("robots", "--fleet reads the catalog, and this server records nothing (--no-record)");
-    auto& cat = recorder_->catalog();
-    if (cat.serverId().empty())
-      return fail("robots", "--fleet needs a catalog that several servers share (--catalog postgresql://...); "
-                            "this server's robots are 'robots'");
-    out_ << fleetTable(cat.listPresence(), cat.listServers(), std::chrono::system_clock::now());
-    return true;
-  }
-  const auto all = registry_.snapshots(clock_->nowNs());
-  if (all.empty()) {
-    out_ << "no robot has connected yet\n";
-    return true;
-  }
-  out_ << "  " << padRight("id", 16) << " " << padRight("connected", 9) << " " << padRight("address", 21) << " "
-       << padLeft("tlm Hz", 6) << " " << padRight("mode", 9) << " " << padLeft("tlm age", 8) << "\n";
-  for (const auto& r : all) {
-    const std::string age = r.has_telemetry ? fmtFixed(r.telemetry_age_s, 2) + " s" : "-";
-    const std::string mode = r.has_telemetry ? modeName(r.telemetry.mode()) : "-";
-    out_ << (r.id == selected_ ? "* " : "  ") << padRight(r.id, 16) << " " << padRight(r.connected ? "yes" : "no", 9)
-         << " " << padRight(r.address, 21) << " " << padLeft(fmtFixed(r.telemetry_hz, 1), 6) << " "
-         << padRight(mode, 9) << " " << padLeft(age, 8) << "\n";
-  }
-  return true;
-}
-
-bool Console::cmdSelect(const CommandArgs& a) { return select(a.text("robot")); }
-
 bool Console::select(const std::string& robot) {
   if (!net::validRobotId(robot)) return fail("select", "'" + robot + "' is not a valid robot id ([A-Za-z0-9_-]{1,64})");
   selected_ = robot;
@@ -283,142 +245,11 @@ bool Console::select(const std::string& robot) {
   return true;
 }
 
-bool Console::cmdStatus(const CommandArgs& a) {
-  const std::string robot = a.has("robot") ? a.text("robot") : selected_;
-  if (robot.empty()) return fail("status", "no robot selected");
-  out_ << statusText(robot) << "\n";
-  return true;
-}
-
 std::string Console::statusText(const std::string& robot) const {
   std::string s = statusLine(robot, registry_.snapshot(robot, clock_->nowNs()), video_);
   if (recorder_)
     if (const auto run = recorder_->activeRun(robot)) s += " | REC " + *run;
   return s;
-}
-
-bool Console::cmdRecord(const CommandArgs& a) {
-  if (!recorder_) return fail("record", "the server records nothing (recording.enabled: false or --no-record)");
-  const CallResult r = a.has("stop") ? service_->recordStop(session_, selected_)
-                                     : service_->recordStart(session_, selected_, a.text("name"));
-  if (!r.ok()) return fail("record", r.reason);
-  out_ << r.robot << ": " << r.reason << "\n";
-  return true;
-}
-
-bool Console::cmdRuns(const CommandArgs& args) {
-  if (!recorder_) return fail("runs", "the server records nothing (recording.enabled: false or --no-record)");
-  catalog::RunFilter f;
-  f.limit = 20;
-  const bool fleet = args.has("--fleet");
-  auto& cat = recorder_->catalog();
-  if (!fleet) f.server = cat.serverId();  // "" = every run (a catalog of one server)
-  for (const auto& a : args.list("words")) {
-    if (const auto n = parseInteger(a); n && *n > 0) {
-      f.limit = static_cast<int>(*n);
-    } else if (a == "completed" || a == "stopped" || a == "failed" || a == "incomplete" || a == "running") {
-      f.outcome = a;
-    } else if (registry_.snapshot(a, clock_->nowNs())) {
-      f.robot = a;
-    } else {
-      f.name_contains = a;
-    }
-  }
-  const auto runs = cat.listRuns(f);
-  std::map<std::string, std::string> attach;  // server id -> where to attach
-  if (fleet)
-    for (const auto& sv : cat.listServers()) attach[sv.id] = sv.attach;
-  out_ << padRight("run", 28) << padRight("robot", 10) << padRight("started (UTC)", 26) << padRight("outcome", 12)
-       << (fleet ? padRight("server", 22) : "") << "name\n";
-  for (const auto& r : runs) {
-    std::string server;
-    if (fleet) {
-      server = r.server.empty() ? "-" : r.server;
-      if (const auto at = attach.find(r.server); at != attach.end() && !at->second.empty()) server += " @" + at->second;
-    }
-    out_ << padRight(r.id, 28) << padRight(r.robot, 10) << padRight(catalog::formatIsoUtc(r.start), 26)
-         << padRight(r.outcome.empty() ? "running" : r.outcome, 12) << (fleet ? padRight(server, 22) : "") << r.name
-         << "\n";
-  }
-  out_ << runs.size() << " run" << (runs.size() == 1 ? "" : "s") << "\n";
-  return true;
-}
-
-bool Console::cmdRun(const CommandArgs& a) {
-  if (!recorder_) return fail("run", "the server records nothing (recording.enabled: false or --no-record)");
-  const auto d = recorder_->catalog().run(a.text("run-id"));
-  if (!d) return fail("run", "no run '" + a.text("run-id") + "' in the catalog (see runs)");
-  const auto& i = d->info;
-  out_ << "run " << i.id << " (" << i.robot << ")" << (i.name.empty() ? "" : ": " + i.name) << "\n";
-  out_ << "  started " << catalog::formatIsoUtc(i.start)
-       << (i.end ? ", ended " + catalog::formatIsoUtc(*i.end) : std::string(", still recording"))
-       << (i.outcome.empty() ? "" : ", " + i.outcome) << "\n";
-  if (d->summary) {
-    const auto& s = *d->summary;
-    out_ << "  duration " << fmtFixed(s.duration_s, 1) << " s, distance " << fmtFixed(s.distance_m, 2) << " m"
-         << (s.min_person_m ? ", nearest person " + fmtFixed(*s.min_person_m, 2) + " m" : std::string()) << "\n";
-    if (s.track_max_pos_err_m)
-      out_ << "  tracking: max position error " << fmtFixed(*s.track_max_pos_err_m, 3) << " m, rms "
-           << fmtFixed(s.track_rms_pos_err_m.value_or(0), 3) << " m, max angle error "
-           << fmtFixed(s.track_max_angle_err_rad.value_or(0), 3) << " rad\n";
-    out_ << "  video: " << s.video_frames_received << " frames received, " << s.video_frames_decoded
-         << " decoded, " << s.video_packets_lost << " packets lost\n";
-    for (const auto& g : s.gas)
-      out_ << "  " << g.channel << ": max " << fmtShort(g.max, 3) << " mean " << fmtShort(g.mean, 3) << " " << g.unit
-           << "\n";
-  }
-  out_ << "  events " << d->event_count << ", alarms " << d->alarm_count << "\n";
-  for (const auto& f : d->files) out_ << "  " << f.kind << ": " << f.path << " (" << f.bytes << " bytes)\n";
-  return true;
-}
-
-bool Console::cmdWait(const CommandArgs& a) {
-  if (!sleepPumping(*a.number("seconds"))) return fail("wait", "interrupted (server stopping)");
-  return true;
-}
-
-bool Console::cmdExpect(const CommandArgs& a) {
-  const int line_no = a.line_no;
-  const auto parsed = parseExpect(a.words);
-  if (const auto* err = std::get_if<std::string>(&parsed)) {
-    out_ << "EXPECT FAILED (line " << line_no << "): " << *err << "\n";
-    ++tally_.expects_failed;
-    return false;
-  }
-  const auto& spec = std::get<ExpectSpec>(parsed);
-  const int64_t deadline = deadlineAfter(spec.within_s);
-  FieldReading r;
-  bool interrupted = false;
-  for (;;) {
-    r = readField(spec.field, registry_, selected_, clock_->nowNs());
-    if (satisfied(spec, r)) {
-      out_ << "expect ok (line " << line_no << "): " << spec.field << " = " << r.text << "\n";
-      ++tally_.expects_passed;
-      return true;
-    }
-    if (clock_->nowNs() >= deadline) break;
-    pump();
-    if (!clock_->sleep(options_.poll_period_s)) {
-      interrupted = true;
-      break;
-    }
-  }
-  out_ << "EXPECT FAILED (line " << line_no << "): " << spec.field;
-  if (r.ok) out_ << " = " << r.text;
-  else out_ << ": " << r.error;
-  out_ << ", wanted " << describeWanted(spec) << (interrupted ? " (interrupted)" : "") << "\n";
-  ++tally_.expects_failed;
-  return false;
-}
-
-bool Console::cmdEcho(const CommandArgs& a) {
-  out_ << a.rest << "\n";
-  return true;
-}
-
-bool Console::cmdQuit(const CommandArgs&) {
-  quit_ = true;
-  return true;
 }
 
 }  // namespace inspect::server

@@ -1,7 +1,11 @@
 #pragma once
-// The operator console's commands: parsing, dispatch and output. It holds no
-// terminal and no socket: lines in, text out (tested on strings); the robots
-// are reached through the registry (state) and a CommandSink (commands).
+// The operator console: a thin parser and formatter over the operator service.
+// It parses a line against the command table, runs the command's handler and
+// prints robot events, control notes and completed runs between commands. The
+// commands themselves are families registered in console.cpp (session, motion,
+// gas, tuning, runs, scripts: console/*_commands.hpp), each reaching the robots
+// through this console's OperatorService. It holds no terminal and no socket:
+// lines in, text out (tested on strings).
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -14,26 +18,19 @@
 
 #include "pc_server/link/command_sink.hpp"
 #include "pc_server/console/command_args.hpp"
+#include "pc_server/console/command_family.hpp"
 #include "pc_server/console/console_clock.hpp"
 #include "pc_server/operator/control_arbiter.hpp"
 #include "pc_server/operator/operator_service.hpp"
 #include "pc_server/console/teleop_mode.hpp"
 #include "pc_server/link/robot_registry.hpp"
 #include "pc_server/operator/stop_flag.hpp"
-#include "shared/catalog/catalog.hpp"
-#include "shared/control/gain_set.hpp"
-
-namespace inspect::tuning {
-struct TuneSetup;
-struct TuneResult;
-struct Comparison;
-class Tuner;
-}  // namespace inspect::tuning
 
 namespace inspect::server {
 
 class VideoHub;
 class Recorder;
+class TuningCommands;
 namespace scene {
 class SiteMaps;
 }
@@ -71,6 +68,9 @@ class Console {
 
   Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop);
   Console(RobotRegistry& registry, CommandSink& sink, std::ostream& out, StopFlag& stop, Options options);
+  ~Console();
+  Console(const Console&) = delete;
+  Console& operator=(const Console&) = delete;
 
   /// Runs one line (blank lines and '#' comments are fine); false if it failed
   /// (an error, or an expect that did not hold). `line_no` appears in expect results.
@@ -142,108 +142,31 @@ class Console {
   void setTuningPaths(std::string robot_config, std::string control_config, std::string dir);
 
   /// The text of `help` (all commands) or `help <command>`; empty for an unknown command.
-  static std::string helpText(const std::string& command = "");
+  std::string helpText(const std::string& command = "") const;
   /// The words that may complete the last word of `partial_line` (a command
   /// name, a keyword, a choice, a robot id), from the command table; sorted.
   std::vector<std::string> completions(const std::string& partial_line) const;
   /// What is wrong with the command table's forms, one line each ("" = nothing).
-  static std::string tableProblems();
+  std::string tableProblems() const;
 
- private:
-  using Handler = bool (Console::*)(const CommandArgs& a);
-  /// A command: its forms of typed arguments (command_args.hpp: the syntax,
-  /// the argument errors and completion come from them), its help, its handler.
-  struct CommandDef {
-    const char* name;
-    std::vector<CommandForm> forms;
-    const char* summary;
-    const char* details;
-    Handler run;
-  };
-  /// Every command, by family (help lists them in this order).
-  static const std::vector<CommandDef>& commands();
-  static std::vector<CommandDef> sessionCommands();
-  static std::vector<CommandDef> motionCommands();
-  static std::vector<CommandDef> gasCommands();
-  static std::vector<CommandDef> tuningCommands();
-  static std::vector<CommandDef> runCommands();
-  static std::vector<CommandDef> scriptCommands();
-  static const CommandDef* findCommand(const std::string& name);
-
-  bool cmdHelp(const CommandArgs& a);
-  bool cmdRobots(const CommandArgs& a);
-  bool cmdSelect(const CommandArgs& a);
-  bool cmdStatus(const CommandArgs& a);
-  bool cmdDrive(const CommandArgs& a);
-  bool cmdTeleop(const CommandArgs& a);
-  bool cmdTrack(const CommandArgs& a);
-  bool cmdGoto(const CommandArgs& a);
-  bool cmdRoute(const CommandArgs& a);
-  bool cmdStop(const CommandArgs& a);
-  bool cmdEstop(const CommandArgs& a);
-  bool cmdResume(const CommandArgs& a);
-  bool cmdVideo(const CommandArgs& a);
-  bool cmdPtz(const CommandArgs& a);
-  bool cmdSnapshot(const CommandArgs& a);
-  bool cmdFoxglove(const CommandArgs& a);
-  bool cmdRecord(const CommandArgs& a);
-  bool cmdRuns(const CommandArgs& a);
-  bool cmdRun(const CommandArgs& a);
-  bool cmdReport(const CommandArgs& a);
-  bool cmdExport(const CommandArgs& a);
-  bool cmdReplay(const CommandArgs& a);
-  bool cmdInspect(const CommandArgs& a);
-  bool cmdAlarms(const CommandArgs& a);
-  bool cmdAck(const CommandArgs& a);
-  bool cmdIdentify(const CommandArgs& a);
-  bool cmdTune(const CommandArgs& a);
-  bool cmdGains(const CommandArgs& a);
-  struct TuningState;
-  /// `gains show [robot]`: working, the robot's, the paper's and the tuned set side by side.
-  bool gainsShow(const CommandArgs& a, TuningState& ts);
-  /// `gains set name=value ... | paper | tuned | robot`: the working set, checked.
-  bool gainsSet(const CommandArgs& a, TuningState& ts);
-  /// `tune list`: the tuning sessions in the catalog, newest first.
-  bool cmdTuneList();
-  /// tune's key=value options for the command table: each key's type and range.
-  static std::vector<ArgSpec> tuneOptionKeys();
-  /// Sets from tune's key=value options (parsed by the command table) each
-  /// part of `s`, the plant's description and the start gains; "" or why not.
-  std::string applyTuneOptions(const CommandArgs& a, TuningState& ts, tuning::TuneSetup& s,
-                               std::string& plant_source, std::string& start);
-  /// Runs the optimiser from `start` with its progress line (Ctrl-C cancels); nullopt (printed why) on failure.
-  std::optional<tuning::TuneResult> runTuner(tuning::Tuner& tuner, const control::GainSet& start);
-  /// Writes the session's files under the tuning directory and books it in the
-  /// catalog; the session's id, or nullopt (printed why).
-  std::optional<std::string> saveTuneSession(const tuning::TuneSetup& setup, const tuning::TuneResult& result,
-                                             const tuning::Comparison& cmp, const std::string& params,
-                                             const std::string& robot);
-  /// The tuning host's state, loaded on first use; prints why (as `cmd`) and returns null on failure.
-  TuningState* tuning(const std::string& cmd);
-  /// Sends gains to a robot, reports its Ack and books the push in the catalog.
-  bool pushGains(const std::string& robot, const control::GainSet& g, const std::string& source,
-                 const std::string& session);
-  /// A run of the catalog and its directory; prints why not (as `cmd`) when there is none.
-  std::optional<std::pair<catalog::RunDetail, std::string>> findRun(const std::string& cmd, const std::string& id);
-  bool cmdWait(const CommandArgs& a);
-  bool cmdExpect(const CommandArgs& a);
-  bool cmdEcho(const CommandArgs& a);
-  bool cmdQuit(const CommandArgs& a);
-
-  /// Prints "<cmd>: <message>" and returns false.
+ // --- For the command families (console/*_commands.hpp) -------------------
+  /// The console's output.
+  std::ostream& out() { return out_; }
+  /// Prints "<cmd>: <message>", counts an error and returns false.
   bool fail(const std::string& cmd, const std::string& message);
+  /// Counts an error printed otherwise (a rejection, a failed teleop).
+  void countError() { ++tally_.errors; }
+  /// Counts an `expect` that held or failed.
+  void countExpect(bool passed) { ++(passed ? tally_.expects_passed : tally_.expects_failed); }
   /// The selected robot when it is connected; otherwise prints why (as `cmd`) and returns nullopt.
   std::optional<std::string> connectedRobot(const std::string& cmd);
   /// Whether this session may move `robot` (see setSession); prints why not.
   bool mayMove(const std::string& robot, const std::string& cmd);
-  bool cmdControl(const CommandArgs& a);
   /// Sends `cmd` to the selected robot through the service, waits for its Ack and prints the answer.
   bool sendAndReport(const std::string& name, v1::Command cmd, bool runs = false);
   /// A service call's result, waited for when pending, printed. With `runs` (track, goto,
   /// route) the command's COMPLETED Ack is printed when it comes (background()).
   bool report(const Issued& issued, bool runs = false);
-  /// The result of a pending call, pumping while it waits (timed out when the server stops).
-  CallResult await(const PendingCall& pending);
   /// A call's result: the one it had at once, or (after printing the control note) the one awaited.
   CallResult outcomeOf(const Issued& issued);
   /// Sleeps up to `seconds` while pumping; false if the server is stopping.
@@ -252,6 +175,22 @@ class Console {
   double nowS() { return static_cast<double>(clock_->nowNs()) * 1e-9; }
   /// The time `seconds` from now on this console's clock, in its nanoseconds.
   int64_t deadlineAfter(double seconds) { return clock_->nowNs() + std::llround(seconds * 1e9); }
+  StopFlag& stopFlag() { return stop_; }
+  /// Whether this is an interactive terminal (alarm style on).
+  bool alarmStyle() const { return alarm_style_; }
+  ControlArbiter* arbiter() { return control_; }
+  const TeleopHandler& teleopHandler() const { return teleop_handler_; }
+  const std::function<std::string()>& foxgloveReport() const { return foxglove_report_; }
+  scene::SiteMaps* siteMaps() const { return site_maps_; }
+  /// The robot this session's last accepted `drive` went to (operatorPresent renews its lease).
+  void setDriveRobot(const std::string& robot) { drive_robot_ = robot; }
+  void requestQuit() { quit_ = true; }
+
+ private:
+  /// The command of that name in the table, or null.
+  const ConsoleCommand* findCommand(const std::string& name) const;
+  /// The result of a pending call, pumping while it waits (timed out when the server stops).
+  CallResult await(const PendingCall& pending);
 
   RobotRegistry& registry_;
   CommandSink& sink_;
@@ -283,13 +222,10 @@ class Console {
     std::string name;
   };
   std::vector<Run> runs_;
-  struct Tuning {  // the tuning host's state (console_tuning.cpp)
-    std::shared_ptr<TuningState> state;  // made on the first tuning command
-    std::atomic<bool> cancel{false};     // Ctrl-C during tune (StopFlag's interrupt target)
-    std::string robot_config = "config/robot.yaml";
-    std::string control_config = "config/control.yaml";
-    std::string dir = "runs/tuning";
-  } tune_;
+  /// The command families, in help's order, and their commands (console.cpp).
+  std::vector<std::unique_ptr<CommandFamily>> families_;
+  TuningCommands* tuning_ = nullptr;  // one of families_ (setTuningPaths)
+  std::vector<ConsoleCommand> table_;
 };
 
 }  // namespace inspect::server

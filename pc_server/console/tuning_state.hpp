@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "pc_server/console/console.hpp"
+#include "pc_server/console/tuning_commands.hpp"
 #include "shared/config/control_config.hpp"
 #include "shared/config/robot_config.hpp"
 #include "shared/control/gain_set.hpp"
@@ -14,7 +14,7 @@
 
 namespace inspect::server {
 
-struct Console::TuningState {
+struct TuningState {
   config::RobotConfig robot;
   config::ControlConfig control;
   fuzzy::Fis fis;                  // the fuzzy system of control.fis_path (or imported)

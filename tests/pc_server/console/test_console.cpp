@@ -152,7 +152,7 @@ TEST_F(ConsoleTest, HelpListsEveryCommandAndExplainsOne) {
   EXPECT_HAS(out, "unknown command 'nope'");
 }
 
-TEST_F(ConsoleTest, TheCommandTableParsesUnambiguously) { EXPECT_EQ(Console::tableProblems(), ""); }
+TEST_F(ConsoleTest, TheCommandTableParsesUnambiguously) { EXPECT_EQ(console_.tableProblems(), ""); }
 
 TEST_F(ConsoleTest, CompletionComesFromTheCommandTable) {
   connectRobot();
@@ -169,7 +169,7 @@ TEST_F(ConsoleTest, CompletionComesFromTheCommandTable) {
   EXPECT_TRUE(console_.completions("drive 0.1 ").empty());
   EXPECT_TRUE(console_.completions("nonsense ").empty());
   // Help shows the same syntax the errors quote.
-  EXPECT_EQ(Console::helpText("control").rfind("control\ncontrol take [force]\ncontrol release\n", 0), 0u);
+  EXPECT_EQ(console_.helpText("control").rfind("control\ncontrol take [force]\ncontrol release\n", 0), 0u);
   const auto [ok, out] = run("control take forse");
   EXPECT_FALSE(ok);
   EXPECT_HAS(out, "syntax: control | control take [force] | control release");

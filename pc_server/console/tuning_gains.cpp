@@ -1,9 +1,5 @@
 // The console's `gains` command: show, set, use, push and revert the
 // tracking gains (docs/tuning.md).
-// The console's tuning commands (docs/tuning.md): identify <run>, tune, gains.
-// The tuning host's state (plant, working gains, last session) lives in one
-// TuningState per console; it is created on first use from the robot and
-// control configs (config/robot.yaml, config/control.yaml by default).
 #include <unistd.h>
 
 #include <atomic>
@@ -15,9 +11,10 @@
 #include <sstream>
 
 #include "pc_server/console/console.hpp"
+#include "pc_server/console/text_util.hpp"
+#include "pc_server/console/tuning_commands.hpp"
 #include "pc_server/console/tuning_state.hpp"
 #include "pc_server/recording/recorder.hpp"
-#include "pc_server/console/text_util.hpp"
 #include "pc_server/tuning/plant_id.hpp"
 #include "pc_server/tuning/tuner.hpp"
 #include "pc_server/tuning/tuning_report.hpp"
@@ -33,45 +30,45 @@
 
 namespace inspect::server {
 
-bool Console::gainsShow(const CommandArgs& a, TuningState& ts) {
-  const std::string robot = a.has("robot") ? a.text("robot") : selected_;
+bool TuningCommands::gainsShow(const CommandArgs& a, TuningState& ts) {
+  const std::string robot = a.has("robot") ? a.text("robot") : c_.selected();
   std::optional<RobotSnapshot> snap;
-  if (!robot.empty()) snap = registry_.snapshot(robot, clock_->nowNs());
+  if (!robot.empty()) snap = c_.registry().snapshot(robot, c_.clock().nowNs());
   const bool have_robot = snap && snap->gains_known;
   const control::GainSet rg = have_robot ? net::fromProto(snap->gains) : control::GainSet{};
   char head[200];
   std::snprintf(head, sizeof head, "%-6s %12s %12s %12s %12s\n", "gain", "working",
                 have_robot ? (robot + " v" + std::to_string(snap->gains_version)).c_str() : "robot", "paper",
                 ts.tuned ? "tuned" : "");
-  out_ << head;
+  c_.out() << head;
   for (const char* n : control::kGainNames) {
     char row[200];
     const std::string rv = have_robot ? fmtShort(control::gainValue(rg, n), 5) : std::string("--");
     const std::string tv = ts.tuned ? fmtShort(control::gainValue(*ts.tuned, n), 5) : std::string();
     std::snprintf(row, sizeof row, "%-6s %12s %12s %12s %12s\n", n, fmtShort(control::gainValue(ts.working, n), 5).c_str(),
                   rv.c_str(), fmtShort(control::gainValue(ts.paper, n), 5).c_str(), tv.c_str());
-    out_ << row;
+    c_.out() << row;
   }
-  out_ << "fuzzy system: " << ts.fis.name << (ts.fis_imported ? " (imported; pushed with the gains)" : "")
+  c_.out() << "fuzzy system: " << ts.fis.name << (ts.fis_imported ? " (imported; pushed with the gains)" : "")
        << (have_robot && !snap->hello.fis_name().empty() ? "; robot's: " + snap->hello.fis_name() : std::string())
        << "\n";
-  if (!have_robot && !robot.empty()) out_ << "(" << robot << " has not announced its gains)\n";
+  if (!have_robot && !robot.empty()) c_.out() << "(" << robot << " has not announced its gains)\n";
   return true;
 }
 
-bool Console::gainsSet(const CommandArgs& a, TuningState& ts) {
+bool TuningCommands::gainsSet(const CommandArgs& a, TuningState& ts) {
   if (const std::string& set = a.text("preset"); !set.empty()) {
     if (set == "paper") ts.working = ts.paper;
     if (set == "tuned") {
-      if (!ts.tuned) return fail("gains", "nothing tuned yet (tune)");
+      if (!ts.tuned) return c_.fail("gains", "nothing tuned yet (tune)");
       ts.working = *ts.tuned;
     }
     if (set == "robot") {
-      const auto snap = selected_.empty() ? std::optional<RobotSnapshot>() : registry_.snapshot(selected_, clock_->nowNs());
-      if (!snap || !snap->gains_known) return fail("gains", "the selected robot has not announced its gains");
+      const auto snap = c_.selected().empty() ? std::optional<RobotSnapshot>() : c_.registry().snapshot(c_.selected(), c_.clock().nowNs());
+      if (!snap || !snap->gains_known) return c_.fail("gains", "the selected robot has not announced its gains");
       ts.working = net::fromProto(snap->gains);
     }
-    out_ << "gains: working set = " << set << ": " << gainsText(ts.working) << "\n";
+    c_.out() << "gains: working set = " << set << ": " << gainsText(ts.working) << "\n";
     return true;
   }
   const auto& args = a.list("gains");
@@ -85,22 +82,22 @@ bool Console::gainsSet(const CommandArgs& a, TuningState& ts) {
         v = args[1];
         i = 1;
       } else {
-        return fail("gains", "'" + args[i] + "' is not name=value");
+        return c_.fail("gains", "'" + args[i] + "' is not name=value");
       }
     }
     double* slot = control::gainByName(next, k);
-    if (!slot) return fail("gains", "unknown gain '" + k + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3)");
+    if (!slot) return c_.fail("gains", "unknown gain '" + k + "' (kp ki kd ke kec k1 k2 k3 a1 a2 a3)");
     const auto x = parseNumber(v);
-    if (!x) return fail("gains", k + ": '" + v + "' is not a number");
+    if (!x) return c_.fail("gains", k + ": '" + v + "' is not a number");
     *slot = *x;
   }
-  if (const std::string why = control::validateGains(next); !why.empty()) return fail("gains", why + " (nothing changed)");
+  if (const std::string why = control::validateGains(next); !why.empty()) return c_.fail("gains", why + " (nothing changed)");
   ts.working = next;
-  out_ << "gains: working set: " << gainsText(ts.working) << "\n";
+  c_.out() << "gains: working set: " << gainsText(ts.working) << "\n";
   return true;
 }
 
-bool Console::cmdGains(const CommandArgs& a) {
+bool TuningCommands::cmdGains(const CommandArgs& a) {
   TuningState* ts = tuning("gains");
   if (!ts) return false;
   const std::string& sub = a.words.front();  // the form's keyword
@@ -110,10 +107,10 @@ bool Console::cmdGains(const CommandArgs& a) {
     std::string robot;
     if (a.has("robot")) {
       robot = a.text("robot");
-      const auto snap = registry_.snapshot(robot, clock_->nowNs());
-      if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
+      const auto snap = c_.registry().snapshot(robot, c_.clock().nowNs());
+      if (!snap || !snap->connected) return c_.fail("gains", robot + " is not connected");
     } else {
-      const auto r = connectedRobot("gains");
+      const auto r = c_.connectedRobot("gains");
       if (!r) return false;
       robot = *r;
     }
@@ -122,13 +119,13 @@ bool Console::cmdGains(const CommandArgs& a) {
                      tuned ? ts->tuned_session : "");
   }
   if (sub == "revert") {
-    const std::string robot = a.has("robot") ? a.text("robot") : selected_;
-    if (robot.empty()) return fail("gains", "no robot selected");
-    const auto snap = registry_.snapshot(robot, clock_->nowNs());
-    if (!snap || !snap->connected) return fail("gains", robot + " is not connected");
-    if (snap->gains_history.empty()) return fail("gains", robot + ": no earlier gains to go back to");
+    const std::string robot = a.has("robot") ? a.text("robot") : c_.selected();
+    if (robot.empty()) return c_.fail("gains", "no robot selected");
+    const auto snap = c_.registry().snapshot(robot, c_.clock().nowNs());
+    if (!snap || !snap->connected) return c_.fail("gains", robot + " is not connected");
+    if (snap->gains_history.empty()) return c_.fail("gains", robot + ": no earlier gains to go back to");
     const auto& [version, prev] = snap->gains_history.back();
-    out_ << "gains: reverting " << robot << " to the set of v" << version << "\n";
+    c_.out() << "gains: reverting " << robot << " to the set of v" << version << "\n";
     if (!pushGains(robot, net::fromProto(prev), "revert to v" + std::to_string(version), "")) return false;
     return true;
   }
@@ -137,9 +134,9 @@ bool Console::cmdGains(const CommandArgs& a) {
     try {
       config::exportGains(ts->working, ts->fis, file, "exported from the pc_server console");
     } catch (const std::exception& e) {
-      return fail("gains", e.what());
+      return c_.fail("gains", e.what());
     }
-    out_ << "gains: working set written to " << file << " with its fuzzy system beside it\n";
+    c_.out() << "gains: working set written to " << file << " with its fuzzy system beside it\n";
     return true;
   }
   if (sub == "import") {
@@ -148,18 +145,18 @@ bool Console::cmdGains(const CommandArgs& a) {
     try {
       f = config::importGains(file, ts->working, &fis);
     } catch (const std::exception& e) {
-      return fail("gains", e.what());
+      return c_.fail("gains", e.what());
     }
     ts->working = f.gains;
     if (!f.fis_path.empty()) {
       ts->fis_imported = fuzzy::formatFis(fis) != fuzzy::formatFis(ts->fis) || ts->fis_imported;
       ts->fis = fis;
     }
-    out_ << "gains: working set from " << file << ": " << gainsText(ts->working) << "\n";
-    if (ts->fis_imported) out_ << "gains: fuzzy system '" << ts->fis.name << "' goes with the next push\n";
+    c_.out() << "gains: working set from " << file << ": " << gainsText(ts->working) << "\n";
+    if (ts->fis_imported) c_.out() << "gains: fuzzy system '" << ts->fis.name << "' goes with the next push\n";
     return true;
   }
-  return fail("gains", "unknown subcommand '" + sub + "'");  // a form without its handler
+  return c_.fail("gains", "unknown subcommand '" + sub + "'");  // a form without its handler
 }
 
 }  // namespace inspect::server

@@ -13,9 +13,11 @@
 #include <sstream>
 
 #include "pc_server/console/console.hpp"
+#include "pc_server/console/run_commands.hpp"
+#include "pc_server/console/text_util.hpp"
+#include "pc_server/console/tuning_commands.hpp"
 #include "pc_server/console/tuning_state.hpp"
 #include "pc_server/recording/recorder.hpp"
-#include "pc_server/console/text_util.hpp"
 #include "pc_server/tuning/plant_id.hpp"
 #include "pc_server/tuning/tuner.hpp"
 #include "pc_server/tuning/tuning_report.hpp"
@@ -31,8 +33,10 @@
 
 namespace inspect::server {
 
-namespace fs = std::filesystem;
+using namespace args;
+using Source = ArgSpec::Source;
 
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -58,14 +62,14 @@ std::string sessionStamp() {
 
 }  // namespace
 
-void Console::setTuningPaths(std::string robot_config, std::string control_config, std::string dir) {
+void TuningCommands::setPaths(std::string robot_config, std::string control_config, std::string dir) {
   tune_.robot_config = std::move(robot_config);
   tune_.control_config = std::move(control_config);
   tune_.dir = std::move(dir);
   tune_.state.reset();
 }
 
-Console::TuningState* Console::tuning(const std::string& cmd) {
+TuningState* TuningCommands::tuning(const std::string& cmd) {
   if (tune_.state) return tune_.state.get();
   try {
     auto t = std::make_shared<TuningState>();
@@ -79,7 +83,7 @@ Console::TuningState* Console::tuning(const std::string& cmd) {
     t->plant = sim::nominalPlant(t->robot);
     tune_.state = std::move(t);
   } catch (const std::exception& e) {
-    fail(cmd, std::string("cannot load the tuning configs: ") + e.what());
+    c_.fail(cmd, std::string("cannot load the tuning configs: ") + e.what());
     return nullptr;
   }
   return tune_.state.get();
@@ -87,23 +91,23 @@ Console::TuningState* Console::tuning(const std::string& cmd) {
 
 // ------------------------------------------------------------------ identify
 
-bool Console::cmdIdentify(const CommandArgs& a) {
+bool TuningCommands::cmdIdentify(const CommandArgs& a) {
   TuningState* ts = tuning("identify");
   if (!ts) return false;
-  if (!recorder_) return fail("identify", "the server records nothing (--no-record): there are no runs");
+  if (!c_.recorder()) return c_.fail("identify", "the server records nothing (--no-record): there are no runs");
   std::string id = a.text("run-id|last");
   if (id == "last") {
     // The newest run that played a wheel test (an identification route).
     catalog::RunFilter f;
     f.limit = 50;
-    for (const auto& r : recorder_->catalog().listRuns(f))
+    for (const auto& r : c_.recorder()->catalog().listRuns(f))
       if (r.name.rfind("identification", 0) == 0) {
         id = r.id;
         break;
       }
-    if (id == "last") return fail("identify", "no identification run in the catalog (route identification records one)");
+    if (id == "last") return c_.fail("identify", "no identification run in the catalog (route identification records one)");
   }
-  const auto run = findRun("identify", id);
+  const auto run = findRun(c_, "identify", id);
   if (!run) return false;
   const auto& [d, dir] = *run;
   tuning::PlantFit fit;
@@ -114,20 +118,20 @@ bool Console::cmdIdentify(const CommandArgs& a) {
     o.nominal_saturation_rad_s = ts->robot.limits.max_wheel_speed_rad_s;
     fit = tuning::identifyPlant(data.left, data.right, o);
   } catch (const std::exception& e) {
-    return fail("identify", "run " + d.info.id + ": " + e.what());
+    return c_.fail("identify", "run " + d.info.id + ": " + e.what());
   }
-  out_ << "identify: run " << d.info.id << " (" << d.info.name << "): " << data.samples_used << " of "
+  c_.out() << "identify: run " << d.info.id << " (" << d.info.name << "): " << data.samples_used << " of "
        << data.telemetry_messages << " telemetry samples, " << fmtShort(fit.duration_s, 1) << " s, grid "
        << fmtShort(fit.sample_period_s * 1000.0, 3) << " ms\n";
   for (const auto& [name, w] : {std::pair{"left", &fit.left}, std::pair{"right", &fit.right}}) {
-    out_ << "  " << wheelLine(name, w->model) << "  fit " << fmtFixed(w->fit_percent, 1) << " %  rms "
+    c_.out() << "  " << wheelLine(name, w->model) << "  fit " << fmtFixed(w->fit_percent, 1) << " %  rms "
          << fmtShort(w->rms_error_rad_s, 3) << " rad/s" << (w->saturation_observed ? "" : "  (saturation not reached: nominal)")
          << "\n";
   }
   const auto nominal = sim::nominalPlant(ts->robot);
-  out_ << "  nominal (config/robot.yaml): gain 1, time constant " << fmtShort(nominal.left.time_constant_s, 3)
+  c_.out() << "  nominal (config/robot.yaml): gain 1, time constant " << fmtShort(nominal.left.time_constant_s, 3)
        << " s, no dead time\n";
-  for (const auto& w : fit.warnings) out_ << "  warning: " << w << "\n";
+  for (const auto& w : fit.warnings) c_.out() << "  warning: " << w << "\n";
   const std::string path = dir + "/plant.yaml";
   try {
     std::ofstream f(path);
@@ -135,25 +139,25 @@ bool Console::cmdIdentify(const CommandArgs& a) {
     if (!f) throw std::runtime_error("cannot write " + path);
     f.close();
     std::error_code ec;
-    recorder_->catalog().addFile(d.info.id, "plant", path, static_cast<int64_t>(fs::file_size(path, ec)));
+    c_.recorder()->catalog().addFile(d.info.id, "plant", path, static_cast<int64_t>(fs::file_size(path, ec)));
   } catch (const std::exception& e) {
-    return fail("identify", e.what());
+    return c_.fail("identify", e.what());
   }
   ts->plant = fit.model;
   ts->plant_source = "identified from run " + d.info.id;
-  out_ << "identify: model saved as " << path << "; tune now uses it\n";
+  c_.out() << "identify: model saved as " << path << "; tune now uses it\n";
   return true;
 }
 
 // ---------------------------------------------------------------------- tune
 
-bool Console::cmdTuneList() {
+bool TuningCommands::cmdTuneList() {
   // The tuning sessions in the catalog, newest first.
   // The tuning sessions in the catalog, newest first.
-  if (!recorder_) return fail("tune", "the server records nothing (--no-record): no catalog of sessions");
-  const auto list = recorder_->catalog().listTuningSessions(20);
+  if (!c_.recorder()) return c_.fail("tune", "the server records nothing (--no-record): no catalog of sessions");
+  const auto list = c_.recorder()->catalog().listTuningSessions(20);
   if (list.empty()) {
-    out_ << "no tuning sessions in the catalog\n";
+    c_.out() << "no tuning sessions in the catalog\n";
     return true;
   }
   for (const auto& t : list) {
@@ -161,12 +165,12 @@ bool Console::cmdTuneList() {
     std::snprintf(line, sizeof line, "%-34s %-8s %-36s %5lld evals %7.1f s  cost %.4g -> %.4g%s  %s\n", t.id.c_str(),
                   t.robot.empty() ? "-" : t.robot.c_str(), t.reference.c_str(), static_cast<long long>(t.evals),
                   t.wall_s, t.initial_cost, t.best_cost, t.cancelled ? " (cancelled)" : "", t.dir.c_str());
-    out_ << line;
+    c_.out() << line;
   }
   return true;
 }
 
-std::vector<ArgSpec> Console::tuneOptionKeys() {
+std::vector<ArgSpec> TuningCommands::tuneOptionKeys() {
   using namespace args;
   const auto count = [](const char* key, double lo, double hi) { return within(integer(key), lo, hi); };
   return {choice("ref", {"circle", "line", "waypoints"}),
@@ -184,7 +188,7 @@ std::vector<ArgSpec> Console::tuneOptionKeys() {
           choice("start", {"working", "paper", "tuned"})};
 }
 
-std::string Console::applyTuneOptions(const CommandArgs& a, TuningState& ts, tuning::TuneSetup& s,
+std::string TuningCommands::applyTuneOptions(const CommandArgs& a, TuningState& ts, tuning::TuneSetup& s,
                                       std::string& plant_source, std::string& start) {
   // Types and ranges are checked by the command table (tuneOptionKeys); what
   // depends on this robot and these files is checked here.
@@ -230,8 +234,8 @@ std::string Console::applyTuneOptions(const CommandArgs& a, TuningState& ts, tun
     } else {
       try {
         std::string path = v;
-        if (!fs::exists(path) && recorder_) {  // a run id: its identified plant
-          path = recorder_->config().dir + "/" + v + "/plant.yaml";
+        if (!fs::exists(path) && c_.recorder()) {  // a run id: its identified plant
+          path = c_.recorder()->config().dir + "/" + v + "/plant.yaml";
           if (!fs::exists(path))
             return "plant=" + v + ": no such file, and no run '" + v + "' with plant.yaml (identify it first)";
         }
@@ -249,21 +253,21 @@ std::string Console::applyTuneOptions(const CommandArgs& a, TuningState& ts, tun
   return "";
 }
 
-std::optional<tuning::TuneResult> Console::runTuner(tuning::Tuner& tuner, const control::GainSet& start_gains) {
+std::optional<tuning::TuneResult> TuningCommands::runTuner(tuning::Tuner& tuner, const control::GainSet& start_gains) {
   std::atomic<bool>& cancel = tune_.cancel;  // outlives the command: the signal handler may still hold it
   cancel.store(false);
-  stop_.setInterruptTarget(&cancel);
-  const bool tty = alarm_style_;  // an interactive terminal: one redrawn progress line
+  c_.stopFlag().setInterruptTarget(&cancel);
+  const bool tty = c_.alarmStyle();  // an interactive terminal: one redrawn progress line
   int last_decile = -1;
-  const double t0 = nowS();
+  const double t0 = c_.nowS();
   double last_draw_s = -1.0;
   tuning::TuneResult result;
   try {
     result = tuner.run(
         start_gains,
         [&](const tuning::TuneProgress& p) {
-          if (stop_.requested()) cancel.store(true);
-          const double el = nowS() - t0;
+          if (c_.stopFlag().requested()) cancel.store(true);
+          const double el = c_.nowS() - t0;
           const double frac = p.max_evals > 0 ? static_cast<double>(p.evals) / p.max_evals : 1.0;
           const int decile = static_cast<int>(frac * 10.0);
           char line[200];
@@ -275,27 +279,27 @@ std::optional<tuning::TuneResult> Console::runTuner(tuning::Tuner& tuner, const 
                         p.phase.c_str(), el);
           if (tty) {
             if (el - last_draw_s >= 0.1 || p.evals == p.max_evals) {
-              out_ << "\r\x1b[K" << line << std::flush;
+              c_.out() << "\r\x1b[K" << line << std::flush;
               last_draw_s = el;
             }
           } else if (decile != last_decile) {
-            out_ << "  " << line << "\n" << std::flush;
+            c_.out() << "  " << line << "\n" << std::flush;
             last_decile = decile;
           }
         },
         &cancel);
   } catch (const std::exception& e) {
-    stop_.setInterruptTarget(nullptr);
-    if (tty) out_ << "\n";
-    fail("tune", e.what());
+    c_.stopFlag().setInterruptTarget(nullptr);
+    if (tty) c_.out() << "\n";
+    c_.fail("tune", e.what());
     return std::nullopt;
   }
-  stop_.setInterruptTarget(nullptr);
-  if (tty) out_ << "\n";
+  c_.stopFlag().setInterruptTarget(nullptr);
+  if (tty) c_.out() << "\n";
   return result;
 }
 
-std::optional<std::string> Console::saveTuneSession(const tuning::TuneSetup& setup, const tuning::TuneResult& result,
+std::optional<std::string> TuningCommands::saveTuneSession(const tuning::TuneSetup& setup, const tuning::TuneResult& result,
                                                     const tuning::Comparison& cmp, const std::string& params,
                                                     const std::string& robot) {
   TuningState* ts = tune_.state.get();
@@ -305,13 +309,13 @@ std::optional<std::string> Console::saveTuneSession(const tuning::TuneSetup& set
   const std::string dir = tune_.dir + "/" + session;
   try {
     const auto files = tuning::writeTuningSession(dir, setup, result, cmp, ts->fis);
-    for (const auto& n : files.notes) out_ << "  note: " << n << "\n";
-    out_ << "tune: session " << session << ": " << files.files.size() << " files in " << dir << "/\n";
+    for (const auto& n : files.notes) c_.out() << "  note: " << n << "\n";
+    c_.out() << "tune: session " << session << ": " << files.files.size() << " files in " << dir << "/\n";
   } catch (const std::exception& e) {
-    fail("tune", "cannot write the session: " + std::string(e.what()));
+    c_.fail("tune", "cannot write the session: " + std::string(e.what()));
     return std::nullopt;
   }
-  if (recorder_) {
+  if (c_.recorder()) {
     catalog::TuningSession cs;
     cs.id = session;
     cs.created = std::chrono::system_clock::now();
@@ -329,15 +333,15 @@ std::optional<std::string> Console::saveTuneSession(const tuning::TuneSetup& set
     cs.best_gains_json = config::gainsJson(result.best);
     cs.dir = dir;
     try {
-      recorder_->catalog().addTuningSession(cs);
+      c_.recorder()->catalog().addTuningSession(cs);
     } catch (const std::exception& e) {
-      out_ << "tune: warning: session not in the catalog: " << e.what() << "\n";
+      c_.out() << "tune: warning: session not in the catalog: " << e.what() << "\n";
     }
   }
   return session;
 }
 
-bool Console::cmdTune(const CommandArgs& a) {
+bool TuningCommands::cmdTune(const CommandArgs& a) {
   if (a.has("list")) return cmdTuneList();
   TuningState* ts = tuning("tune");
   if (!ts) return false;
@@ -349,7 +353,7 @@ bool Console::cmdTune(const CommandArgs& a) {
   std::string plant_source = ts->plant_source;
   std::string start = "working";
   if (const std::string why = applyTuneOptions(a, *ts, s, plant_source, start); !why.empty())
-    return fail("tune", why);
+    return c_.fail("tune", why);
   const control::GainSet start_gains = start == "paper" ? ts->paper : start == "tuned" ? *ts->tuned : ts->working;
   // Each run's samples are held in memory: a reference longer than 5 minutes
   // (a slow, many-lap circle) would cost gigabytes and minutes per evaluation.
@@ -358,33 +362,33 @@ bool Console::cmdTune(const CommandArgs& a) {
     double t = 0.0;
     for (double d = 0.0; d < path->length_m(); d += 0.05) t += 0.05 / std::max(1e-3, path->at(d).speed_m_s);
     if (t > kMaxTuneReference_s)
-      return fail("tune", s.reference.describe() + " lasts " + fmtShort(t, 0) + " s: at most " +
+      return c_.fail("tune", s.reference.describe() + " lasts " + fmtShort(t, 0) + " s: at most " +
                               fmtShort(kMaxTuneReference_s, 0) + " s (fewer laps, a smaller radius or a higher speed)");
   } catch (const std::exception& e) {
-    return fail("tune", e.what());
+    return c_.fail("tune", e.what());
   }
   std::unique_ptr<tuning::Tuner> tuner;
   try {
     tuner = std::make_unique<tuning::Tuner>(s);
   } catch (const std::exception& e) {
-    return fail("tune", e.what());
+    return c_.fail("tune", e.what());
   }
   const auto& setup = tuner->setup();
   std::string params;
   for (const auto& p : setup.params) params += (params.empty() ? "" : ",") + p;
-  out_ << "tune: " << setup.reference.describe() << "; plant " << plant_source << "\n"
+  c_.out() << "tune: " << setup.reference.describe() << "; plant " << plant_source << "\n"
        << "  " << wheelLine("left", setup.plant.left) << "\n  " << wheelLine("right", setup.plant.right) << "\n"
        << "  tuning " << params << " from the " << start << " gains; " << setup.max_evals << " evaluations x "
        << setup.plant_variations * setup.seeds << " runs (" << setup.plant_variations << " plant variations x "
        << setup.seeds << " noise seeds); Ctrl-C stops and keeps the best so far\n";
-  out_.flush();
+  c_.out().flush();
 
   const auto result = runTuner(*tuner, start_gains);
   if (!result) return false;
-  out_ << "tune: " << (result->cancelled ? "cancelled after " : "done: ") << result->evals << " evaluations in "
+  c_.out() << "tune: " << (result->cancelled ? "cancelled after " : "done: ") << result->evals << " evaluations in "
        << fmtShort(result->wall_s, 3) << " s (" << result->algorithm << "); cost " << fmtShort(result->initial_eval.cost, 4)
        << " -> " << fmtShort(result->best_eval.cost, 4) << "\n";
-  out_ << "  best: " << gainsText(result->best) << "\n";
+  c_.out() << "  best: " << gainsText(result->best) << "\n";
 
   // PID and fuzzy-PID with the paper's gains against the tuned set.
   tuning::Comparison cmp;
@@ -393,49 +397,49 @@ bool Console::cmdTune(const CommandArgs& a) {
                                               {"fuzzy-PID (paper)", control::WheelControl::kFuzzyPid, ts->paper},
                                               {"fuzzy-PID (tuned)", control::WheelControl::kFuzzyPid, result->best}});
   } catch (const std::exception& e) {
-    return fail("tune", std::string("comparison: ") + e.what());
+    return c_.fail("tune", std::string("comparison: ") + e.what());
   }
-  out_ << tuning::comparisonTable(cmp);
-  const std::string robot = selected_;
+  c_.out() << tuning::comparisonTable(cmp);
+  const std::string robot = c_.selected();
   const auto session = saveTuneSession(setup, *result, cmp, params, robot);
   if (!session) return false;
   ts->tuned = result->best;
   ts->tuned_session = *session;
   ts->working = result->best;
   ts->last_session_dir = tune_.dir + "/" + *session;
-  out_ << "tune: the working gains are now the tuned set; `gains push` sends them to " << (robot.empty() ? "the selected robot" : robot)
+  c_.out() << "tune: the working gains are now the tuned set; `gains push` sends them to " << (robot.empty() ? "the selected robot" : robot)
        << "\n";
   return true;
 }
 
 // --------------------------------------------------------------------- gains
 
-bool Console::pushGains(const std::string& robot, const control::GainSet& g, const std::string& source,
+bool TuningCommands::pushGains(const std::string& robot, const control::GainSet& g, const std::string& source,
                         const std::string& session) {
   TuningState* ts = tuning("gains");
   if (!ts) return false;
-  if (const std::string why = control::validateGains(g); !why.empty()) return fail("gains", "not pushed: " + why);
+  if (const std::string why = control::validateGains(g); !why.empty()) return c_.fail("gains", "not pushed: " + why);
   v1::Command c;
   auto* u = c.mutable_gains();
   net::toProto(g, *u->mutable_gains());
   u->set_source(source);
   if (ts->fis_imported) u->set_fis(fuzzy::formatFis(ts->fis));
-  const CallResult r = outcomeOf(service_->send(session_, robot, "gains push", std::move(c), clock_->nowNs()));
-  if (r.outcome == CallOutcome::kInvalid || r.outcome == CallOutcome::kRefused) return report(r);  // nothing sent
+  const CallResult r = c_.outcomeOf(c_.service().send(c_.session(), robot, "gains push", std::move(c), c_.clock().nowNs()));
+  if (r.outcome == CallOutcome::kInvalid || r.outcome == CallOutcome::kRefused) return c_.report(r);  // nothing sent
   if (r.outcome == CallOutcome::kTimedOut) {
-    ++tally_.errors;
-    out_ << r.text() << "\n";
+    c_.countError();
+    c_.out() << r.text() << "\n";
     return false;
   }
   const v1::Ack& ack = r.ack;
   const bool ok = ack.status() == v1::Ack::ACCEPTED;
   if (ok) {
-    out_ << robot << ": gains v" << ack.gains_version() << " accepted (" << ack.reason() << ")\n";
+    c_.out() << robot << ": gains v" << ack.gains_version() << " accepted (" << ack.reason() << ")\n";
   } else {
-    ++tally_.errors;
-    out_ << robot << ": gains push rejected: " << ack.reason() << " (v" << ack.gains_version() << " stays in force)\n";
+    c_.countError();
+    c_.out() << robot << ": gains push rejected: " << ack.reason() << " (v" << ack.gains_version() << " stays in force)\n";
   }
-  if (recorder_) {
+  if (c_.recorder()) {
     catalog::GainsPush p;
     p.robot = robot;
     p.time = std::chrono::system_clock::now();
@@ -445,12 +449,57 @@ bool Console::pushGains(const std::string& robot, const control::GainSet& g, con
     p.reason = ok ? "" : ack.reason();
     p.session_id = session;
     try {
-      recorder_->catalog().addGainsPush(p);
+      c_.recorder()->catalog().addGainsPush(p);
     } catch (const std::exception& e) {
-      out_ << "gains: warning: push not in the catalog: " << e.what() << "\n";
+      c_.out() << "gains: warning: push not in the catalog: " << e.what() << "\n";
     }
   }
   return ok;
+}
+
+// Commands of the tuning host (docs/tuning.md).
+std::vector<ConsoleCommand> TuningCommands::commands() {
+  return {
+    {"identify", {{word("run-id|last")}}, "fit the hub-motor model to a recorded run (for tune)",
+     "  Fits each wheel's gain, time constant, dead time and saturation to the commanded and\n"
+     "  measured wheel speeds of the run's telemetry (an output-error fit), prints the model and\n"
+     "  its fit (100 % = perfect), saves <run>/plant.yaml and makes it the plant tune uses.\n"
+     "  'last' = the newest identification run. Record one with `route identification`.\n"
+     "  example: identify last\n",
+     handler(this, &TuningCommands::cmdIdentify)},
+    {"tune", {{subcommand("list")}, {opt(keyValues("options", "key=value ...", tuneOptionKeys()))}}, "optimise the fuzzy-PID gains in simulation (NLopt), compare, save a session",
+     "  Closed-loop simulations of the robot's own tracker on the plant (nominal, or the last\n"
+     "  `identify`), each candidate over plant variations x noise seeds; cost = weighted max/RMS\n"
+     "  position and angle error, convergence time, effort and saturation (docs/tuning.md).\n"
+     "  Options: ref=circle|line|waypoints radius=3.5 speed=0.5 laps=1 length=10\n"
+     "           params=kp,ki,kd,ke,kec,k1,k2,k3 (or all, adds a1,a2,a3) evals=1000\n"
+     "           plant=current|nominal|<run-id>|<plant.yaml> variations=4 seeds=2 threads=0 seed=1\n"
+     "           start=working|paper|tuned\n"
+     "  Shows a progress bar and the best cost; Ctrl-C stops and keeps the best so far. Then\n"
+     "  prints PID vs fuzzy-PID (paper gains) vs tuned, writes plots and summary.md into\n"
+     "  runs/tuning/<session>/, books the session in the catalog and makes the tuned set the\n"
+     "  working set (gains push sends it). `tune list`: the sessions in the catalog.\n"
+     "  example: tune evals=300 speed=0.5\n",
+     handler(this, &TuningCommands::cmdTune)},
+    {"gains",
+     {{subcommand("show"), opt(completing(word("robot"), Source::kRobots))},
+      {keyword("set"), choice("preset", {"paper", "tuned", "robot"})},
+      {keyword("set"), keyValues("gains", "<name>=<value>...")},
+      {keyword("push"), opt(completing(word("robot"), Source::kRobots))},
+      {keyword("revert"), opt(completing(word("robot"), Source::kRobots))},
+      {keyword("export"), word("file.yaml")},
+      {keyword("import"), word("file.yaml")}},
+     "the tracking gains: working set, push to a robot, revert, files",
+     "  show: working set, the robot's set in force (with its version), the paper's, the tuned.\n"
+     "  set: edit the working set (kp ki kd ke kec k1 k2 k3 a1 a2 a3; bounds are checked).\n"
+     "  push: send the working set; the robot checks it, applies it at its next control tick\n"
+     "    (also to a path being tracked) and answers with the version now in force, or why not.\n"
+     "  revert: push the set the robot had in force before its current one.\n"
+     "  export/import: a YAML file of the gains plus the .fis fuzzy system beside it; an\n"
+     "    imported .fis that differs from the loaded one is pushed with the gains.\n"
+     "  example: gains set kp=12 ki=3\n  example: gains push\n",
+     handler(this, &TuningCommands::cmdGains)},
+  };
 }
 
 }  // namespace inspect::server
