@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -37,6 +38,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <unordered_map>
 #include <vector>
 
@@ -73,6 +75,9 @@ struct Options {
   double ber_seconds = 45;
   double garbage_per_s = 0;  // serial_relay --garbage-per-s in the BER test
   bool verbose = false;
+  // Faults run at once, each on its own stack (the short form in ctest: 2;
+  // the measurement: 1, the machine to itself).
+  int jobs = 1;
 };
 
 // ---------------------------------------------------------------- small helpers
@@ -1138,6 +1143,42 @@ bool printBer(const std::vector<BerResult>& rs, const Options& o, std::string& j
   return ok;
 }
 
+// Every chosen fault, in the table's order: one after the other with one
+// random sequence (--jobs 1), or --jobs at once, each fault on its own stack
+// with a random sequence of its own (seed + its place in the table).
+std::vector<FaultResult> runFaults(const Options& o) {
+  std::vector<const FaultDef*> chosen;
+  for (const auto& d : faultDefs())
+    if (o.faults.empty() || std::find(o.faults.begin(), o.faults.end(), d.name) != o.faults.end()) chosen.push_back(&d);
+  std::vector<FaultResult> results(chosen.size());
+  const bool keep = std::getenv("KEEP_TEST_DIRS") != nullptr;
+  auto finished = [&](const FaultResult& r) {
+    if (keep) std::fprintf(stderr, "fault_inject: %s kept in %s\n", r.def->name, r.dir.c_str());
+  };
+  if (o.jobs <= 1) {
+    std::mt19937 rng(o.seed);
+    for (std::size_t i = 0; i < chosen.size(); ++i) {
+      std::fprintf(stderr, "fault_inject: %s x %d ", chosen[i]->name, o.trials);
+      results[i] = FaultRunner(*chosen[i], o, rng).run();
+      finished(results[i]);
+    }
+    return results;
+  }
+  std::atomic<std::size_t> next{0};
+  std::vector<std::thread> lanes;
+  for (int j = 0; j < o.jobs; ++j)
+    lanes.emplace_back([&] {
+      for (std::size_t i; (i = next.fetch_add(1)) < chosen.size();) {
+        std::fprintf(stderr, "fault_inject: %s x %d (lane of %d)\n", chosen[i]->name, o.trials, o.jobs);
+        std::mt19937 rng(o.seed + static_cast<unsigned>(i));
+        results[i] = FaultRunner(*chosen[i], o, rng).run();
+        finished(results[i]);
+      }
+    });
+  for (auto& t : lanes) t.join();
+  return results;
+}
+
 // ---------------------------------------------------------------- main
 
 constexpr const char* kUsage = R"(usage: fault_inject [options]
@@ -1162,6 +1203,8 @@ options:
   --garbage-per-s N   with --ber: also bursts of 1-24 random bytes per second each way (default 0)
   --json FILE         write the figures as JSON
   --seed N            random seed (fault timing, bit errors; default 1)
+  --jobs N            faults run at once, each on a stack of its own (default 1: the measurement;
+                      ctest's short form runs 2, which leaves the 2-core machine room)
   --verbose           progress and logs of failed trials on stderr
   --help
 
@@ -1212,6 +1255,8 @@ int main(int argc, char** argv) {
       o.seed = static_cast<unsigned>(a.integer(0, 4294967295LL));
     } else if (a.is("--verbose")) {
       o.verbose = true;
+    } else if (a.is("--jobs")) {
+      o.jobs = static_cast<int>(a.integer(1, 7));
     } else {
       a.unknown();
     }
@@ -1228,14 +1273,7 @@ int main(int argc, char** argv) {
     }
     ok = printBer(rs, o, json);
   } else {
-    std::mt19937 rng(o.seed);
-    std::vector<FaultResult> results;
-    for (const auto& d : faultDefs()) {
-      if (!o.faults.empty() && std::find(o.faults.begin(), o.faults.end(), d.name) == o.faults.end()) continue;
-      std::fprintf(stderr, "fault_inject: %s x %d ", d.name, o.trials);
-      results.push_back(FaultRunner(d, o, rng).run());
-      if (std::getenv("KEEP_TEST_DIRS")) std::fprintf(stderr, "fault_inject: %s kept in %s\n", d.name, results.back().dir.c_str());
-    }
+    const std::vector<FaultResult> results = runFaults(o);
     const Verdict v = printFaults(results, o, json);
     ok = v.ok;
     if (!v.notes.empty()) {
