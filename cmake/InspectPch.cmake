@@ -15,6 +15,12 @@
 # With ccache, scripts/build.sh sets the sloppiness ccache needs to cache a
 # unit that uses a PCH (pch_defines, time_macros, include_file_*time).
 option(INSPECT_PCH "Precompiled headers for the libraries, programs and tests (faster builds)" ON)
+# clang writes the time it was made into a PCH and refuses it when its headers
+# are newer; ccache cannot cache a unit that uses such a PCH (ccache's manual,
+# "Precompiled headers"): without this, a warm sanitizer build hit 18 of 94.
+if(INSPECT_PCH AND CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+  add_compile_options("SHELL:-Xclang -fno-pch-timestamp")
+endif()
 
 set(INSPECT_PCH_HEADERS
   <algorithm> <array> <atomic> <chrono> <cmath> <condition_variable> <cstdint> <cstdio> <cstdlib> <cstring>
