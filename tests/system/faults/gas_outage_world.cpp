@@ -69,6 +69,21 @@ std::vector<CatalogAlarm> catalogAlarms(const std::string& db, const std::string
   return out;
 }
 
+std::optional<double> catalogRunEndUnix(const std::string& db, const std::string& run_id) {
+  sqlite3* h = nullptr;
+  std::optional<double> end;
+  if (sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(h, "SELECT end_unix FROM runs WHERE run_id = ?", -1, &st, nullptr) == SQLITE_OK) {
+      sqlite3_bind_text(st, 1, run_id.c_str(), -1, SQLITE_TRANSIENT);
+      if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_type(st, 0) != SQLITE_NULL) end = sqlite3_column_double(st, 0);
+    }
+    sqlite3_finalize(st);
+  }
+  sqlite3_close(h);
+  return end;
+}
+
 std::vector<RecordedAlarm> mcapAlarms(const std::string& path) {
   std::vector<RecordedAlarm> out;
   auto r = record::McapReader::open(path);

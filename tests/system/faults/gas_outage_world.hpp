@@ -3,6 +3,7 @@
 // cleared all along, and the readers of the alarm transitions robot_client
 // logged and the catalog filed (docs/store-and-forward.md).
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,9 @@ struct LoggedAlarm {
 };
 /// Every alarm transition in a robot_client log (appended across restarts), in order.
 std::vector<LoggedAlarm> robotLoggedAlarms(const std::string& log_path);
+
+/// When a run of the catalog ended (`record stop`), Unix seconds; nullopt while it runs or when not found.
+std::optional<double> catalogRunEndUnix(const std::string& db, const std::string& run_id);
 
 /// One row of the catalog's alarms table.
 struct CatalogAlarm {
