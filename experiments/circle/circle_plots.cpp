@@ -101,7 +101,7 @@ std::string plotErrors(const Options& o, const std::vector<const Run*>& runs, co
 }
 
 // Wheel speeds and fuzzy-scheduled gains during the start transient, and kp over the whole run.
-std::string plotWheelsAndGains(const Options& o, const std::vector<const Run*>& runs, const control::PidGains& base, const std::string& dir,
+std::string plotWheelsAndGains(const std::vector<const Run*>& runs, const control::PidGains& base, const std::string& dir,
                  std::vector<std::string>& written) {
   const double window_s = 3.0;
   auto wheels = panel("Wheel speeds, first " + fmt(window_s, 0) + " s (solid: left, dashed: right)", "t (s)",
@@ -178,7 +178,7 @@ std::string writePlots(const Options& o, const std::vector<const Run*>& runs, co
   const std::string dir = o.plots_dir + "/";
   if (auto err = plotTrajectories(o, runs, dir, written); !err.empty()) return err;
   if (auto err = plotErrors(o, runs, dir, written); !err.empty()) return err;
-  return plotWheelsAndGains(o, runs, base, dir, written);
+  return plotWheelsAndGains(runs, base, dir, written);
 }
 
 }  // namespace inspect::circle
