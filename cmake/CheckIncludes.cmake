@@ -28,6 +28,10 @@
 #                    on console/ and operator/, never on each other nor app/
 #                 4. app/ (main, options, config, the consoles' wiring):
 #                    included by nobody
+#   firmware/core/  the MCU's logic: firmware/core/ and the serial codec
+#                 (shared/serial/) only: it is built for the STM32 too
+#   firmware/host/, firmware/tools/: no program (robot_client, pc_server, sim,
+#                 experiments, tests)
 #   experiments/  no robot_client/; of tests/ only tests/support/paths.hpp,
 #                 udp_relay.hpp (the seeded lossy link of bench_video --loss) and
 #                 postgres_server.hpp (bench_catalog's own PostgreSQL server)
@@ -38,8 +42,9 @@ endif()
 set(problems "")
 set(checked 0)
 
-# rule(<folder> <what may not be included: a regex on the include path> <why>)
-function(check_folder folder deny why)
+# _check_includes(<folder> <regex on the include path> <DENY|ONLY> <why>): DENY
+# refuses the includes that match, ONLY those that do not.
+function(_check_includes folder regex mode why)
   file(GLOB_RECURSE files RELATIVE ${ROOT} ${ROOT}/${folder}/*.cpp ${ROOT}/${folder}/*.hpp)
   foreach(f IN LISTS files)
     if(DEFINED skip_regex AND f MATCHES "${skip_regex}")
@@ -48,11 +53,25 @@ function(check_folder folder deny why)
     file(STRINGS ${ROOT}/${f} lines REGEX "^[ \t]*#[ \t]*include[ \t]*\"")
     foreach(l IN LISTS lines)
       string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]*\"([^\"]+)\".*$" "\\1" inc "${l}")
-      if(inc MATCHES "${deny}")
+      set(matched FALSE)
+      if(inc MATCHES "${regex}")
+        set(matched TRUE)
+      endif()
+      if((mode STREQUAL "DENY" AND matched) OR (mode STREQUAL "ONLY" AND NOT matched))
         set(problems "${problems}\n  ${f}: #include \"${inc}\": ${why}")
       endif()
     endforeach()
   endforeach()
+  set(problems "${problems}" PARENT_SCOPE)
+endfunction()
+# check_folder(<folder> <what may not be included: a regex on the include path> <why>)
+function(check_folder folder deny why)
+  _check_includes(${folder} "${deny}" DENY "${why}")
+  set(problems "${problems}" PARENT_SCOPE)
+endfunction()
+# check_folder_only(<folder> <what alone may be included: a regex> <why>)
+function(check_folder_only folder allow why)
+  _check_includes(${folder} "${allow}" ONLY "${why}")
   set(problems "${problems}" PARENT_SCOPE)
 endfunction()
 
@@ -71,6 +90,9 @@ check_folder(pc_server/operator "^pc_server/(console|terminal|foxglove|app)/" "t
 check_folder(pc_server/console "^pc_server/(terminal|foxglove|app)/" "the console's parser and formatter include no terminal/, foxglove/ or app/ (front ends stand on it)")
 check_folder(pc_server/terminal "^pc_server/(foxglove|app)/" "the terminal front end includes no foxglove/ nor app/")
 check_folder(pc_server/foxglove "^pc_server/(terminal|app)/" "the Foxglove bridge includes no terminal/ nor app/")
+check_folder_only(firmware/core "^(firmware/core|shared/serial)/" "the firmware's core includes only firmware/core/ and shared/serial/ (it is built for the STM32)")
+check_folder(firmware/host "${programs}" "the firmware's host tools include no program")
+check_folder(firmware/tools "${programs}" "the firmware's host tools include no program")
 check_folder(experiments "^robot_client/|^tests/(.*/)?[a-z_]+\\.hpp$" "an experiment includes no program's code (of tests/ only tests/support/paths.hpp, udp_relay.hpp, postgres_server.hpp)")
 
 # The allowed exception of the rule above.

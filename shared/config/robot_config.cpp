@@ -48,6 +48,26 @@ RobotConfig loadRobotConfig(const ConfigNode& root) {
   c.camera.z_m = cam.number("z_m", c.camera.z_m, 0.05, 5.0);
   c.camera.hfov_deg = cam.number("hfov_deg", c.camera.hfov_deg, 10.0, 150.0);
   c.camera.tilt_deg = cam.number("tilt_deg", c.camera.tilt_deg, -45.0, 45.0);
+  const auto mcu = root.optChild("mcu");
+  auto& f = c.mcu;
+  f.encoder_counts_per_rev = static_cast<int>(mcu.integer("encoder_counts_per_rev", f.encoder_counts_per_rev, 16, 1000000));
+  f.speed_kp = mcu.number("speed_kp", f.speed_kp, 0.0, 100.0);
+  f.speed_ki = mcu.number("speed_ki", f.speed_ki, 0.0, 1000.0);
+  f.speed_ff = mcu.number("speed_ff", f.speed_ff, 0.0, 10.0);
+  f.obstacle_stop_m = mcu.number("obstacle_stop_m", f.obstacle_stop_m, 0.0, 2.0);
+  f.obstacle_clear_m = mcu.number("obstacle_clear_m", f.obstacle_clear_m, 0.0, 2.5);
+  if (f.obstacle_stop_m > 0 && f.obstacle_clear_m <= f.obstacle_stop_m)
+    mcu.fail("obstacle_clear_m", "must exceed obstacle_stop_m (the stop's hysteresis)");
+  f.ultrasonic_slot_ms = static_cast<int>(mcu.integer("ultrasonic_slot_ms", f.ultrasonic_slot_ms, 10, 100));
+  f.ultrasonic_missed_limit = static_cast<int>(mcu.integer("ultrasonic_missed_limit", f.ultrasonic_missed_limit, 1, 100));
+  f.gas_shunt_ohm = mcu.number("gas_shunt_ohm", f.gas_shunt_ohm, 10.0, 1000.0);
+  if (21e-3 * f.gas_shunt_ohm > 3.3) mcu.fail("gas_shunt_ohm", "21 mA across it exceeds the ADC's 3.3 V");
+  f.battery_divider = mcu.number("battery_divider", f.battery_divider, 1.0, 100.0);
+  f.battery_low_mv = static_cast<int>(mcu.integer("battery_low_mv", f.battery_low_mv, 0, 60000));
+  f.battery_clear_mv = static_cast<int>(mcu.integer("battery_clear_mv", f.battery_clear_mv, 0, 60000));
+  if (f.battery_clear_mv <= f.battery_low_mv) mcu.fail("battery_clear_mv", "must exceed battery_low_mv");
+  f.ptz_slew_deg_s = mcu.number("ptz_slew_deg_s", f.ptz_slew_deg_s, 1.0, 3600.0);
+  f.servo_us_per_deg = mcu.number("servo_us_per_deg", f.servo_us_per_deg, 1.0, 100.0);
   c.gas = loadGasConfig(root.optChild("gas"), root.has("gas"));
   return c;
 }

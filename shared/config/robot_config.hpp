@@ -71,12 +71,34 @@ struct CameraMount {
   double tilt_deg = 0.0;  // the head's own tilt on the robot, up positive; the PTZ's tilt adds to it
 };
 
+/// The MCU firmware's own settings (the `mcu` section; firmware/, docs/firmware.md):
+/// its hub-motor speed loops, encoders, anti-collision stop, sensors' electrical
+/// interfaces and the camera mount's servos. scripts/build_firmware.sh turns
+/// them into the firmware's settings header.
+struct McuConfig {
+  int encoder_counts_per_rev = 16384;  // quadrature counts per wheel revolution (4096 lines x 4)
+  double speed_kp = 1.0;               // duty per rad/s of wheel speed error
+  double speed_ki = 2.0;               // duty per rad of integrated error
+  double speed_ff = 0.154;             // feed-forward duty per rad/s of set-point (1 / no-load speed at full duty)
+  double obstacle_stop_m = 0.15;       // forward motion stopped while a front range is under this (0 = off)
+  double obstacle_clear_m = 0.20;      // ... until both front ranges are above this
+  int ultrasonic_slot_ms = 30;         // one sensor fired per slot, in turn (4.5 m and back: 26 ms)
+  int ultrasonic_missed_limit = 3;     // slots in a row without an echo pulse: ULTRASONIC
+  double gas_shunt_ohm = 150.0;        // 4-20 mA gas transmitters into this shunt at the ADC
+  double battery_divider = 11.0;       // battery voltage / ADC pin voltage
+  int battery_low_mv = 22200;          // BATTERY_LOW below this
+  int battery_clear_mv = 22600;        // ... until above this
+  double ptz_slew_deg_s = 120.0;       // servo set-point slew limit
+  double servo_us_per_deg = 11.11;     // servo pulse per degree (1000 us per 90 degrees)
+};
+
 struct RobotConfig {
   RobotGeometry geometry;
   RobotLimits limits;
   MotorModel motor;
   UltrasonicConfig ultrasonic;
   CameraMount camera;
+  McuConfig mcu;
   GasConfig gas;  // the `gas` section (none when absent; defaultGasConfig() = config/robot.yaml's)
 };
 

@@ -1,6 +1,7 @@
 # The build's include check (cmake/CheckIncludes.cmake) on scratch trees:
-# a tree that keeps the arrows passes; one deliberate inner-layer include
-# (pc_server/link including pc_server/console) fails, naming the file.
+# a tree that keeps the arrows passes; every include across pc_server's
+# floors, and the firmware's core including more than itself and the serial
+# codec, fails, naming the file.
 #   cmake -DSCRIPT=<CheckIncludes.cmake> -DWORK=<scratch dir> -P check_includes_test.cmake
 set(tree ${WORK}/include_check_tree)
 file(REMOVE_RECURSE ${tree})
@@ -40,5 +41,19 @@ execute_process(COMMAND ${CMAKE_COMMAND} -DROOT=${tree} -P ${SCRIPT} RESULT_VARI
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "a front end standing on the console was refused:\n${err}")
 endif()
+# The firmware's core includes only itself and the serial codec: it is built for the STM32.
+file(WRITE ${tree}/firmware/core/ok.cpp "#include \"firmware/core/a.hpp\"\n#include \"shared/serial/frame_codec.hpp\"\n")
+execute_process(COMMAND ${CMAKE_COMMAND} -DROOT=${tree} -P ${SCRIPT} RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the firmware's core including the serial codec was refused:\n${err}")
+endif()
+foreach(inc shared/config/robot_config.hpp firmware/host/settings_from_config.hpp sim/robot_plant.hpp)
+  file(WRITE ${tree}/firmware/core/bad.cpp "#include \"${inc}\"\n")
+  execute_process(COMMAND ${CMAKE_COMMAND} -DROOT=${tree} -P ${SCRIPT} RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "firmware/core/bad.cpp: #include \"${inc}\"")
+    message(FATAL_ERROR "firmware/core including ${inc} was not refused (rc ${rc}):\n${err}")
+  endif()
+  math(EXPR refused "${refused} + 1")
+endforeach()
 file(REMOVE_RECURSE ${tree})
 message(STATUS "include check: the clean tree passes, ${refused} includes across floors refused")

@@ -1,0 +1,32 @@
+#pragma once
+// Wheel travel and heading from the encoders' totals (docs/serial-protocol.md
+// SensorFrame): each wheel's cumulative travel in 0.1 mm (int32, wrapping),
+// and the heading integrated from the difference of the wheels' travel
+// (Eq 1's differential drive: dtheta = (d_right - d_left) / track),
+// counter-clockwise positive, wrapped to [-pi, pi], in 0.1 mrad.
+#include <array>
+#include <cstdint>
+
+#include "firmware/core/mcu_settings.hpp"
+
+namespace inspect::firmware {
+
+class Odometry {
+ public:
+  explicit Odometry(const McuSettings& s);
+  /// The encoders' totals (counts since start, left and right).
+  void update(int64_t left_counts, int64_t right_counts);
+  std::array<int32_t, 2> displacement0p1mm() const { return disp_; }
+  int16_t heading0p1mrad() const;
+  float headingRad() const { return heading_rad_; }
+
+ private:
+  double m_per_count_;
+  double track_m_;
+  bool started_ = false;
+  std::array<int64_t, 2> last_{};
+  std::array<int32_t, 2> disp_{};
+  float heading_rad_ = 0.0f;
+};
+
+}  // namespace inspect::firmware
