@@ -1,5 +1,7 @@
 #include "firmware/core/analog_inputs.hpp"
 
+#include "shared/serial/messages.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -12,7 +14,7 @@ constexpr float kFaultBelowA = 3.6e-3f, kFaultAboveA = 21e-3f;  // NAMUR NE 43
 
 uint16_t gasCount(const McuSettings& s, const GasChannelSettings& ch, uint16_t adc_counts) {
   const float amps = static_cast<float>(adc_counts) / kAdcFullScale * kAdcVref / s.gas_shunt_ohm;
-  if (amps < kFaultBelowA || amps > kFaultAboveA) return kGasNoData;
+  if (amps < kFaultBelowA || amps > kFaultAboveA) return serial::kGasNoData;
   const float value = ch.range_min + (amps - kLoopMinA) / kLoopSpanA * (ch.range_max - ch.range_min);
   const float count = std::round(value / ch.scale);
   return static_cast<uint16_t>(std::clamp(count, 0.0f, 65534.0f));  // 0xFFFF is the fault

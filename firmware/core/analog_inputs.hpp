@@ -3,7 +3,7 @@
 // Gas: each channel a 4-20 mA transmitter across the shunt (gas_shunt_ohm):
 // 4 mA = the channel's range_min, 20 mA = its range_max, the frame's count =
 // value / scale (docs/serial-protocol.md gas_raw); under 3.6 mA or over 21 mA
-// is a sensor fault (NAMUR NE 43): 0xFFFF and GAS_SENSOR.
+// is a sensor fault (NAMUR NE 43): serial::kGasNoData (0xFFFF) and GAS_SENSOR.
 // Battery: the pin's voltage times battery_divider, mV; BATTERY_LOW below
 // battery_low_mv until above battery_clear_mv.
 #include <array>
@@ -12,8 +12,6 @@
 #include "firmware/core/mcu_settings.hpp"
 
 namespace inspect::firmware {
-
-inline constexpr uint16_t kGasNoData = 0xFFFF;
 
 /// A gas channel's frame count from its ADC counts (0xFFFF: sensor fault).
 uint16_t gasCount(const McuSettings& s, const GasChannelSettings& ch, uint16_t adc_counts);

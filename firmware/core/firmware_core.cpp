@@ -65,7 +65,6 @@ PeripheralOutputs FirmwareCore::tick(uint32_t now_ms, const PeripheralInputs& in
   obstacle_.limit(applied_[0], applied_[1]);
   out.duty = {left_.step(applied_[0], drive, in.encoder[0]), right_.step(applied_[1], drive, in.encoder[1])};
   out.brake = !drive;
-  odometry_.update(left_.encoder().total(), right_.encoder().total());
   ptz_.step();
   out.servo_us = ptz_.pulsesUs();
 
@@ -84,6 +83,7 @@ void FirmwareCore::sendFrame(uint32_t now_ms, const PeripheralInputs& in) {
     return static_cast<int16_t>(std::clamp(std::lround(rad_s * 1000.0f), -32768L, 32767L));
   };
   f.wheel_speed_mrad_s = {mrad(left_.speedRadS()), mrad(right_.speedRadS())};
+  odometry_.update(left_.encoder().total(), right_.encoder().total());
   f.wheel_disp_0p1mm = odometry_.displacement0p1mm();
   f.heading_0p1mrad = odometry_.heading0p1mrad();
   f.ultrasonic_mm = ultrasonic_.rangesMm();
@@ -91,7 +91,7 @@ void FirmwareCore::sendFrame(uint32_t now_ms, const PeripheralInputs& in) {
   gas_fault_ = false;
   for (std::size_t i = 0; i < f.gas_raw.size(); ++i) {
     f.gas_raw[i] = i < s_.gas_channel_count ? gasCount(s_, s_.gas[i], in.gas_adc[i]) : 0;
-    gas_fault_ = gas_fault_ || (i < s_.gas_channel_count && f.gas_raw[i] == kGasNoData);
+    gas_fault_ = gas_fault_ || (i < s_.gas_channel_count && f.gas_raw[i] == serial::kGasNoData);
   }
   f.battery_mv = batteryMv(s_, in.battery_adc);
   battery_.update(f.battery_mv);

@@ -33,7 +33,7 @@ namespace inspect::firmware {
 struct PeripheralInputs {
   std::array<uint16_t, 2> encoder{};  // the left and right encoder timers' counters
   EchoCapture echo;                   // the echo of the sensor fired in the slot that ends now
-  std::array<uint16_t, 4> gas_adc{};  // ADC counts of the gas channels, in slot order
+  std::array<uint16_t, serial::kGasChannels> gas_adc{};  // ADC counts of the gas channels, in slot order
   uint16_t battery_adc = 0;
   uint8_t grayscale = 0;              // bit i = line sensor channel i sees a line
   bool estop_pressed = false;         // the button's contact, raw

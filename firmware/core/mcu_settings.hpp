@@ -7,6 +7,8 @@
 #include <array>
 #include <cstdint>
 
+#include "shared/serial/messages.hpp"
+
 namespace inspect::firmware {
 
 /// One gas channel of the sensor frame: a 4-20 mA transmitter read across the
@@ -36,7 +38,7 @@ struct McuSettings {
   float obstacle_clear_m = 0.20f;
   // Gas channels (robot.yaml gas.channels, in slot order).
   uint8_t gas_channel_count = 0;
-  std::array<GasChannelSettings, 4> gas{};
+  std::array<GasChannelSettings, serial::kGasChannels> gas{};
   float gas_shunt_ohm = 150.0f;
   // Battery.
   float battery_divider = 11.0f;

@@ -14,20 +14,13 @@ Odometry::Odometry(const McuSettings& s)
 
 void Odometry::update(int64_t left_counts, int64_t right_counts) {
   const std::array<int64_t, 2> now{left_counts, right_counts};
-  // Travel since start in 0.1 mm, from the totals (no error accumulates); the
-  // frame's int32 wraps as the protocol says.
+  // Everything from the totals, so nothing accumulates and any rate will do:
+  // each wheel's travel in 0.1 mm (the frame's int32 wraps as the protocol
+  // says), and the heading, linear in the travel difference.
   for (std::size_t i = 0; i < 2; ++i)
     disp_[i] = static_cast<int32_t>(static_cast<uint32_t>(std::llround(static_cast<double>(now[i]) * m_per_count_ * 1e4)));
-  if (started_) {
-    const double dl = static_cast<double>(now[0] - last_[0]) * m_per_count_;
-    const double dr = static_cast<double>(now[1] - last_[1]) * m_per_count_;
-    double h = static_cast<double>(heading_rad_) + (dr - dl) / track_m_;
-    while (h > kPi) h -= 2 * kPi;
-    while (h < -kPi) h += 2 * kPi;
-    heading_rad_ = static_cast<float>(h);
-  }
-  started_ = true;
-  last_ = now;
+  const double turned = static_cast<double>(now[1] - now[0]) * m_per_count_ / track_m_;
+  heading_rad_ = static_cast<float>(std::remainder(turned, 2 * kPi));  // [-pi, pi]
 }
 
 int16_t Odometry::heading0p1mrad() const {

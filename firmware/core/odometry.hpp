@@ -1,9 +1,10 @@
 #pragma once
 // Wheel travel and heading from the encoders' totals (docs/serial-protocol.md
 // SensorFrame): each wheel's cumulative travel in 0.1 mm (int32, wrapping),
-// and the heading integrated from the difference of the wheels' travel
-// (Eq 1's differential drive: dtheta = (d_right - d_left) / track),
-// counter-clockwise positive, wrapped to [-pi, pi], in 0.1 mrad.
+// and the heading from the difference of the wheels' travel since boot
+// (Eq 1's differential drive: theta = (d_right - d_left) / track),
+// counter-clockwise positive, wrapped to [-pi, pi], in 0.1 mrad. A pure
+// function of the totals: computed when a frame is built, not every tick.
 #include <array>
 #include <cstdint>
 
@@ -23,8 +24,6 @@ class Odometry {
  private:
   double m_per_count_;
   double track_m_;
-  bool started_ = false;
-  std::array<int64_t, 2> last_{};
   std::array<int32_t, 2> disp_{};
   float heading_rad_ = 0.0f;
 };

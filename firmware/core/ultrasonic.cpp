@@ -9,9 +9,9 @@ constexpr float kSoundMmPerUs = 0.343f;  // 343 m/s
 }
 
 uint16_t UltrasonicScheduler::toMm(const EchoCapture& c) const {
-  if (!c.fell) return kNoEcho;  // still high at the slot's end: nothing within it
+  if (!c.fell) return serial::kNoEcho;  // still high at the slot's end: nothing within it
   const float mm = static_cast<float>(c.width_us) * kSoundMmPerUs / 2.0f;
-  if (mm > s_.ultrasonic_max_range_m * 1000.0f) return kNoEcho;
+  if (mm > s_.ultrasonic_max_range_m * 1000.0f) return serial::kNoEcho;
   return static_cast<uint16_t>(std::max(mm, s_.ultrasonic_min_range_m * 1000.0f) + 0.5f);
 }
 
@@ -25,12 +25,12 @@ int UltrasonicScheduler::tick(uint32_t now_ms, const EchoCapture& capture) {
       ranges_[i] = toMm(capture);
     } else {
       if (missed_[i] < 255) ++missed_[i];
-      ranges_[i] = kNoEcho;
+      ranges_[i] = serial::kNoEcho;
     }
   }
   started_ = true;
   slot_start_ms_ = now_ms;
-  current_ = (current_ + 1) % 4;
+  current_ = (current_ + 1) % serial::kUltrasonicCount;
   return current_;
 }
 

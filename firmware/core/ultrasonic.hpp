@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "firmware/core/mcu_settings.hpp"
+#include "shared/serial/messages.hpp"
 
 namespace inspect::firmware {
 
@@ -23,18 +24,17 @@ struct EchoCapture {
 
 class UltrasonicScheduler {
  public:
-  static constexpr uint16_t kNoEcho = 0xFFFF;
   explicit UltrasonicScheduler(const McuSettings& s) : s_(s) {}
 
-  /// Every ms: the sensor to trigger now (0-3), or -1. `capture` is the echo
+  /// Every ms: the sensor to trigger now (serial::UltrasonicIndex), or -1. `capture` is the echo
   /// of the sensor fired in the slot that ends now (read when a slot ends).
   int tick(uint32_t now_ms, const EchoCapture& capture);
 
-  std::array<uint16_t, 4> rangesMm() const { return ranges_; }
+  std::array<uint16_t, serial::kUltrasonicCount> rangesMm() const { return ranges_; }
   /// Some sensor does not answer (ULTRASONIC).
   bool fault() const;
   /// Slots completed per sensor (its readings).
-  const std::array<uint32_t, 4>& readings() const { return readings_; }
+  const std::array<uint32_t, serial::kUltrasonicCount>& readings() const { return readings_; }
 
  private:
   uint16_t toMm(const EchoCapture& c) const;
@@ -42,9 +42,10 @@ class UltrasonicScheduler {
   bool started_ = false;
   uint32_t slot_start_ms_ = 0;
   int current_ = -1;  // the sensor fired in the running slot
-  std::array<uint16_t, 4> ranges_{kNoEcho, kNoEcho, kNoEcho, kNoEcho};
-  std::array<uint8_t, 4> missed_{};
-  std::array<uint32_t, 4> readings_{};
+  std::array<uint16_t, serial::kUltrasonicCount> ranges_{serial::kNoEcho, serial::kNoEcho, serial::kNoEcho,
+                                                        serial::kNoEcho};
+  std::array<uint8_t, serial::kUltrasonicCount> missed_{};
+  std::array<uint32_t, serial::kUltrasonicCount> readings_{};
 };
 
 /// The MCU's own anti-collision stop: active from a front range under

@@ -6,7 +6,6 @@
 // gas, tuning, runs, scripts: console/*_commands.hpp), each reaching the robots
 // through this console's OperatorService. It holds no terminal and no socket:
 // lines in, text out (tested on strings).
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <functional>

@@ -8,11 +8,12 @@
 #include <vector>
 
 #include "shared/config/config_node.hpp"
+#include "shared/serial/messages.hpp"
 
 namespace inspect::config {
 
-/// Raw value a gas slot carries when its sensor gives no reading.
-inline constexpr uint16_t kGasNoData = 0xFFFF;
+/// Raw value a gas slot carries when its sensor gives no reading (the protocol's).
+inline constexpr uint16_t kGasNoData = serial::kGasNoData;
 /// Largest raw value that is a reading.
 inline constexpr uint16_t kGasRawMax = 0xFFFE;
 

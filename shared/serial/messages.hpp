@@ -21,6 +21,8 @@ enum UltrasonicIndex : int { kFrontLeft = 0, kFrontRight = 1, kLeft = 2, kRight 
 inline constexpr int kGasChannels = 4;
 /// Ultrasonic value meaning "no echo within range".
 inline constexpr uint16_t kNoEcho = 0xFFFF;
+/// Gas slot value meaning "the sensor gives no data" (0..0xFFFE are readings).
+inline constexpr uint16_t kGasNoData = 0xFFFF;
 
 /// MCU fault flag bits (SensorFrame::faults).
 enum McuFault : uint16_t {

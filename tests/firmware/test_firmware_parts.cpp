@@ -124,9 +124,9 @@ TEST(UltrasonicScheduler, NoEchoBeyondRangeAndASilentSensorIsAFault) {
   };
   u.tick(t++, {});  // fires sensor 0
   slot({true, false, 0});  // still high at the slot's end: nothing in range
-  EXPECT_EQ(u.rangesMm()[0], UltrasonicScheduler::kNoEcho);
+  EXPECT_EQ(u.rangesMm()[0], serial::kNoEcho);
   slot({true, true, 30000});  // 5.1 m: beyond max_range_m 4.5
-  EXPECT_EQ(u.rangesMm()[1], UltrasonicScheduler::kNoEcho);
+  EXPECT_EQ(u.rangesMm()[1], serial::kNoEcho);
   slot({true, true, 58});  // 1 cm: under min_range_m reads as min
   EXPECT_EQ(u.rangesMm()[2], 20);
   for (int i = 0; i < 4 * s.ultrasonic_missed_limit; ++i) slot({});  // nobody answers
@@ -166,10 +166,10 @@ TEST(AnalogInputs, GasTransmittersFourToTwentyMilliampsWithNamurFaults) {
   EXPECT_NEAR(gasCount(s, ch4, gasAdcCounts(s, ch4, 50.0f)), 5000, 5);  // 12 mA: 50 %LEL
   EXPECT_NEAR(gasCount(s, ch4, gasAdcCounts(s, ch4, 12.5f)), 1250, 5);
   const float amps_per_count = kAdcVref / kAdcFullScale / s.gas_shunt_ohm;
-  EXPECT_EQ(gasCount(s, ch4, static_cast<uint16_t>(3.5e-3f / amps_per_count)), kGasNoData);   // under 3.6 mA
-  EXPECT_EQ(gasCount(s, ch4, static_cast<uint16_t>(21.2e-3f / amps_per_count)), kGasNoData);  // over 21 mA
-  EXPECT_EQ(gasCount(s, ch4, 0), kGasNoData);  // a broken loop
-  EXPECT_NE(gasCount(s, ch4, static_cast<uint16_t>(3.8e-3f / amps_per_count)), kGasNoData);  // under-range, no fault
+  EXPECT_EQ(gasCount(s, ch4, static_cast<uint16_t>(3.5e-3f / amps_per_count)), serial::kGasNoData);   // under 3.6 mA
+  EXPECT_EQ(gasCount(s, ch4, static_cast<uint16_t>(21.2e-3f / amps_per_count)), serial::kGasNoData);  // over 21 mA
+  EXPECT_EQ(gasCount(s, ch4, 0), serial::kGasNoData);  // a broken loop
+  EXPECT_NE(gasCount(s, ch4, static_cast<uint16_t>(3.8e-3f / amps_per_count)), serial::kGasNoData);  // under-range, no fault
 }
 
 TEST(AnalogInputs, BatteryMillivoltsAndItsLowFlagWithHysteresis) {
