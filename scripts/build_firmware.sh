@@ -14,7 +14,8 @@
 #    malloc/free, operator new/delete, __cxa_throw, typeinfo: arm-none-eabi-nm)
 #    and prints the sizes (arm-none-eabi-size).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+self=$(readlink -f "$0")
+cd "$(dirname "$self")/.."
 ROOT=$PWD
 robot=config/robot.yaml out=build-firmware gen=""
 while [ $# -gt 0 ]; do
@@ -22,7 +23,7 @@ while [ $# -gt 0 ]; do
     --robot) robot=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --settings-gen) gen=$2; shift 2 ;;
-    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$self" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "build_firmware: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done

@@ -2,16 +2,21 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 namespace inspect::firmware {
 
 namespace {
 constexpr double kPi = 3.14159265358979;
 
-/// A float literal of C++ (0 -> 0.0f, 1e-05 -> 1e-05f).
-std::string num(double v) {
+/// The shortest float literal of C++ that reads back as `v` (0.2f, not
+/// 0.200000003f; 0 -> 0.0f, 1e-05 -> 1e-05f).
+std::string num(float v) {
   char b[64];
-  std::snprintf(b, sizeof b, "%.9g", v);
+  for (int digits = 6; digits <= 9; ++digits) {
+    std::snprintf(b, sizeof b, "%.*g", digits, static_cast<double>(v));
+    if (std::strtof(b, nullptr) == v) break;
+  }
   std::string s = b;
   if (s.find_first_of(".e") == std::string::npos) s += ".0";
   return s + "f";
@@ -53,7 +58,7 @@ std::string settingsHeader(const McuSettings& s, const std::string& source) {
                   " by firmware/tools/mcu_settings_gen (scripts/build_firmware.sh). Do not edit.\n"
                   "#include \"firmware/core/mcu_settings.hpp\"\n\nnamespace inspect::firmware {\n\n"
                   "inline constexpr McuSettings kMcuSettings = [] {\n  McuSettings s;\n";
-  auto f = [&](const char* name, double v) { h += std::string("  s.") + name + " = " + num(v) + ";\n"; };
+  auto f = [&](const char* name, float v) { h += std::string("  s.") + name + " = " + num(v) + ";\n"; };
   auto u = [&](const char* name, unsigned long v) { h += std::string("  s.") + name + " = " + std::to_string(v) + ";\n"; };
   f("wheel_radius_m", s.wheel_radius_m);
   f("track_m", s.track_m);
