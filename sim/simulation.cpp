@@ -157,17 +157,49 @@ behavior::Agent Simulation::robotBody() const {
   return r;
 }
 
-void Simulation::receive(std::span<const uint8_t> bytes) { mcu_.receive(bytes, t_ms_); }
+void Simulation::receive(std::span<const uint8_t> bytes) {
+  if (hil_) {
+    hil_->receive(bytes, t_ms_);
+  } else {
+    mcu_.receive(bytes, t_ms_);
+  }
+}
 
 void Simulation::emitFrame() {
   McuInputs in;
   in.truth = state_;
-  in.ultrasonic_mm = ultrasonic_.measureAllMm(world_, state_.pose, people_.crowd.circles());
-  in.grayscale = GrayscaleModel::read(world_, state_.pose);
-  sampleGas(in);
-  const auto frame = mcu_.sendSensorFrame(t_ms_, in, tx_);
-  if (observer_) observer_->onSample({timeS(), state_.pose, state_.wheel, mcu_.setpoints(), frame.faults});
+  if (hil_) {
+    // The firmware builds the frames: here the gas sensors are sampled for its ADC inputs.
+    sampleGas(in);
+    hil_gas_raw_ = in.gas_raw;
+    if (observer_) observer_->onSample({timeS(), state_.pose, state_.wheel, wheelTargets(), 0});
+  } else {
+    in.ultrasonic_mm = ultrasonic_.measureAllMm(world_, state_.pose, people_.crowd.circles());
+    in.grayscale = GrayscaleModel::read(world_, state_.pose);
+    sampleGas(in);
+    const auto frame = mcu_.sendSensorFrame(t_ms_, in, tx_);
+    if (observer_) observer_->onSample({timeS(), state_.pose, state_.wheel, mcu_.setpoints(), frame.faults});
+  }
   if (t_ms_ % kPedestrianPeriod_ms == 0) emitPedestrians();
+}
+
+void Simulation::useHilFirmware(const config::RobotConfig& robot) {
+  hil_ = std::make_unique<HilMcu>(robot);
+  if (observer_) observer_->onEvent(timeS(), "hil", "the MCU is the firmware on the HIL link");
+}
+
+void Simulation::stepHil() {
+  // A ping is answered at once with the range now (the echo returns within the
+  // firmware's 30 ms slot); the encoders go out every 2 ms, the rest every 20 ms
+  // and with each answer.
+  bool answered = false;
+  if (const int s = hil_->pendingPing(); s >= 0) {
+    hil_->answerPing(ultrasonic_.measureMm(world_, state_.pose, s, people_.crowd.circles()));
+    answered = true;
+  }
+  if (t_ms_ % HilMcu::kInputPeriod_ms == 0) hil_->sendEncoders(state_, tx_);
+  if (answered || t_ms_ % HilMcu::kSensorPeriod_ms == 0)
+    hil_->sendSensors(t_ms_, GrayscaleModel::read(world_, state_.pose), hil_gas_raw_, tx_);
 }
 
 void Simulation::emitPedestrians() {
@@ -204,7 +236,11 @@ void Simulation::checkPersonContacts() {
 }
 
 void Simulation::step() {
-  mcu_.tick(t_ms_);
+  if (hil_) {
+    stepHil();
+  } else {
+    mcu_.tick(t_ms_);
+  }
   people_.crowd.reportInitial();
   reportGasStart();
   if (t_ms_ % kGasPeriod_ms == 0) gas_.model.advanceTo(timeS());  // fields at t for this step's frame
@@ -212,7 +248,7 @@ void Simulation::step() {
   const double dt_s = static_cast<double>(kStep_ms) / 1000.0;
   // Both from the state at t: the people react to where the robot is now.
   if (people_.wait_for_motion && !people_.started) {
-    const auto sp = mcu_.setpoints();
+    const auto sp = wheelTargets();
     if (sp.left_rad_s != 0.0 || sp.right_rad_s != 0.0) {
       people_.started = true;
       people_.t0_s = timeS();
@@ -220,7 +256,7 @@ void Simulation::step() {
     }
   }
   if (!people_.wait_for_motion || people_.started) people_.crowd.step(timeS() - people_.t0_s, dt_s, robotBody());
-  const auto r = plant_.step(state_, motor_delay_.apply(timeS(), mcu_.setpoints()), dt_s);
+  const auto r = plant_.step(state_, motor_delay_.apply(timeS(), wheelTargets()), dt_s);
   state_ = r.state;
   checkPersonContacts();
   if (r.blocked && !in_contact_) {

@@ -4,6 +4,7 @@
 // and no clocks: bytes go in through receive(), frames come out of takeTx().
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "sim/gas_model.hpp"
 #include "sim/gas_sensor.hpp"
 #include "sim/grayscale_model.hpp"
+#include "sim/hil_mcu.hpp"
 #include "sim/mcu_emulator.hpp"
 #include "sim/pedestrian_crowd.hpp"
 #include "sim/robot_plant.hpp"
@@ -47,7 +49,19 @@ class Simulation {
   /// Sim time at which the pedestrians' clock started (0 unless waiting; < 0 while still waiting).
   double peopleClockStartS() const { return people_.wait_for_motion && !people_.started ? -1.0 : people_.t0_s; }
 
-  /// Bytes from the host, applied at the current sim time.
+  /// From now on the MCU is the real firmware, hardware-in-the-loop (mcu_sim
+  /// --hil, sim/hil_mcu.hpp): receive() takes its board's HIL bytes, takeTx()
+  /// gives what its peripherals read (every HilMcu::kInputPeriod_ms), and the
+  /// motors follow its PWM duty. The emulator stays idle.
+  void useHilFirmware(const config::RobotConfig& robot);
+  /// The HIL link's end, when useHilFirmware() was called.
+  const HilMcu* hilMcu() const { return hil_.get(); }
+  /// How often takeTx() has something: the sensor frame's period, or the HIL inputs'.
+  uint64_t outputPeriodMs() const { return hil_ ? HilMcu::kInputPeriod_ms : kFramePeriod_ms; }
+  /// The speeds the motors run toward now: the emulator's set-points, or the firmware's duty's.
+  control::WheelSpeeds wheelTargets() const { return hil_ ? hil_->motorTargets() : mcu_.setpoints(); }
+
+  /// Bytes from the host (or the HIL board), applied at the current sim time.
   void receive(std::span<const uint8_t> bytes);
   /// One 1 ms step: MCU timers, a sensor frame when due, physics (robot and pedestrians).
   void step();
@@ -88,6 +102,7 @@ class Simulation {
     std::vector<std::pair<int, double>> cross;  // (field, factor) of the other gases that leak
   };
   void emitFrame();
+  void stepHil();
   void emitPedestrians();
   void checkPersonContacts();
   void reportGasStart();
@@ -99,6 +114,8 @@ class Simulation {
   control::SetpointDelay motor_delay_;  // the plant's dead time (world `plant:`)
   UltrasonicModel ultrasonic_;
   McuEmulator mcu_;
+  std::unique_ptr<HilMcu> hil_;
+  std::array<uint16_t, serial::kGasChannels> hil_gas_raw_{};  // the gas sensors' last readings, for the HIL inputs
   SimObserver* observer_;
   PlantState state_;
   uint64_t t_ms_ = 0;

@@ -75,6 +75,7 @@ class FirmwareCore {
   std::size_t takeTx(std::span<uint8_t> out);
   std::size_t txPending() const { return tx_len_; }
 
+  const McuSettings& settings() const { return s_; }
   /// McuFault bits now.
   uint16_t faults() const;
   /// The last sensor frame built.

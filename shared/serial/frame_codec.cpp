@@ -3,42 +3,13 @@
 #include <type_traits>
 
 #include "shared/serial/crc16.hpp"
+#include "shared/serial/wire_io.hpp"
 
 namespace inspect::serial {
 namespace {
 
-// Little-endian writer/reader over a fixed buffer.
-struct Writer {
-  uint8_t* p;
-  std::size_t n = 0;
-  void u8(uint8_t v) { p[n++] = v; }
-  void u16(uint16_t v) {
-    u8(static_cast<uint8_t>(v));
-    u8(static_cast<uint8_t>(v >> 8));
-  }
-  void i16(int16_t v) { u16(static_cast<uint16_t>(v)); }
-  void u32(uint32_t v) {
-    u16(static_cast<uint16_t>(v));
-    u16(static_cast<uint16_t>(v >> 16));
-  }
-  void i32(int32_t v) { u32(static_cast<uint32_t>(v)); }
-};
-
-struct Reader {
-  const uint8_t* p;
-  std::size_t n = 0;
-  uint8_t u8() { return p[n++]; }
-  uint16_t u16() {
-    const uint16_t lo = u8();
-    return static_cast<uint16_t>(lo | (static_cast<uint16_t>(u8()) << 8));
-  }
-  int16_t i16() { return static_cast<int16_t>(u16()); }
-  uint32_t u32() {
-    const uint32_t lo = u16();
-    return lo | (static_cast<uint32_t>(u16()) << 16);
-  }
-  int32_t i32() { return static_cast<int32_t>(u32()); }
-};
+using Writer = WireWriter;
+using Reader = WireReader;
 
 MsgId idOf(const Message& m) {
   return std::visit(
@@ -111,14 +82,12 @@ bool readAs(Reader& r, std::size_t payload_len, std::size_t expected, Message& o
 
 }  // namespace
 
-EncodedFrame FrameEncoder::encode(const Message& msg) {
+EncodedFrame encodeRawFrame(uint8_t id, uint8_t seq, std::span<const uint8_t> payload) {
   std::array<uint8_t, kMaxRawFrame> raw{};
   Writer w{raw.data()};
-  const auto id = static_cast<uint8_t>(idOf(msg));
-  const uint8_t seq = next_seq_[id]++;
   w.u8(id);
   w.u8(seq);
-  std::visit([&](const auto& v) { writePayload(w, v); }, msg);
+  for (uint8_t b : payload) w.u8(b);
   const uint16_t crc = crc16CcittFalse({raw.data(), w.n});
   w.u16(crc);
   EncodedFrame f;
@@ -128,20 +97,35 @@ EncodedFrame FrameEncoder::encode(const Message& msg) {
   return f;
 }
 
-FrameError decodeFrame(std::span<const uint8_t> cobs_bytes, Message& msg, uint8_t& seq) {
-  std::array<uint8_t, kMaxRawFrame> raw{};
-  const auto n = cobsDecode(cobs_bytes, raw);
+FrameError decodeRawFrame(std::span<const uint8_t> cobs_bytes, RawFrame& out) {
+  const auto n = cobsDecode(cobs_bytes, out.raw);
   if (!n) return FrameError::kBadCobs;
   if (*n < 4) return FrameError::kBadLength;
   const std::size_t body = *n - 2;
-  const uint16_t want = static_cast<uint16_t>(raw[body] | (raw[body + 1] << 8));
-  if (crc16CcittFalse({raw.data(), body}) != want) return FrameError::kBadCrc;
-  Reader r{raw.data()};
-  const uint8_t id = r.u8();
-  seq = r.u8();
-  const std::size_t payload = body - 2;
+  const uint16_t want = static_cast<uint16_t>(out.raw[body] | (out.raw[body + 1] << 8));
+  if (crc16CcittFalse({out.raw.data(), body}) != want) return FrameError::kBadCrc;
+  out.id = out.raw[0];
+  out.seq = out.raw[1];
+  out.payload = {out.raw.data() + 2, body - 2};
+  return FrameError::kNone;
+}
+
+EncodedFrame FrameEncoder::encode(const Message& msg) {
+  std::array<uint8_t, kMaxRawFrame> payload{};
+  Writer w{payload.data()};
+  std::visit([&](const auto& v) { writePayload(w, v); }, msg);
+  const auto id = static_cast<uint8_t>(idOf(msg));
+  return encodeRawFrame(id, next_seq_[id]++, {payload.data(), w.n});
+}
+
+FrameError decodeFrame(std::span<const uint8_t> cobs_bytes, Message& msg, uint8_t& seq) {
+  RawFrame f;
+  if (const FrameError err = decodeRawFrame(cobs_bytes, f); err != FrameError::kNone) return err;
+  seq = f.seq;
+  Reader r{f.payload.data()};
+  const std::size_t payload = f.payload.size();
   bool ok = false;
-  switch (static_cast<MsgId>(id)) {
+  switch (static_cast<MsgId>(f.id)) {
     case MsgId::kSensorFrame: ok = readAs<SensorFrame>(r, payload, kSensorFramePayload, msg); break;
     case MsgId::kWheelCommand: ok = readAs<WheelCommand>(r, payload, kWheelCommandPayload, msg); break;
     case MsgId::kHeartbeat: ok = readAs<Heartbeat>(r, payload, kHeartbeatPayload, msg); break;

@@ -48,13 +48,27 @@ struct DecoderCounters {
 /// `msg` and `seq` when it is valid.
 FrameError decodeFrame(std::span<const uint8_t> cobs_bytes, Message& msg, uint8_t& seq);
 
-/// Streaming decoder: accepts bytes in any split, resynchronises on 0x00.
-class FrameDecoder {
+/// The frame layer alone, for a link with messages of its own (the HIL link,
+/// shared/hil): [id][seq][payload][CRC-16/CCITT-FALSE], COBS, then 0x00.
+EncodedFrame encodeRawFrame(uint8_t id, uint8_t seq, std::span<const uint8_t> payload);
+/// A raw frame's parts after decodeRawFrame; `payload` points into `raw`.
+struct RawFrame {
+  std::array<uint8_t, kMaxRawFrame> raw{};
+  uint8_t id = 0;
+  uint8_t seq = 0;
+  std::span<const uint8_t> payload;
+};
+/// Checks COBS, length and CRC of one frame (COBS bytes without delimiter):
+/// kNone with `out` filled, or kBadCobs, kBadLength, kBadCrc.
+FrameError decodeRawFrame(std::span<const uint8_t> cobs_bytes, RawFrame& out);
+
+/// Splits a byte stream at the 0x00 delimiters, in any split: on_frame(cobs
+/// bytes) for each non-empty frame; a frame longer than kMaxEncodedFrame is
+/// dropped whole and given as on_overflow().
+class FrameAssembler {
  public:
-  /// Feeds received bytes; calls on_message(const Message&, uint8_t seq) for each valid frame.
-  template <class F>
-  void feed(std::span<const uint8_t> bytes, F&& on_message) {
-    counters_.bytes_rx += bytes.size();
+  template <class F, class G>
+  void feed(std::span<const uint8_t> bytes, F&& on_frame, G&& on_overflow) {
     for (uint8_t b : bytes) {
       if (b != 0) {
         if (len_ < buf_.size()) {
@@ -65,16 +79,37 @@ class FrameDecoder {
         continue;
       }
       if (overflowing_) {
-        ++counters_.overflow;
+        on_overflow();
       } else if (len_ > 0) {
-        Message msg;
-        uint8_t seq = 0;
-        const FrameError err = decodeFrame({buf_.data(), len_}, msg, seq);
-        if (accept(err, msg, seq)) on_message(msg, seq);
+        on_frame(std::span<const uint8_t>(buf_.data(), len_));
       }
       len_ = 0;
       overflowing_ = false;
     }
+  }
+
+ private:
+  std::array<uint8_t, kMaxEncodedFrame> buf_{};
+  std::size_t len_ = 0;
+  bool overflowing_ = false;
+};
+
+/// Streaming decoder: accepts bytes in any split, resynchronises on 0x00.
+class FrameDecoder {
+ public:
+  /// Feeds received bytes; calls on_message(const Message&, uint8_t seq) for each valid frame.
+  template <class F>
+  void feed(std::span<const uint8_t> bytes, F&& on_message) {
+    counters_.bytes_rx += bytes.size();
+    assembler_.feed(
+        bytes,
+        [&](std::span<const uint8_t> frame) {
+          Message msg;
+          uint8_t seq = 0;
+          const FrameError err = decodeFrame(frame, msg, seq);
+          if (accept(err, msg, seq)) on_message(msg, seq);
+        },
+        [&] { ++counters_.overflow; });
   }
   const DecoderCounters& counters() const { return counters_; }
   /// The reason the most recent bad frame was dropped.
@@ -82,9 +117,7 @@ class FrameDecoder {
 
  private:
   bool accept(FrameError err, const Message& msg, uint8_t seq);
-  std::array<uint8_t, kMaxEncodedFrame> buf_{};
-  std::size_t len_ = 0;
-  bool overflowing_ = false;
+  FrameAssembler assembler_;
   DecoderCounters counters_;
   FrameError last_error_ = FrameError::kNone;
   std::array<int16_t, 256> last_seq_ = [] {

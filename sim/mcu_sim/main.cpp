@@ -49,10 +49,17 @@ int main(int argc, char** argv) {
       camera->publish(simulation);
       camera->start();
     }
-    sim::PtyPort port(opt.pty_link);
-
-    std::printf("mcu_sim: serial device %s\n", port.slavePath().c_str());
-    if (!opt.pty_link.empty()) std::printf("mcu_sim: linked at %s\n", opt.pty_link.c_str());
+    std::unique_ptr<sim::PtyPort> port_owner;
+    if (opt.hil_device.empty()) {
+      port_owner = std::make_unique<sim::PtyPort>(opt.pty_link);
+      std::printf("mcu_sim: serial device %s\n", port_owner->slavePath().c_str());
+      if (!opt.pty_link.empty()) std::printf("mcu_sim: linked at %s\n", opt.pty_link.c_str());
+    } else {
+      port_owner = std::make_unique<sim::PtyPort>(sim::PtyPort::Device{opt.hil_device});
+      simulation.useHilFirmware(robot);
+      std::printf("mcu_sim: hil link %s (the MCU is the firmware on its board)\n", opt.hil_device.c_str());
+    }
+    sim::PtyPort& port = *port_owner;
     if (camera)
       std::printf("mcu_sim: camera %s (%dx%d at %g fps; robot_client --video-source sim:%s)\n",
                   opt.camera_path.c_str(), opt.camera_width, opt.camera_height, opt.camera_fps,
@@ -80,6 +87,13 @@ int main(int argc, char** argv) {
                 r.final_pose.theta_rad);
     std::printf("mcu_sim: %s\n", stats.c_str());
     if (camera) std::printf("mcu_sim: %s\n", camera->summary().c_str());
+    if (const sim::HilMcu* hil = simulation.hilMcu()) {
+      std::printf("mcu_sim: hil frames_in=%u errors=%u inputs_out=%llu held_back=%llu pings=%llu; %s\n",
+                  hil->framesReceived(), hil->errors(), static_cast<unsigned long long>(hil->framesSent()),
+                  static_cast<unsigned long long>(hil->framesHeldBack()),
+                  static_cast<unsigned long long>(hil->pings()),
+                  hil->tickLateness().summary("firmware control ticks late (TIM2)").c_str());
+    }
     std::fflush(stdout);
     if (truth) {
       truth->comment(stats);

@@ -62,6 +62,17 @@ PtyPort::PtyPort(const std::string& link_path) {
   }
 }
 
+PtyPort::PtyPort(const Device& device) : slave_path_(device.path) {
+  master_fd_ = ::open(device.path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+  if (master_fd_ < 0) fail("--hil " + device.path);
+  try {
+    makeRaw(master_fd_, device.path.c_str());
+  } catch (...) {
+    ::close(master_fd_);
+    throw;
+  }
+}
+
 PtyPort::~PtyPort() {
   if (!link_path_.empty()) {
     // Remove the link only if it is still ours (another mcu_sim may have replaced it).

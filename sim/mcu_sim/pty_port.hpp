@@ -8,12 +8,18 @@
 
 namespace inspect::sim {
 
-/// A pty pair owned by mcu_sim. Throws std::system_error when it cannot be set up.
+/// A pty pair owned by mcu_sim (or a terminal device it opened). Throws std::system_error when it cannot be set up.
 class PtyPort {
  public:
   /// Opens the pty; when link_path is non-empty, points a symlink there at the
   /// slave device (replacing an existing symlink, never another kind of file).
   explicit PtyPort(const std::string& link_path = "");
+  /// An existing terminal device instead (mcu_sim --hil: the pty QEMU made for
+  /// the firmware board's USART2), raw and non-blocking; nothing is linked.
+  struct Device {
+    std::string path;
+  };
+  explicit PtyPort(const Device& device);
   ~PtyPort();
   PtyPort(const PtyPort&) = delete;
   PtyPort& operator=(const PtyPort&) = delete;

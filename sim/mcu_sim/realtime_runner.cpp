@@ -74,7 +74,7 @@ SerialStats RealtimeRunner::stats(double wall_s) const {
   s.bytes_sent = port_.bytesWritten();
   s.bytes_dropped = port_.bytesDropped();
   s.bytes_received = port_.bytesRead();
-  s.frames_sent = sim_.mcu().framesSent();
+  s.frames_sent = sim_.hilMcu() ? sim_.hilMcu()->framesSent() : sim_.mcu().framesSent();
   s.rx = sim_.mcu().rxCounters();
   s.sim_s = sim_.timeS();
   s.wall_s = wall_s;
@@ -105,7 +105,7 @@ RunSummary RealtimeRunner::run() {
     uint64_t target_ms = simNowMs(monoNowNs());
     // Wall time since the first frame still to send was due: beyond a frame
     // period, this process was not run when it should have been.
-    constexpr uint64_t kP = Simulation::kFramePeriod_ms;
+    const uint64_t kP = sim_.outputPeriodMs();
     const uint64_t due_ms = (sim_.timeMs() + kP - 1) / kP * kP;
     if (target_ms > due_ms + kP) {
       const double late_ms = static_cast<double>(target_ms - due_ms) / rate;
@@ -141,7 +141,7 @@ RunSummary RealtimeRunner::run() {
     }
     // Wake when the step that emits the next pending frame is due (the frame
     // at t is sent by the step from t to t + 1 ms).
-    constexpr uint64_t kP = Simulation::kFramePeriod_ms;
+    const uint64_t kP = sim_.outputPeriodMs();
     uint64_t wake_ms = (sim_.timeMs() + kP - 1) / kP * kP + Simulation::kStep_ms;
     // The MCU's watchdog runs every 1 ms step like the firmware's timer
     // interrupt: wake for the step in which it would trip, so that the motors

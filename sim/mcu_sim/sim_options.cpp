@@ -12,6 +12,11 @@ std::string simUsage() {
          "  --world FILE     world file (config/worlds/*.yaml), required\n"
          "  --robot FILE     robot config (default: config/robot.yaml, relative to the working directory)\n"
          "  --pty-link PATH  also make PATH a symlink to the serial device (removed on exit)\n"
+         "  --hil TTY        hardware-in-the-loop: the MCU is the real firmware (scripts/mcu_qemu.sh\n"
+         "                   --hil-link TTY), not emulated: the world is sent to its board over TTY (encoder\n"
+         "                   counts, echoes, ADC counts, line bits) and its PWM duty drives the motors;\n"
+         "                   robot_client opens the board's own serial line. Real time only (no --rate,\n"
+         "                   --pty-link or --frame-log; docs/firmware.md)\n"
          "  --truth FILE     write the ground-truth CSV log (docs/simulator.md)\n"
          "  --frame-log FILE also log every sensor frame sent (id, sequence number, CRC; needs --truth),\n"
          "                   to check what a receiver accepted against what was sent (docs/failsafes.md)\n"
@@ -46,6 +51,7 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     else if (a.is("--world")) o.world_path = a.text(), have_world = true;
     else if (a.is("--robot")) o.robot_path = a.path();
     else if (a.is("--pty-link")) o.pty_link = a.path();
+    else if (a.is("--hil")) o.hil_device = a.path();
     else if (a.is("--truth")) o.truth_path = a.path();
     else if (a.is("--frame-log")) o.frame_log_path = a.path();
     else if (a.is("--people-wait-motion")) o.people_wait_motion = true;
@@ -63,6 +69,12 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
   if (!o.help && o.camera_path.empty() && camera_fps) throw cli::UsageError("--camera-fps: needs --camera");
   if (!o.help && (!have_world || o.world_path.empty())) throw cli::UsageError("--world: required");
   if (!o.help && !o.frame_log_path.empty() && o.truth_path.empty()) throw cli::UsageError("--frame-log: needs --truth");
+  if (!o.help && !o.hil_device.empty()) {
+    // The firmware runs on the wall clock and owns the Pi's line and its frames.
+    if (o.rate != 1.0) throw cli::UsageError("--rate: the firmware in the loop runs in real time (--hil)");
+    if (!o.pty_link.empty()) throw cli::UsageError("--pty-link: with --hil the Pi's line is the board's (scripts/mcu_qemu.sh --serial-link)");
+    if (!o.frame_log_path.empty()) throw cli::UsageError("--frame-log: with --hil the firmware sends the frames");
+  }
   return o;
 }
 

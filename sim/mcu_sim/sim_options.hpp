@@ -14,6 +14,7 @@ struct SimOptions {
   std::string world_path;
   std::string robot_path = "config/robot.yaml";
   std::string pty_link;              // empty: no symlink
+  std::string hil_device;            // --hil: the firmware board's HIL link (a tty); empty: the MCU is emulated
   std::string truth_path;            // empty: no truth log
   std::string frame_log_path;        // empty: no log of the sensor frames sent (needs truth_path)
   double rate = 1.0;                 // sim seconds per wall second, [0.1, 100]

@@ -55,5 +55,21 @@ foreach(inc shared/config/robot_config.hpp firmware/host/settings_from_config.hp
   endif()
   math(EXPR refused "${refused} + 1")
 endforeach()
+file(REMOVE ${tree}/firmware/core/bad.cpp)
+# What is built for the STM32 besides the core: the boards, the serial codec
+# and the HIL link include nothing of the host's.
+foreach(pair "firmware/boards/qemu|shared/config/robot_config.hpp" "firmware/boards/f405|sim/hil_mcu.hpp"
+        "shared/hil|shared/config/robot_config.hpp" "shared/serial|shared/util/log.hpp")
+  string(REPLACE "|" ";" pair "${pair}")
+  list(GET pair 0 folder)
+  list(GET pair 1 inc)
+  file(WRITE ${tree}/${folder}/bad.cpp "#include \"${inc}\"\n")
+  execute_process(COMMAND ${CMAKE_COMMAND} -DROOT=${tree} -P ${SCRIPT} RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "${folder}/bad.cpp: #include \"${inc}\"")
+    message(FATAL_ERROR "${folder} including ${inc} was not refused (rc ${rc}):\n${err}")
+  endif()
+  file(REMOVE ${tree}/${folder}/bad.cpp)
+  math(EXPR refused "${refused} + 1")
+endforeach()
 file(REMOVE_RECURSE ${tree})
 message(STATUS "include check: the clean tree passes, ${refused} includes across floors refused")

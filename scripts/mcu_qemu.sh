@@ -1,0 +1,113 @@
+#!/usr/bin/env bash
+# Runs the MCU firmware in QEMU (docs/firmware.md): the QEMU board's image on
+# QEMU's netduinoplus2 (an STM32F405), its USART1 (the Pi's serial line) on a
+# pseudo-terminal linked at PATH, for robot_client --serial PATH.
+#
+#   scripts/mcu_qemu.sh --serial-link PATH [--elf FILE] [--mcu-sim PROGRAM]
+#                       [--hil-link PATH2 | --world FILE [mcu_sim options...]]
+#
+# --world FILE [options]: the simulated world attached: `mcu_sim --hil` on
+#   USART2, the hardware-in-the-loop link, with the world file and the mcu_sim
+#   options after it (--truth, --duration, --camera ...; mcu_sim --help).
+# --hil-link PATH2: USART2 on a pty linked at PATH2 instead, for an mcu_sim
+#   started by hand (`mcu_sim --hil PATH2 --world ...`).
+# Neither: the world is held still (the wheels at rest, nothing in range, gas
+#   at 4 mA, the battery full).
+# --elf FILE: the image (default build-firmware/inspect-mcu-qemu.elf, built by
+#   scripts/build_firmware.sh when missing).
+# --mcu-sim PROGRAM: default build/bin/mcu_sim.
+# Runs until SIGINT/SIGTERM (or mcu_sim's --duration); QEMU's own messages go
+# to stderr. Stops what it started and removes its links.
+set -euo pipefail
+self=$(readlink -f "$0")
+cd "$(dirname "$self")/.."
+link="" hil_link="" elf="" world="" mcu_sim=build/bin/mcu_sim
+sim_args=()
+while [ $# -gt 0 ]; do
+  case $1 in
+    --serial-link) link=$2; shift 2 ;;
+    --hil-link) hil_link=$2; shift 2 ;;
+    --elf) elf=$2; shift 2 ;;
+    --mcu-sim) mcu_sim=$2; shift 2 ;;
+    --world) world=$2; shift 2; sim_args=("$@"); break ;;
+    -h|--help) sed -n '2,22p' "$self" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "mcu_qemu: unknown argument '$1' (try --help)" >&2; exit 2 ;;
+  esac
+done
+if [ -z "$link" ]; then
+  echo "mcu_qemu: --serial-link PATH is required (try --help)" >&2
+  exit 2
+fi
+if [ -n "$world" ] && [ -n "$hil_link" ]; then
+  echo "mcu_qemu: --world starts mcu_sim on the HIL link itself; --hil-link is for one started by hand" >&2
+  exit 2
+fi
+if [ -n "$world" ]; then
+  [ -x "$mcu_sim" ] || { echo "mcu_qemu: no mcu_sim at $mcu_sim (scripts/build.sh, or --mcu-sim)" >&2; exit 1; }
+  hil_link=$(mktemp -u "${TMPDIR:-/tmp}/mcu-qemu-hil-XXXXXX")
+fi
+if ! command -v qemu-system-arm >/dev/null; then
+  echo "mcu_qemu: qemu-system-arm is missing: run scripts/setup.sh (qemu-system-arm)" >&2
+  exit 1
+fi
+if [ -z "$elf" ]; then
+  elf=build-firmware/inspect-mcu-qemu.elf
+  [ -f "$elf" ] || bash scripts/build_firmware.sh >&2
+fi
+if [ ! -f "$elf" ]; then
+  echo "mcu_qemu: no firmware image at $elf" >&2
+  exit 1
+fi
+
+log=$(mktemp)
+second=null
+[ -n "$hil_link" ] && second=pty
+qemu-system-arm -M netduinoplus2 -display none -monitor none -serial pty -serial "$second" \
+  -kernel "$elf" >"$log" 2>&1 &
+qemu=$!
+sim=""
+cleanup() {
+  [ -n "$sim" ] && { kill "$sim" 2>/dev/null || true; wait "$sim" 2>/dev/null || true; }
+  kill "$qemu" 2>/dev/null || true
+  wait "$qemu" 2>/dev/null || true
+  rm -f "$log"
+  [ -L "$link" ] && rm -f "$link"
+  [ -n "$hil_link" ] && [ -L "$hil_link" ] && rm -f "$hil_link"
+  return 0
+}
+trap 'cleanup; exit 0' INT TERM
+trap cleanup EXIT
+# QEMU names its ptys on stderr: "char device redirected to /dev/pts/N (label serial0)".
+pty_of() { sed -n "s|.*redirected to \(/dev/pts/[0-9]*\) (label $1).*|\1|p" "$log" | head -n 1; }
+for _ in $(seq 1 100); do
+  [ -n "$(pty_of serial0)" ] && { [ -z "$hil_link" ] || [ -n "$(pty_of serial1)" ]; } && break
+  kill -0 "$qemu" 2>/dev/null || break
+  sleep 0.05
+done
+usart1=$(pty_of serial0)
+if [ -z "$usart1" ]; then
+  echo "mcu_qemu: QEMU did not start:" >&2
+  cat "$log" >&2
+  exit 1
+fi
+ln -sfn "$usart1" "$link"
+echo "mcu_qemu: firmware $elf, USART1 (serial line) $usart1 at $link"
+if [ -n "$hil_link" ]; then
+  ln -sfn "$(pty_of serial1)" "$hil_link"
+  echo "mcu_qemu: USART2 (HIL link) $(pty_of serial1) at $hil_link"
+fi
+tail -n +1 -f "$log" >&2 &
+tailer=$!
+if [ -n "$world" ]; then
+  "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" &
+  sim=$!
+  # Until either ends: mcu_sim's --duration, or QEMU stopped.
+  while kill -0 "$sim" 2>/dev/null && kill -0 "$qemu" 2>/dev/null; do sleep 0.2; done
+  rc=0
+  wait "$sim" || rc=$?
+  sim=""
+  kill "$tailer" 2>/dev/null || true
+  exit $rc
+fi
+wait "$qemu" || true
+kill "$tailer" 2>/dev/null || true

@@ -1,0 +1,93 @@
+#include "sim/hil_mcu.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "firmware/core/analog_inputs.hpp"
+#include "firmware/host/settings_from_config.hpp"
+#include "sim/mcu_emulator.hpp"
+
+namespace inspect::sim {
+
+HilMcu::HilMcu(const config::RobotConfig& robot)
+    : settings_(firmware::settingsFrom(robot)), wheel_radius_m_(robot.geometry.wheel_radius_m) {
+  echo_.echo_flags = hil::HilSensors::kEchoRose;  // until a ping: nothing in range
+}
+
+void HilMcu::receive(std::span<const uint8_t> bytes, uint64_t) {
+  decoder_.feed(bytes, [&](const hil::HilMessage& m, uint8_t) {
+    const auto* out = std::get_if<hil::HilOutputs>(&m);
+    if (!out) return;  // the board sends nothing else
+    if (!heard_) {
+      answered_count_ = out->trigger_count;  // pings before the link came up are gone
+      seq_ = static_cast<uint8_t>(out->input_seq + 1);
+    }
+    last_ = *out;
+    acked_seq_ = out->input_seq;
+    heard_ = true;
+    late_.record(static_cast<int64_t>(out->tick_late_us) * 1000);
+  });
+}
+
+control::WheelSpeeds HilMcu::motorTargets() const {
+  if (!heard_ || (last_.flags & hil::HilOutputs::kBrake)) return {0.0, 0.0};
+  const double per_duty = 1.0 / (10000.0 * settings_.speed_ff);
+  return {last_.duty_1e4[0] * per_duty, last_.duty_1e4[1] * per_duty};
+}
+
+void HilMcu::answerPing(uint16_t range_mm) {
+  ++pings_;
+  answered_count_ = last_.trigger_count;
+  echo_.echo_count = last_.trigger_count;
+  if (range_mm == serial::kNoEcho) {
+    echo_.echo_flags = hil::HilSensors::kEchoRose;  // still high when the slot ends
+    echo_.echo_width_us = 0;
+  } else {
+    // Out and back at 343 m/s, as the firmware reads it (firmware/core/ultrasonic.cpp).
+    echo_.echo_flags = hil::HilSensors::kEchoRose | hil::HilSensors::kEchoFell;
+    echo_.echo_width_us = static_cast<uint32_t>(std::lround(range_mm * 2.0 / 0.343));
+  }
+}
+
+void HilMcu::sendEncoders(const PlantState& truth, std::vector<uint8_t>& tx) {
+  const double counts_per_m = settings_.encoder_counts_per_rev / (2.0 * std::numbers::pi * wheel_radius_m_);
+  auto counter = [&](double travel_m) {
+    return static_cast<uint16_t>(static_cast<int64_t>(std::floor(travel_m * counts_per_m)) & 0xFFFF);
+  };
+  append(hil::HilEncoders{{counter(truth.wheel_travel_left_m), counter(truth.wheel_travel_right_m)}}, tx);
+}
+
+void HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
+                         std::vector<uint8_t>& tx) {
+  hil::HilSensors in = echo_;
+  for (std::size_t i = 0; i < serial::kGasChannels; ++i) {
+    const firmware::GasChannelSettings& ch = settings_.gas[i];
+    if (i >= settings_.gas_channel_count || gas_raw[i] == serial::kGasNoData) {
+      // No transmitter, or a failed one: the fault current.
+      const float span = ch.range_max - ch.range_min;
+      in.gas_adc[i] = firmware::gasAdcCounts(settings_, ch, ch.range_min - span * (4.0f - kFailedTransmitterMa) / 16.0f);
+    } else {
+      in.gas_adc[i] = firmware::gasAdcCounts(settings_, ch, static_cast<float>(gas_raw[i]) * ch.scale);
+    }
+  }
+  // The battery as the emulated MCU's (sim/mcu_emulator.hpp).
+  const double mv = McuEmulator::kBatteryStart_mv - McuEmulator::kBatteryDrain_mv_per_s * static_cast<double>(now_ms) / 1000.0;
+  in.battery_adc = firmware::batteryAdcCounts(settings_, static_cast<uint16_t>(std::max(0.0, std::round(mv))));
+  in.grayscale = grayscale;
+  in.switches = 0;
+  append(in, tx);
+}
+
+void HilMcu::append(const hil::HilMessage& m, std::vector<uint8_t>& tx) {
+  // Nothing before the board speaks (it holds the world still meanwhile), and
+  // no more than kMaxInFlight frames it has not taken.
+  if (!heard_ || static_cast<uint8_t>(seq_ - acked_seq_ - 1) >= kMaxInFlight) {
+    ++held_back_;
+    return;
+  }
+  const auto frame = hil::encodeHil(m, seq_++);
+  tx.insert(tx.end(), frame.bytes.begin(), frame.bytes.begin() + static_cast<std::ptrdiff_t>(frame.size));
+  ++frames_sent_;
+}
+
+}  // namespace inspect::sim

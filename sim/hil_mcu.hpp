@@ -1,0 +1,85 @@
+#pragma once
+// The MCU as the real firmware, hardware-in-the-loop (mcu_sim --hil,
+// docs/firmware.md): in place of McuEmulator, the simulation stands in for
+// the peripherals the firmware's QEMU board does not have. It reads the
+// board's HilOutputs (shared/hil: PWM duty, brake, pings, servo pulses) and
+// sends it the encoder counters every kInputPeriod_ms (HilEncoders) and the
+// other peripherals every kSensorPeriod_ms and at each ping's answer
+// (HilSensors: the echo, gas and battery ADC counts, line bits, the switches).
+// The motors: a DC motor per wheel, a first order toward the speed its duty
+// drives it at without load (duty / mcu.speed_ff: 6.5 rad/s at full duty),
+// with the plant's time constant; braked, toward 0. So the firmware's speed
+// loop is what moves the robot. Pure: no I/O, time is an argument.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "firmware/core/mcu_settings.hpp"
+#include "shared/config/robot_config.hpp"
+#include "shared/control/diff_drive.hpp"
+#include "shared/hil/hil_link.hpp"
+#include "shared/util/latency_histogram.hpp"
+#include "sim/robot_plant.hpp"
+
+namespace inspect::sim {
+
+class HilMcu {
+ public:
+  static constexpr uint64_t kInputPeriod_ms = 2;    // encoders, 500 Hz
+  static constexpr uint64_t kSensorPeriod_ms = 20;  // the rest, 50 Hz (QEMU takes about 9 KB/s)
+  /// Frames sent and not yet taken by the board (HilOutputs::input_seq) at
+  /// most: QEMU takes a pty's bytes one at a time, slower than 500 frames a
+  /// second when its host is busy, and a frame that waited in the pty's queue
+  /// would give the firmware a stale encoder count. Beyond it the frame is not
+  /// sent (the next one carries newer values: every field is absolute).
+  static constexpr uint8_t kMaxInFlight = 4;
+  /// Below this the drivers' fault current (NAMUR NE 43: a failed transmitter's 2 mA).
+  static constexpr float kFailedTransmitterMa = 2.0f;
+
+  explicit HilMcu(const config::RobotConfig& robot);
+
+  /// Bytes from the board's USART2 at now_ms.
+  void receive(std::span<const uint8_t> bytes, uint64_t now_ms);
+  /// The speeds the motors run toward now (rad/s), from the latest duty.
+  control::WheelSpeeds motorTargets() const;
+  /// The sensor of a ping not answered yet, or -1.
+  int pendingPing() const { return answered_count_ != last_.trigger_count && heard_ ? last_.trigger_sensor : -1; }
+  /// Answers it with the range the world gives (serial::kNoEcho: nothing in range).
+  void answerPing(uint16_t range_mm);
+  /// The encoder counters of `truth`, as a frame appended to tx.
+  void sendEncoders(const PlantState& truth, std::vector<uint8_t>& tx);
+  /// What the other peripherals read at now_ms, as a frame appended to tx.
+  void sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
+                   std::vector<uint8_t>& tx);
+
+  bool heard() const { return heard_; }
+  const hil::HilOutputs& lastOutputs() const { return last_; }
+  uint32_t framesReceived() const { return decoder_.framesOk(); }
+  uint32_t errors() const { return decoder_.errors(); }
+  uint64_t framesSent() const { return frames_sent_; }
+  uint64_t pings() const { return pings_; }
+  /// Frames not sent: kMaxInFlight were in flight.
+  uint64_t framesHeldBack() const { return held_back_; }
+  /// How late the firmware's control ticks started (TIM2), from its reports.
+  const util::LatencyHistogram& tickLateness() const { return late_; }
+
+ private:
+  firmware::McuSettings settings_;
+  double wheel_radius_m_;
+  hil::HilDecoder decoder_;
+  hil::HilOutputs last_;
+  bool heard_ = false;
+  hil::HilSensors echo_;  // the echo fields of the answer to the latest ping
+  uint8_t answered_count_ = 0;
+  uint8_t seq_ = 0;
+  uint8_t acked_seq_ = 0;  // the board's input_seq
+  uint64_t frames_sent_ = 0;
+  uint64_t held_back_ = 0;
+  uint64_t pings_ = 0;
+  util::LatencyHistogram late_;
+
+  void append(const hil::HilMessage& m, std::vector<uint8_t>& tx);
+};
+
+}  // namespace inspect::sim

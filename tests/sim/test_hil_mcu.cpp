@@ -1,0 +1,210 @@
+// The simulator's end of the HIL link (sim/hil_mcu.hpp) and the link's codec
+// (shared/hil): what the firmware's board would read, turned back by the
+// firmware core's own conversions; its duty as the motors' targets.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "firmware/core/analog_inputs.hpp"
+#include "firmware/host/settings_from_config.hpp"
+#include "shared/config/robot_config.hpp"
+#include "shared/hil/hil_link.hpp"
+#include "sim/hil_mcu.hpp"
+#include "sim/simulation.hpp"
+#include "tests/support/paths.hpp"
+
+namespace inspect::sim {
+namespace {
+
+config::RobotConfig robot() { return config::loadRobotConfigFile(test::srcPath("config/robot.yaml")); }
+
+template <class T>
+std::vector<T> decodeAll(const std::vector<uint8_t>& bytes) {
+  std::vector<T> out;
+  hil::HilDecoder d;
+  d.feed(bytes, [&](const hil::HilMessage& m, uint8_t) {
+    if (const auto* in = std::get_if<T>(&m)) out.push_back(*in);
+  });
+  EXPECT_EQ(d.errors(), 0u);
+  return out;
+}
+const auto decodeInputs = decodeAll<hil::HilSensors>;
+
+std::vector<uint8_t> frameOf(const hil::HilOutputs& o, uint8_t seq = 0) {
+  const auto f = hil::encodeHil(o, seq);
+  return {f.bytes.begin(), f.bytes.begin() + static_cast<std::ptrdiff_t>(f.size)};
+}
+
+TEST(HilLink, EveryMessageRoundTripsAndCorruptionIsCounted) {
+  const hil::HilEncoders enc{{65535, 12}};
+  hil::HilSensors in;
+  in.echo_count = 7;
+  in.echo_flags = hil::HilSensors::kEchoRose | hil::HilSensors::kEchoFell;
+  in.echo_width_us = 5831;
+  in.gas_adc = {1, 2, 3, 4095};
+  in.battery_adc = 2800;
+  in.grayscale = 0xA5;
+  in.switches = hil::HilSensors::kEStopPressed;
+  hil::HilOutputs out;
+  out.mcu_time_ms = 123456789;
+  out.duty_1e4 = {-10000, 2500};
+  out.flags = hil::HilOutputs::kBrake;
+  out.trigger_sensor = 3;
+  out.trigger_count = 255;
+  out.servo_us = {500, 2500};
+  out.tick_late_us = 65535;
+  out.input_seq = 77;
+  std::vector<uint8_t> wire;
+  for (const hil::HilMessage& m : {hil::HilMessage(enc), hil::HilMessage(in), hil::HilMessage(out)}) {
+    const auto f = hil::encodeHil(m, 9);
+    wire.insert(wire.end(), f.bytes.begin(), f.bytes.begin() + static_cast<std::ptrdiff_t>(f.size));
+  }
+  std::vector<hil::HilMessage> got;
+  hil::HilDecoder d;
+  d.feed(wire, [&](const hil::HilMessage& m, uint8_t seq) {
+    EXPECT_EQ(seq, 9);
+    got.push_back(m);
+  });
+  ASSERT_EQ(got.size(), 3u);
+  EXPECT_EQ(std::get<hil::HilEncoders>(got[0]), enc);
+  EXPECT_EQ(std::get<hil::HilSensors>(got[1]), in);
+  EXPECT_EQ(std::get<hil::HilOutputs>(got[2]), out);
+  // One bit flipped in a frame: dropped and counted, the next one taken.
+  auto bad = frameOf(out);
+  bad[4] ^= 0x01;
+  bad.insert(bad.end(), wire.begin(), wire.end());
+  got.clear();
+  d.feed(bad, [&](const hil::HilMessage& m, uint8_t) { got.push_back(m); });
+  EXPECT_EQ(d.errors(), 1u);
+  EXPECT_EQ(got.size(), 3u);
+}
+
+TEST(HilMcu, TheFirmwaresDutyDrivesTheMotorsAndTheBrakeStopsThem) {
+  const auto r = robot();
+  const auto s = firmware::settingsFrom(r);
+  HilMcu mcu(r);
+  EXPECT_EQ(mcu.motorTargets().left_rad_s, 0.0);  // nothing heard: at rest
+  hil::HilOutputs o;
+  o.duty_1e4 = {5000, -2500};
+  mcu.receive(frameOf(o), 0);
+  EXPECT_NEAR(mcu.motorTargets().left_rad_s, 0.5 / s.speed_ff, 1e-6);
+  EXPECT_NEAR(mcu.motorTargets().right_rad_s, -0.25 / s.speed_ff, 1e-6);
+  o.flags = hil::HilOutputs::kBrake;
+  mcu.receive(frameOf(o, 1), 2);
+  EXPECT_EQ(mcu.motorTargets().left_rad_s, 0.0);
+  EXPECT_EQ(mcu.framesReceived(), 2u);
+}
+
+TEST(HilMcu, WhatItSendsReadsBackThroughTheFirmwaresConversions) {
+  const auto r = robot();
+  const auto s = firmware::settingsFrom(r);
+  HilMcu mcu(r);
+  PlantState truth;
+  const double per_count = 2.0 * std::numbers::pi * r.geometry.wheel_radius_m / s.encoder_counts_per_rev;
+  truth.wheel_travel_left_m = 1000.5 * per_count;
+  truth.wheel_travel_right_m = -3.5 * per_count;
+  mcu.receive(frameOf(hil::HilOutputs{}), 0);  // the board speaks: the simulator sends
+  std::array<uint16_t, serial::kGasChannels> gas{};
+  gas[0] = 250;                  // a reading
+  gas[1] = serial::kGasNoData;  // a failed sensor
+  std::vector<uint8_t> tx;
+  mcu.sendEncoders(truth, tx);
+  const auto enc = decodeAll<hil::HilEncoders>(tx);
+  ASSERT_EQ(enc.size(), 1u);
+  EXPECT_EQ(enc[0].counter[0], 1000);
+  EXPECT_EQ(enc[0].counter[1], static_cast<uint16_t>(-4));
+  tx.clear();
+  mcu.sendSensors(60000, 0x18, gas, tx);
+  const auto in = decodeInputs(tx);
+  ASSERT_EQ(in.size(), 1u);
+  EXPECT_EQ(in[0].grayscale, 0x18);
+  ASSERT_GE(s.gas_channel_count, 2);
+  EXPECT_NEAR(firmware::gasCount(s, s.gas[0], in[0].gas_adc[0]), 250, 2);  // within the ADC's resolution
+  EXPECT_EQ(firmware::gasCount(s, s.gas[1], in[0].gas_adc[1]), serial::kGasNoData);
+  // The emulated MCU's battery after a minute: 25200 - 0.5 x 60 mV.
+  EXPECT_NEAR(firmware::batteryMv(s, in[0].battery_adc), 25170, 15);
+  EXPECT_EQ(in[0].echo_flags, hil::HilSensors::kEchoRose);  // no ping yet: nothing in range
+}
+
+TEST(HilMcu, APingIsAnsweredOnceWithItsEcho) {
+  const auto r = robot();
+  HilMcu mcu(r);
+  hil::HilOutputs o;
+  mcu.receive(frameOf(o), 0);
+  EXPECT_EQ(mcu.pendingPing(), -1);
+  o.trigger_sensor = 2;
+  o.trigger_count = 1;
+  mcu.receive(frameOf(o, 1), 2);
+  EXPECT_EQ(mcu.pendingPing(), 2);
+  mcu.answerPing(1000);  // 1 m: 5831 us out and back at 343 m/s
+  EXPECT_EQ(mcu.pendingPing(), -1);
+  std::vector<uint8_t> tx;
+  mcu.sendSensors(4, 0, {}, tx);
+  auto in = decodeInputs(tx);
+  ASSERT_EQ(in.size(), 1u);
+  EXPECT_EQ(in[0].echo_count, 1);
+  EXPECT_EQ(in[0].echo_flags, hil::HilSensors::kEchoRose | hil::HilSensors::kEchoFell);
+  EXPECT_NEAR(in[0].echo_width_us, 5831, 1);
+  o.trigger_count = 2;
+  mcu.receive(frameOf(o, 2), 6);
+  mcu.answerPing(serial::kNoEcho);
+  tx.clear();
+  mcu.sendSensors(8, 0, {}, tx);
+  in = decodeInputs(tx);
+  EXPECT_EQ(in[0].echo_count, 2);
+  EXPECT_EQ(in[0].echo_flags, hil::HilSensors::kEchoRose);
+}
+
+TEST(HilMcu, NothingBeforeTheBoardSpeaksAndAtMostFourFramesInFlight) {
+  const auto r = robot();
+  HilMcu mcu(r);
+  std::vector<uint8_t> tx;
+  mcu.sendEncoders(PlantState{}, tx);
+  EXPECT_TRUE(tx.empty());  // the board holds the world still until it speaks
+  hil::HilOutputs o;
+  o.input_seq = 200;
+  mcu.receive(frameOf(o), 0);
+  for (int i = 0; i < 10; ++i) mcu.sendEncoders(PlantState{}, tx);
+  EXPECT_EQ(decodeAll<hil::HilEncoders>(tx).size(), HilMcu::kMaxInFlight);
+  EXPECT_EQ(mcu.framesHeldBack(), 1u + 10u - HilMcu::kMaxInFlight);
+  o.input_seq = 200 + HilMcu::kMaxInFlight;  // the board took them all
+  mcu.receive(frameOf(o, 1), 2);
+  tx.clear();
+  mcu.sendEncoders(PlantState{}, tx);
+  EXPECT_EQ(decodeAll<hil::HilEncoders>(tx).size(), 1u);
+}
+
+TEST(HilMcu, TheSimulationInTheLoopSendsEncodersEvery2msSensorsEvery20msAndFollowsTheDuty) {
+  const auto r = robot();
+  Simulation sim(r, loadWorldFile(test::srcPath("config/worlds/empty.yaml")), 1);
+  sim.useHilFirmware(r);
+  EXPECT_EQ(sim.outputPeriodMs(), 2u);
+  // A board that takes every frame at once and answers every 2 ms.
+  hil::HilOutputs o;
+  o.duty_1e4 = {3000, 3000};
+  hil::HilDecoder board;
+  std::size_t encoders = 0, sensors = 0;
+  std::vector<uint8_t> tx;
+  for (uint64_t t = 0; t < 1000; t += 2) {
+    sim.receive(frameOf(o, static_cast<uint8_t>(t / 2)));
+    sim.advanceTo(t + 2);
+    sim.takeTx(tx);
+    board.feed(tx, [&](const hil::HilMessage& m, uint8_t seq) {
+      o.input_seq = seq;
+      encoders += std::holds_alternative<hil::HilEncoders>(m);
+      sensors += std::holds_alternative<hil::HilSensors>(m);
+    });
+  }
+  EXPECT_EQ(board.errors(), 0u);
+  EXPECT_EQ(encoders, 500u);
+  EXPECT_EQ(sensors, 50u);
+  // 0.3 duty: toward 0.3 / speed_ff = 1.95 rad/s; after 1 s (5 time constants) nearly there.
+  const double want = 0.3 / firmware::settingsFrom(r).speed_ff;
+  EXPECT_NEAR(sim.state().wheel.left_rad_s, want, 0.05 * want);
+  EXPECT_GT(sim.state().pose.x_m, 0.2);
+}
+
+}  // namespace
+}  // namespace inspect::sim
