@@ -3,7 +3,7 @@
 # QEMU's netduinoplus2 (an STM32F405), its USART1 (the Pi's serial line) on a
 # pseudo-terminal linked at PATH, for robot_client --serial PATH.
 #
-#   scripts/mcu_qemu.sh --serial-link PATH [--elf FILE] [--mcu-sim PROGRAM]
+#   scripts/mcu_qemu.sh --serial-link PATH [--elf FILE] [--mcu-sim PROGRAM] [--realtime-priority N]
 #                       [--hil-link PATH2 | --world FILE [mcu_sim options...]]
 #
 # --world FILE [options]: the simulated world attached: `mcu_sim --hil` on
@@ -13,15 +13,19 @@
 #   started by hand (`mcu_sim --hil PATH2 --world ...`).
 # Neither: the world is held still (the wheels at rest, nothing in range, gas
 #   at 4 mA, the battery full).
-# --elf FILE: the image (default build-firmware/inspect-mcu-qemu.elf, built by
-#   scripts/build_firmware.sh when missing).
-# --mcu-sim PROGRAM: default build/bin/mcu_sim.
+# --elf FILE: the image (default <tree>/build-firmware/inspect-mcu-qemu.elf,
+#   built by scripts/build_firmware.sh when missing).
+# --mcu-sim PROGRAM: default <tree>/build/bin/mcu_sim.
+# --realtime-priority N: QEMU (the MCU, a chip of its own) runs SCHED_FIFO at N
+#   in [1, 99] when this user may (root, CAP_SYS_NICE; else a warning), as
+#   mcu_sim --realtime-priority does; 0 = normal (default).
 # Runs until SIGINT/SIGTERM (or mcu_sim's --duration); QEMU's own messages go
 # to stderr. Stops what it started and removes its links.
 set -euo pipefail
 self=$(readlink -f "$0")
-cd "$(dirname "$self")/.."
-link="" hil_link="" elf="" world="" mcu_sim=build/bin/mcu_sim
+# Paths are the caller's (relative to where it was called from), defaults the tree's.
+root=$(cd "$(dirname "$self")/.." && pwd)
+link="" hil_link="" elf="" world="" mcu_sim=$root/build/bin/mcu_sim priority=0
 sim_args=()
 while [ $# -gt 0 ]; do
   case $1 in
@@ -29,14 +33,27 @@ while [ $# -gt 0 ]; do
     --hil-link) hil_link=$2; shift 2 ;;
     --elf) elf=$2; shift 2 ;;
     --mcu-sim) mcu_sim=$2; shift 2 ;;
+    --realtime-priority) priority=$2; shift 2 ;;
     --world) world=$2; shift 2; sim_args=("$@"); break ;;
-    -h|--help) sed -n '2,22p' "$self" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,25p' "$self" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "mcu_qemu: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
 if [ -z "$link" ]; then
   echo "mcu_qemu: --serial-link PATH is required (try --help)" >&2
   exit 2
+fi
+if ! [[ "$priority" =~ ^[0-9]+$ ]] || [ "$priority" -gt 99 ]; then
+  echo "mcu_qemu: --realtime-priority: '$priority' is not a whole number in [0, 99]" >&2
+  exit 2
+fi
+rt=()
+if [ "$priority" -gt 0 ]; then
+  if chrt -f "$priority" true 2>/dev/null; then
+    rt=(chrt -f "$priority")
+  else
+    echo "mcu_qemu: warning: QEMU runs at normal priority: SCHED_FIFO $priority not permitted" >&2
+  fi
 fi
 if [ -n "$world" ] && [ -n "$hil_link" ]; then
   echo "mcu_qemu: --world starts mcu_sim on the HIL link itself; --hil-link is for one started by hand" >&2
@@ -51,8 +68,8 @@ if ! command -v qemu-system-arm >/dev/null; then
   exit 1
 fi
 if [ -z "$elf" ]; then
-  elf=build-firmware/inspect-mcu-qemu.elf
-  [ -f "$elf" ] || bash scripts/build_firmware.sh >&2
+  elf=$root/build-firmware/inspect-mcu-qemu.elf
+  [ -f "$elf" ] || (cd "$root" && bash scripts/build_firmware.sh >&2)
 fi
 if [ ! -f "$elf" ]; then
   echo "mcu_qemu: no firmware image at $elf" >&2
@@ -62,7 +79,8 @@ fi
 log=$(mktemp)
 second=null
 [ -n "$hil_link" ] && second=pty
-qemu-system-arm -M netduinoplus2 -display none -monitor none -serial pty -serial "$second" \
+# QEMU and mcu_sim end with this script even when it is killed outright (SIGTERM on its death).
+setpriv --pdeathsig TERM "${rt[@]}" qemu-system-arm -M netduinoplus2 -display none -monitor none -serial pty -serial "$second" \
   -kernel "$elf" >"$log" 2>&1 &
 qemu=$!
 sim=""
@@ -99,7 +117,7 @@ fi
 tail -n +1 -f "$log" >&2 &
 tailer=$!
 if [ -n "$world" ]; then
-  "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" &
+  setpriv --pdeathsig TERM "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" &
   sim=$!
   # Until either ends: mcu_sim's --duration, or QEMU stopped.
   while kill -0 "$sim" 2>/dev/null && kill -0 "$qemu" 2>/dev/null; do sleep 0.2; done

@@ -5,7 +5,7 @@
 # recorded gas inspection round, alarms, report), then prints what happened.
 #
 #   scripts/run_demo.sh [--interactive|--batch] [--port N] [--foxglove-port N] [--tuning] [--out DIR]
-#                       [--client-config FILE] [--rate F]
+#                       [--client-config FILE] [--rate F] [--firmware]
 #
 # --tuning runs the fuzzy-PID tuning job instead (scripts/demo/tuning.console
 # on config/worlds/tuning_floor.yaml, whose robot has worn, slower motors):
@@ -31,6 +31,10 @@
 # --rate F runs the simulated world F times faster than real time (mcu_sim
 # --rate; the robot's loop runs on the MCU's clock, so it controls the same):
 # the demo's test takes 2 to check the same round in less time.
+# --firmware puts the robot's real MCU firmware on the line instead of
+# mcu_sim's emulator: its QEMU image (built when missing) under
+# scripts/mcu_qemu.sh, with mcu_sim --hil keeping the world (docs/firmware.md).
+# Real time only (not with --rate).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${BUILD_DIR:-build}/bin
@@ -41,6 +45,7 @@ JOB=gas
 OUT=
 CLIENT_CONFIG=config/client.yaml
 RATE=
+FIRMWARE=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --interactive) MODE=interactive ;;
@@ -52,11 +57,16 @@ while [ $# -gt 0 ]; do
     --client-config)  # relative to where the script was called from
       CLIENT_CONFIG=${2:?--client-config needs a file}; [ "${CLIENT_CONFIG#/}" != "$CLIENT_CONFIG" ] || CLIENT_CONFIG=$OLDPWD/$CLIENT_CONFIG; shift ;;
     --rate) RATE=${2:?--rate needs a factor}; shift ;;
-    -h|--help) sed -n '2,33p' "$0"; exit 0 ;;
+    --firmware) FIRMWARE=1 ;;
+    -h|--help) sed -n '2,37p' "$0"; exit 0 ;;
     *) echo "run_demo: unknown option $1" >&2; exit 2 ;;
   esac
   shift
 done
+if [ "$FIRMWARE" = 1 ] && [ -n "$RATE" ]; then
+  echo "run_demo: --firmware runs in real time: not with --rate" >&2
+  exit 2
+fi
 if [ -z "$FOX_PORT" ]; then if [ "$PORT" = 0 ]; then FOX_PORT=0; else FOX_PORT=8765; fi; fi
 if [ "$MODE" = auto ]; then
   if [ -t 0 ] && [ -t 1 ]; then MODE=interactive; else MODE=batch; fi
@@ -87,11 +97,18 @@ if [ -n "$RATE" ]; then SIM_ARGS+=(--rate "$RATE"); fi
 # at 20, above the robot's control loop (realtime_priority: 10 in
 # config/client.yaml), so a busy machine does not starve them into a
 # stale-sensor failsafe (docs/testing.md, "Scheduling").
-"$BIN/mcu_sim" --realtime-priority 20 --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
-  --pty-link "$OUT/mcu" --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
+if [ "$FIRMWARE" = 1 ]; then
+  [ -f build-firmware/inspect-mcu-qemu.elf ] || bash scripts/build_firmware.sh --settings-gen "$BIN/mcu_settings_gen" | sed 's/^/demo: /'
+  bash scripts/mcu_qemu.sh --serial-link "$OUT/mcu" --elf build-firmware/inspect-mcu-qemu.elf --mcu-sim "$BIN/mcu_sim" \
+    --world "$WORLD" --realtime-priority 20 --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
+    --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
+else
+  "$BIN/mcu_sim" --realtime-priority 20 --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
+    --pty-link "$OUT/mcu" --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
+fi
 SIM=$!
 PIDS+=("$SIM")
-for _ in $(seq 100); do [ -e "$OUT/mcu" ] && break; sleep 0.05; done
+for _ in $(seq 400); do [ -e "$OUT/mcu" ] && break; sleep 0.05; done
 [ -e "$OUT/mcu" ] || { echo "demo: mcu_sim did not start:"; cat "$OUT/mcu_sim.err"; exit 1; }
 head -n 1 "$OUT/mcu_sim.out"
 
@@ -140,7 +157,7 @@ wait "$SIM" 2>/dev/null || true
 
 echo
 echo "=== what the robot did"
-grep -E '^mcu_sim: (final pose|serial|camera .* frames=)' "$OUT/mcu_sim.out" || true
+grep -E '^mcu_sim: (final pose|serial|hil |camera .* frames=)' "$OUT/mcu_sim.out" || true
 awk -F, '$1=="T"{ if(!n){x0=$4;y0=$5;t0=$6;n=1} x=$4;y=$5;t=$6 }
   END{ if(!n) exit; dx=x-x0; dy=y-y0; c=cos(t0); s=sin(t0);
        d=t-t0; while(d>3.14159265)d-=6.2831853; while(d<-3.14159265)d+=6.2831853;

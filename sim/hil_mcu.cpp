@@ -2,22 +2,30 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "firmware/core/analog_inputs.hpp"
+#include "firmware/core/ptz_servo.hpp"
 #include "firmware/host/settings_from_config.hpp"
 #include "sim/mcu_emulator.hpp"
 
 namespace inspect::sim {
 
-HilMcu::HilMcu(const config::RobotConfig& robot)
-    : settings_(firmware::settingsFrom(robot)), wheel_radius_m_(robot.geometry.wheel_radius_m) {
+HilMcu::HilMcu(const config::RobotConfig& robot, SimObserver* observer)
+    : settings_(firmware::settingsFrom(robot)), observer_(observer), wheel_radius_m_(robot.geometry.wheel_radius_m) {
   echo_.echo_flags = hil::HilSensors::kEchoRose;  // until a ping: nothing in range
 }
 
-void HilMcu::receive(std::span<const uint8_t> bytes, uint64_t) {
+void HilMcu::receive(std::span<const uint8_t> bytes, uint64_t now_ms) {
   decoder_.feed(bytes, [&](const hil::HilMessage& m, uint8_t) {
     const auto* out = std::get_if<hil::HilOutputs>(&m);
     if (!out) return;  // the board sends nothing else
+    if (observer_ && out->ptz_target_0p1mrad != last_.ptz_target_0p1mrad) {
+      // A new camera-mount target: the PtzCommand the firmware took, logged as the emulator logs it.
+      observer_->onEvent(static_cast<double>(now_ms) / 1000.0, "ptz",
+                         "pan_0p1mrad=" + std::to_string(out->ptz_target_0p1mrad[0]) +
+                             " tilt_0p1mrad=" + std::to_string(out->ptz_target_0p1mrad[1]));
+    }
     if (!heard_) {
       answered_count_ = out->trigger_count;  // pings before the link came up are gone
       seq_ = static_cast<uint8_t>(out->input_seq + 1);
@@ -33,6 +41,12 @@ control::WheelSpeeds HilMcu::motorTargets() const {
   if (!heard_ || (last_.flags & hil::HilOutputs::kBrake)) return {0.0, 0.0};
   const double per_duty = 1.0 / (10000.0 * settings_.speed_ff);
   return {last_.duty_1e4[0] * per_duty, last_.duty_1e4[1] * per_duty};
+}
+
+std::array<double, 2> HilMcu::ptzRad() const {
+  if (!heard_) return {0.0, 0.0};
+  auto angle = [&](uint16_t us) { return (static_cast<double>(us) - firmware::PtzServo::kCentreUs) / settings_.servo_us_per_rad; };
+  return {angle(last_.servo_us[0]), angle(last_.servo_us[1])};
 }
 
 void HilMcu::answerPing(uint16_t range_mm) {

@@ -21,6 +21,7 @@
 #include "shared/hil/hil_link.hpp"
 #include "shared/util/latency_histogram.hpp"
 #include "sim/robot_plant.hpp"
+#include "sim/sim_observer.hpp"
 
 namespace inspect::sim {
 
@@ -37,12 +38,19 @@ class HilMcu {
   /// Below this the drivers' fault current (NAMUR NE 43: a failed transmitter's 2 mA).
   static constexpr float kFailedTransmitterMa = 2.0f;
 
-  explicit HilMcu(const config::RobotConfig& robot);
+  /// `observer` (may be null) gets the firmware's camera-mount targets as `ptz` events, as the emulator's.
+  HilMcu(const config::RobotConfig& robot, SimObserver* observer);
 
   /// Bytes from the board's USART2 at now_ms.
   void receive(std::span<const uint8_t> bytes, uint64_t now_ms);
   /// The speeds the motors run toward now (rad/s), from the latest duty.
   control::WheelSpeeds motorTargets() const;
+  /// The firmware's wheel set-points in force (rad/s; 0 before it speaks).
+  control::WheelSpeeds firmwareSetpoints() const {
+    return {last_.setpoint_mrad_s[0] / 1000.0, last_.setpoint_mrad_s[1] / 1000.0};
+  }
+  /// The camera mount's pan and tilt (rad) its servo pulses put it at (home before the board speaks).
+  std::array<double, 2> ptzRad() const;
   /// The sensor of a ping not answered yet, or -1.
   int pendingPing() const { return answered_count_ != last_.trigger_count && heard_ ? last_.trigger_sensor : -1; }
   /// Answers it with the range the world gives (serial::kNoEcho: nothing in range).
@@ -66,6 +74,7 @@ class HilMcu {
 
  private:
   firmware::McuSettings settings_;
+  SimObserver* observer_;
   double wheel_radius_m_;
   hil::HilDecoder decoder_;
   hil::HilOutputs last_;

@@ -172,7 +172,8 @@ void Simulation::emitFrame() {
     // The firmware builds the frames: here the gas sensors are sampled for its ADC inputs.
     sampleGas(in);
     hil_gas_raw_ = in.gas_raw;
-    if (observer_) observer_->onSample({timeS(), state_.pose, state_.wheel, wheelTargets(), 0});
+    // The truth's set-points: the firmware's in force (its speed loop's targets).
+    if (observer_) observer_->onSample({timeS(), state_.pose, state_.wheel, hil_->firmwareSetpoints(), 0});
   } else {
     in.ultrasonic_mm = ultrasonic_.measureAllMm(world_, state_.pose, people_.crowd.circles());
     in.grayscale = GrayscaleModel::read(world_, state_.pose);
@@ -184,7 +185,7 @@ void Simulation::emitFrame() {
 }
 
 void Simulation::useHilFirmware(const config::RobotConfig& robot) {
-  hil_ = std::make_unique<HilMcu>(robot);
+  hil_ = std::make_unique<HilMcu>(robot, observer_);
   if (observer_) observer_->onEvent(timeS(), "hil", "the MCU is the firmware on the HIL link");
 }
 

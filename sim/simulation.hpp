@@ -58,6 +58,12 @@ class Simulation {
   const HilMcu* hilMcu() const { return hil_.get(); }
   /// How often takeTx() has something: the sensor frame's period, or the HIL inputs'.
   uint64_t outputPeriodMs() const { return hil_ ? HilMcu::kInputPeriod_ms : kFramePeriod_ms; }
+  /// The camera mount's pan and tilt (rad): the emulator's PTZ set-point, or
+  /// where the firmware's servo pulses put it.
+  std::array<double, 2> cameraPanTilt() const {
+    if (hil_) return hil_->ptzRad();
+    return {mcu_.ptz().pan_0p1mrad * 1e-4, mcu_.ptz().tilt_0p1mrad * 1e-4};
+  }
   /// The speeds the motors run toward now: the emulator's set-points, or the firmware's duty's.
   control::WheelSpeeds wheelTargets() const { return hil_ ? hil_->motorTargets() : mcu_.setpoints(); }
 

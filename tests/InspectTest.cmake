@@ -51,7 +51,8 @@ inspect_test_pch_target()
 add_library(inspect_test_paths STATIC ${PROJECT_SOURCE_DIR}/tests/support/paths.cpp)
 target_include_directories(inspect_test_paths PUBLIC ${PROJECT_SOURCE_DIR})
 target_compile_definitions(inspect_test_paths PRIVATE INSPECT_BIN_DIR="${CMAKE_RUNTIME_OUTPUT_DIRECTORY}"
-                                                      INSPECT_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+                                                      INSPECT_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+                                                      INSPECT_FIRMWARE_IMAGE="${CMAKE_BINARY_DIR}/tests/firmware/mcu/inspect-mcu-qemu.elf")
 
 # Child processes, temp dirs, the three programs wired together, the ground
 # truth reader, the UDP relay, test certificates (tests/support).

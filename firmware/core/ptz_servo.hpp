@@ -17,6 +17,8 @@ class PtzServo {
   /// One period: the angles move towards the target.
   void step();
   std::array<float, 2> anglesRad() const { return angle_; }
+  /// Where the last command asked it to go, pan and tilt, rad.
+  std::array<float, 2> targetRad() const { return target_; }
   /// The pulse widths now, pan and tilt, us.
   std::array<uint16_t, 2> pulsesUs() const;
 

@@ -35,8 +35,11 @@ float WheelSpeedLoop::step(float setpoint_rad_s, bool enabled, uint16_t encoder_
   const float target = enabled ? std::clamp(setpoint_rad_s, -s_.max_wheel_speed_rad_s, s_.max_wheel_speed_rad_s) : 0.0f;
   const float max_step = s_.max_wheel_accel_rad_s2 * period_s_;
   slewed_ += std::clamp(target - slewed_, -max_step, max_step);
-  if (!enabled) {
-    // Brake to standstill: no drive, nothing remembered.
+  if (!enabled || (target == 0.0f && slewed_ == 0.0f)) {
+    // Brake to standstill, or stopped on purpose (the set-point and its ramp
+    // at zero): no drive, nothing remembered. The integral would otherwise
+    // hold the duty that was driving, and the wheel would creep on it after
+    // the stop until it bled away (seen in the loop: -0.1 rad/s for a second).
     slewed_ = 0.0f;
     integral_ = 0.0f;
     duty_ = 0.0f;

@@ -40,7 +40,8 @@ class WheelSpeedLoop {
   WheelSpeedLoop(const McuSettings& s, float period_s);
 
   /// One period: the new set-point (rad/s, clamped here), whether the motor is
-  /// enabled (false: brake, integral cleared) and the encoder counter. Returns the duty.
+  /// enabled (false: brake, integral cleared; so too once the set-point and its ramp are at zero)
+  /// and the encoder counter. Returns the duty.
   float step(float setpoint_rad_s, bool enabled, uint16_t encoder_counter);
 
   float speedRadS() const { return speed_rad_s_; }

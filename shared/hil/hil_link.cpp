@@ -28,6 +28,8 @@ void write(serial::WireWriter& w, const HilOutputs& out) {
   for (auto v : out.servo_us) w.u16(v);
   w.u16(out.tick_late_us);
   w.u8(out.input_seq);
+  for (auto v : out.setpoint_mrad_s) w.i16(v);
+  for (auto v : out.ptz_target_0p1mrad) w.i16(v);
 }
 
 void read(serial::WireReader& r, HilEncoders& e) {
@@ -53,6 +55,8 @@ void read(serial::WireReader& r, HilOutputs& out) {
   for (auto& v : out.servo_us) v = r.u16();
   out.tick_late_us = r.u16();
   out.input_seq = r.u8();
+  for (auto& v : out.setpoint_mrad_s) v = r.i16();
+  for (auto& v : out.ptz_target_0p1mrad) v = r.i16();
 }
 
 template <class T>

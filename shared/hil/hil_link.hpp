@@ -46,7 +46,7 @@ struct HilSensors {
   bool operator==(const HilSensors&) const = default;
 };
 
-/// Board -> simulator: what the firmware drives. Payload 18 bytes.
+/// Board -> simulator: what the firmware drives. Payload 26 bytes.
 struct HilOutputs {
   uint32_t mcu_time_ms = 0;           // the firmware's clock (TIM2)
   std::array<int16_t, 2> duty_1e4{};  // PWM duty x 10000, left, right; the sign is the direction
@@ -57,13 +57,18 @@ struct HilOutputs {
   uint16_t tick_late_us = 0;          // how late the latest 1 ms control tick started (TIM2), us
   uint8_t input_seq = 0;              // the seq of the last simulator frame the board took: the
                                       // simulator keeps few in flight, so none waits in a queue
+  std::array<int16_t, 2> setpoint_mrad_s{};  // the wheel set-points in force (after the clamp, the
+                                             // watchdog, the obstacle stop; before the speed loop's
+                                             // slew): the ground truth logs them
+  std::array<int16_t, 2> ptz_target_0p1mrad{};  // the camera mount's target from the last PtzCommand
+                                                // (pan, tilt; the truth log's ptz events)
   static constexpr uint8_t kBrake = 0x01;
   bool operator==(const HilOutputs&) const = default;
 };
 
 inline constexpr std::size_t kHilEncodersPayload = 4;
 inline constexpr std::size_t kHilSensorsPayload = 18;
-inline constexpr std::size_t kHilOutputsPayload = 18;
+inline constexpr std::size_t kHilOutputsPayload = 26;
 
 using HilMessage = std::variant<HilEncoders, HilSensors, HilOutputs>;
 

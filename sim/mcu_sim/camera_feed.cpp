@@ -35,11 +35,11 @@ CameraFeed::~CameraFeed() { stop(); }
 
 void CameraFeed::publish(const Simulation& sim) {
   const auto& crowd = sim.pedestrians();
-  const auto ptz = sim.mcu().ptz();
+  const auto pan_tilt = sim.cameraPanTilt();
   std::lock_guard lk(mu_);
   snapshot_.robot = sim.state().pose;
-  snapshot_.pan_rad = ptz.pan_0p1mrad * 1e-4;
-  snapshot_.tilt_rad = ptz.tilt_0p1mrad * 1e-4;
+  snapshot_.pan_rad = pan_tilt[0];
+  snapshot_.tilt_rad = pan_tilt[1];
   snapshot_.sim_time_s = sim.timeS();
   peopleInView(crowd, snapshot_.people);
 }

@@ -56,6 +56,8 @@ TEST(HilLink, EveryMessageRoundTripsAndCorruptionIsCounted) {
   out.servo_us = {500, 2500};
   out.tick_late_us = 65535;
   out.input_seq = 77;
+  out.setpoint_mrad_s = {-1234, 5000};
+  out.ptz_target_0p1mrad = {-31416, 7854};
   std::vector<uint8_t> wire;
   for (const hil::HilMessage& m : {hil::HilMessage(enc), hil::HilMessage(in), hil::HilMessage(out)}) {
     const auto f = hil::encodeHil(m, 9);
@@ -84,7 +86,7 @@ TEST(HilLink, EveryMessageRoundTripsAndCorruptionIsCounted) {
 TEST(HilMcu, TheFirmwaresDutyDrivesTheMotorsAndTheBrakeStopsThem) {
   const auto r = robot();
   const auto s = firmware::settingsFrom(r);
-  HilMcu mcu(r);
+  HilMcu mcu(r, nullptr);
   EXPECT_EQ(mcu.motorTargets().left_rad_s, 0.0);  // nothing heard: at rest
   hil::HilOutputs o;
   o.duty_1e4 = {5000, -2500};
@@ -100,7 +102,7 @@ TEST(HilMcu, TheFirmwaresDutyDrivesTheMotorsAndTheBrakeStopsThem) {
 TEST(HilMcu, WhatItSendsReadsBackThroughTheFirmwaresConversions) {
   const auto r = robot();
   const auto s = firmware::settingsFrom(r);
-  HilMcu mcu(r);
+  HilMcu mcu(r, nullptr);
   PlantState truth;
   const double per_count = 2.0 * std::numbers::pi * r.geometry.wheel_radius_m / s.encoder_counts_per_rev;
   truth.wheel_travel_left_m = 1000.5 * per_count;
@@ -130,7 +132,7 @@ TEST(HilMcu, WhatItSendsReadsBackThroughTheFirmwaresConversions) {
 
 TEST(HilMcu, APingIsAnsweredOnceWithItsEcho) {
   const auto r = robot();
-  HilMcu mcu(r);
+  HilMcu mcu(r, nullptr);
   hil::HilOutputs o;
   mcu.receive(frameOf(o), 0);
   EXPECT_EQ(mcu.pendingPing(), -1);
@@ -159,7 +161,7 @@ TEST(HilMcu, APingIsAnsweredOnceWithItsEcho) {
 
 TEST(HilMcu, NothingBeforeTheBoardSpeaksAndAtMostFourFramesInFlight) {
   const auto r = robot();
-  HilMcu mcu(r);
+  HilMcu mcu(r, nullptr);
   std::vector<uint8_t> tx;
   mcu.sendEncoders(PlantState{}, tx);
   EXPECT_TRUE(tx.empty());  // the board holds the world still until it speaks

@@ -14,5 +14,6 @@ const std::string& binDir() {
 
 std::string srcPath(const std::string& rel) { return sourceDir() + "/" + rel; }
 std::string binPath(const std::string& prog) { return binDir() + "/" + prog; }
+std::string firmwareImage() { return INSPECT_FIRMWARE_IMAGE; }
 
 }  // namespace inspect::test

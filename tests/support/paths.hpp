@@ -15,5 +15,8 @@ const std::string& binDir();
 std::string srcPath(const std::string& rel);
 /// binDir() + "/" + prog.
 std::string binPath(const std::string& prog);
+/// The firmware's QEMU image that the test firmware_mcu_build builds (ctest
+/// fixture `firmware_images`; tests/firmware/CMakeLists.txt).
+std::string firmwareImage();
 
 }  // namespace inspect::test

@@ -168,11 +168,17 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
   const std::string world_path = world.starts_with("/") ? world : srcPath("config/worlds/" + world);
   std::vector<std::string> sim_argv = {binPath("mcu_sim"), "--world", world_path, "--robot",
                                        srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
+  if (!firmware_elf_.empty()) {
+    // The firmware in QEMU on the line, mcu_sim --hil behind it (the options after --world are mcu_sim's).
+    sim_argv = {"/bin/bash", srcPath("scripts/mcu_qemu.sh"), "--serial-link", sim_pty, "--elf", firmware_elf_,
+                "--mcu-sim", binPath("mcu_sim"), "--world", world_path, "--robot", srcPath("config/robot.yaml"),
+                "--truth", r->truth};
+  }
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
   sim_argv.insert(sim_argv.end(), {"--realtime-priority", kHardwarePriority});
   if (!measure_failsafes_ && !catch_up_) sim_argv.push_back("--freeze-on-stall");
   r->sim = Process::spawn(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
-  waitUntil([&] { return exists(sim_pty); }, 10.0);
+  waitUntil([&] { return exists(sim_pty); }, firmware_elf_.empty() ? 10.0 : 20.0);
   r->pty = sim_pty;
   if (!relay_args.empty()) {
     r->pty = dir_ / (id + "-relay");

@@ -113,6 +113,11 @@ class Stack {
   /// times a manoeuvre by the wall clock (drive for 2 s, then stop): a world
   /// that waited would move less than the operator's wait said.
   void catchUpAfterStalls() { catch_up_ = true; }
+  /// The robots started after this call run the real firmware: the QEMU
+  /// board's image `elf` under scripts/mcu_qemu.sh, with mcu_sim --hil
+  /// keeping the world and its truth log (docs/firmware.md). robot_client
+  /// opens the board's USART1 exactly as it opens mcu_sim's pty.
+  void useFirmware(std::string elf) { firmware_elf_ = std::move(elf); }
   /// robot_client is started through this command for the robots started
   /// after this call (bench_loop: {"taskset", "-c", "1"}).
   void setClientPrefix(std::vector<std::string> prefix) { client_prefix_ = std::move(prefix); }
@@ -148,6 +153,7 @@ class Stack {
   bool measure_failsafes_ = false;
   bool catch_up_ = false;
   std::vector<std::string> client_prefix_;
+  std::string firmware_elf_;
   std::vector<std::unique_ptr<RobotProcs>> robots_;
   std::map<std::string, Process> relays_;
 };

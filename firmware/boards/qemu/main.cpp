@@ -28,6 +28,8 @@ constexpr uint32_t kTimerClockHz = 1000000000;
 constexpr uint32_t kBrr115200 = 0x2D9;  // 84 MHz APB2 / 115200, for the record
 
 f4::Uart g_link(f4::usart::kUsart1);
+
+int16_t rounded(float v) { return static_cast<int16_t>(v + (v < 0 ? -0.5f : 0.5f)); }
 f4::Uart g_hil(f4::usart::kUsart2);
 
 class HilPeripherals final : public f4::Peripherals {
@@ -79,6 +81,12 @@ class HilPeripherals final : public f4::Peripherals {
       out_.servo_us[i] = o.servo_us[i];
     }
     out_.flags = o.brake ? hil::HilOutputs::kBrake : 0;
+    const std::array<float, 2> sp = fw::firmwareCore().setpoints();  // in force, before the slew
+    const std::array<float, 2> ptz = fw::firmwareCore().ptz().targetRad();
+    for (std::size_t i = 0; i < 2; ++i) {
+      out_.setpoint_mrad_s[i] = rounded(sp[i] * 1000.0f);
+      out_.ptz_target_0p1mrad[i] = rounded(ptz[i] * 10000.0f);
+    }
     out_.tick_late_us = static_cast<uint16_t>(late_us > 0xFFFF ? 0xFFFF : late_us);
     const bool ping = o.trigger >= 0;
     if (ping) {

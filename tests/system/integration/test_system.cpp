@@ -53,8 +53,10 @@ const char* kConnect = "expect robots >= 1 within 15\nexpect sensor_hz > 50 with
 
 }  // namespace
 
-TEST(System, ScriptedSquareDriveReachesExpectedPoses) {
-  Stack s("square");
+// A square driven by the console's teleop, judged against the ground truth
+// (the same checks whichever MCU is on the line). Each segment's end pose is
+// held to the motion its set-points commanded within `pose_m` and `angle_rad`.
+void squareDrive(Stack& s, double pose_m, double angle_rad) {
   s.catchUpAfterStalls();  // the legs are timed by the console's wall clock
   std::ostringstream script;
   script << kConnect << "wait 1\n";
@@ -115,8 +117,8 @@ TEST(System, ScriptedSquareDriveReachesExpectedPoses) {
     const double dp = std::hypot(to.x - x, to.y - y), da = std::abs(wrap(to.theta - th));
     worst_pos = std::max(worst_pos, dp);
     worst_ang = std::max(worst_ang, da);
-    EXPECT_LE(dp, 0.05) << "segment " << seg << ": at (" << to.x << ", " << to.y << "), commanded (" << x << ", " << y << ")";
-    EXPECT_LE(da, 0.05) << "segment " << seg << ": heading " << to.theta << ", commanded " << th;
+    EXPECT_LE(dp, pose_m) << "segment " << seg << ": at (" << to.x << ", " << to.y << "), commanded (" << x << ", " << y << ")";
+    EXPECT_LE(da, angle_rad) << "segment " << seg << ": heading " << to.theta << ", commanded " << th;
     const bool is_leg = seg % 2 == 1;
     const double len_err = std::abs(length - (is_leg ? 1.0 : 0.0)), turn_err = std::abs(turn - (is_leg ? 0.0 : kPi / 2));
     worst_cmd_len = std::max(worst_cmd_len, len_err);
@@ -135,8 +137,25 @@ TEST(System, ScriptedSquareDriveReachesExpectedPoses) {
       worst_pos, worst_ang, worst_cmd_len, worst_cmd_turn, worst_shape);
 }
 
-TEST(System, EStopHoldsUntilResume) {
-  Stack s("estop");
+// The emulator hands its set-points to a plant with gain 1: measured 0.0002 m, 0.0001 rad.
+TEST(System, ScriptedSquareDriveReachesExpectedPoses) {
+  Stack s("square");
+  squareDrive(s, 0.05, 0.05);
+}
+
+// The same square with the real firmware on the line (QEMU, mcu_sim --hil):
+// its speed loop, not the emulator's plant, turns the set-points into motion,
+// with its slew (10 rad/s^2) at each start and stop and its tracking on encoder
+// counts that reach it every 2-4 ms: measured 0.023-0.053 m, 0.044-0.047 rad
+// from the commanded motion; held to 0.08 m and 0.08 rad (the console's own
+// checks of the reported pose, 0.15 m, are the same).
+TEST(FirmwareStack, ScriptedSquareDriveReachesExpectedPoses) {
+  Stack s("square_fw");
+  s.useFirmware(firmwareImage());
+  squareDrive(s, 0.08, 0.08);
+}
+
+void eStopHoldsUntilResume(Stack& s) {
   std::string script = kConnect;
   script +=
       "drive 0.2 0\nexpect v ~ 0.2 0.03 within 3\n"
@@ -150,6 +169,17 @@ TEST(System, EStopHoldsUntilResume) {
   const auto rc = s.server().wait(60);
   ASSERT_TRUE(rc.has_value()) << s.logs();
   EXPECT_EQ(*rc, 0) << s.serverOutput();
+}
+
+TEST(System, EStopHoldsUntilResume) {
+  Stack s("estop");
+  eStopHoldsUntilResume(s);
+}
+
+TEST(FirmwareStack, EStopHoldsUntilResume) {
+  Stack s("estop_fw");
+  s.useFirmware(firmwareImage());
+  eStopHoldsUntilResume(s);
 }
 
 
