@@ -108,8 +108,6 @@ if [ -z "$usart1" ]; then
   cat "$log" >&2
   exit 1
 fi
-ln -sfn "$usart1" "$link"
-echo "mcu_qemu: firmware $elf, USART1 (serial line) $usart1 at $link"
 if [ -n "$hil_link" ]; then
   ln -sfn "$(pty_of serial1)" "$hil_link"
   echo "mcu_qemu: USART2 (HIL link) $(pty_of serial1) at $hil_link"
@@ -117,8 +115,23 @@ fi
 tail -n +1 -f "$log" >&2 &
 tailer=$!
 if [ -n "$world" ]; then
-  setpriv --pdeathsig TERM "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" &
+  # The world first: the Pi's line is linked once mcu_sim speaks to the board,
+  # so that robot_client never reads the held-still world's frames (gas at 4
+  # mA: an oxygen channel would read 0 %vol and raise its alarm).
+  sim_out=$(mktemp)
+  setpriv --pdeathsig TERM "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" > >(tee "$sim_out") &
   sim=$!
+  for _ in $(seq 1 200); do
+    grep -q '^mcu_sim: hil link' "$sim_out" && break
+    kill -0 "$sim" 2>/dev/null || break
+    sleep 0.05
+  done
+  sleep 0.2  # its first readings reach the board (it answers the board's first frame at once)
+  rm -f "$sim_out"
+fi
+ln -sfn "$usart1" "$link"
+echo "mcu_qemu: firmware $elf, USART1 (serial line) $usart1 at $link"
+if [ -n "$world" ]; then
   # Until either ends: mcu_sim's --duration, or QEMU stopped.
   while kill -0 "$sim" 2>/dev/null && kill -0 "$qemu" 2>/dev/null; do sleep 0.2; done
   rc=0

@@ -27,6 +27,7 @@ void HilMcu::receive(std::span<const uint8_t> bytes, uint64_t now_ms) {
                              " tilt_0p1mrad=" + std::to_string(out->ptz_target_0p1mrad[1]));
     }
     if (!heard_) {
+      first_sensors_due_ = true;
       answered_count_ = out->trigger_count;  // pings before the link came up are gone
       seq_ = static_cast<uint8_t>(out->input_seq + 1);
     }

@@ -62,6 +62,13 @@ class HilMcu {
                    std::vector<uint8_t>& tx);
 
   bool heard() const { return heard_; }
+  /// True once, right after the board first speaks: the other peripherals' readings are due at once
+  /// (until then the board holds the world still, gas at its transmitters' 4 mA).
+  bool takeFirstSensorsDue() {
+    const bool due = first_sensors_due_;
+    first_sensors_due_ = false;
+    return due;
+  }
   const hil::HilOutputs& lastOutputs() const { return last_; }
   uint32_t framesReceived() const { return decoder_.framesOk(); }
   uint32_t errors() const { return decoder_.errors(); }
@@ -79,6 +86,7 @@ class HilMcu {
   hil::HilDecoder decoder_;
   hil::HilOutputs last_;
   bool heard_ = false;
+  bool first_sensors_due_ = false;
   hil::HilSensors echo_;  // the echo fields of the answer to the latest ping
   uint8_t answered_count_ = 0;
   uint8_t seq_ = 0;

@@ -199,7 +199,8 @@ void Simulation::stepHil() {
     answered = true;
   }
   if (t_ms_ % HilMcu::kInputPeriod_ms == 0) hil_->sendEncoders(state_, tx_);
-  if (answered || t_ms_ % HilMcu::kSensorPeriod_ms == 0)
+  const bool first = hil_->takeFirstSensorsDue();
+  if (first || answered || t_ms_ % HilMcu::kSensorPeriod_ms == 0)
     hil_->sendSensors(t_ms_, GrayscaleModel::read(world_, state_.pose), hil_gas_raw_, tx_);
 }
 
