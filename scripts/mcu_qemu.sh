@@ -126,7 +126,7 @@ if [ -n "$world" ]; then
     kill -0 "$sim" 2>/dev/null || break
     sleep 0.05
   done
-  sleep 0.2  # its first readings reach the board (it answers the board's first frame at once)
+  sleep 0.5  # its first readings reach the board (it answers the board's first frame at once)
   rm -f "$sim_out"
 fi
 ln -sfn "$usart1" "$link"
