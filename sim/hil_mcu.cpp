@@ -85,9 +85,7 @@ void HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<ui
       in.gas_adc[i] = firmware::gasAdcCounts(settings_, ch, static_cast<float>(gas_raw[i]) * ch.scale);
     }
   }
-  // The battery as the emulated MCU's (sim/mcu_emulator.hpp).
-  const double mv = McuEmulator::kBatteryStart_mv - McuEmulator::kBatteryDrain_mv_per_s * static_cast<double>(now_ms) / 1000.0;
-  in.battery_adc = firmware::batteryAdcCounts(settings_, static_cast<uint16_t>(std::max(0.0, std::round(mv))));
+  in.battery_adc = firmware::batteryAdcCounts(settings_, McuEmulator::batteryMvAt(now_ms));
   in.grayscale = grayscale;
   in.switches = 0;
   append(in, tx);

@@ -84,8 +84,12 @@ void McuEmulator::tick(uint64_t now_ms) {
     host_silent_ = true;
     event(now_ms, "host_silent", std::to_string(now_ms - last_heartbeat_ms_));
   }
+  battery_mv_ = batteryMvAt(now_ms);
+}
+
+uint16_t McuEmulator::batteryMvAt(uint64_t now_ms) {
   const double drained = kBatteryStart_mv - kBatteryDrain_mv_per_s * simSeconds(now_ms);
-  battery_mv_ = static_cast<uint16_t>(std::max(0.0, std::round(drained)));
+  return static_cast<uint16_t>(std::max(0.0, std::round(drained)));
 }
 
 uint16_t McuEmulator::faults() const {

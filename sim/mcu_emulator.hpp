@@ -37,6 +37,10 @@ class McuEmulator {
 
   McuEmulator(const config::RobotConfig& robot, uint64_t seed, SimObserver* observer = nullptr);
 
+  /// The simulated battery's voltage at now_ms (mV): what either MCU reads,
+  /// this emulator or the firmware in the loop (sim/hil_mcu.hpp).
+  static uint16_t batteryMvAt(uint64_t now_ms);
+
   /// Feeds bytes from the host received at now_ms. Corrupt frames are only counted.
   void receive(std::span<const uint8_t> bytes, uint64_t now_ms);
   /// Runs the MCU's timers at now_ms (call every simulation step).
