@@ -40,6 +40,7 @@ struct Options {
   uint32_t seed = 1;
   int seeds = 1;
   bool noise = true;
+  double dead_time_s = 0.0;  // the motors' dead time: a command reaches them this late
   double band_m = 0.01;
   double band_rad = 0.01;
   std::string plots_dir;

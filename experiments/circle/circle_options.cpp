@@ -22,6 +22,8 @@ the simulated robot, compared metric by metric with the paper.
   --seed N          noise seed (default 1)
   --seeds K         repeat over seeds N..N+K-1, report mean / max (default 1)
   --no-noise        exact wheel-speed and heading measurements
+  --dead-time S     the motors' dead time, s: the latency from a command to the
+                    wheels, as a serial link and an MCU add it (default 0)
   --band-m M        position convergence band, m (default 0.01)
   --band-rad R      angle convergence band, rad (default 0.01)
   --plots DIR       write Fig 18 / Fig 20 / wheel-and-gain PNGs into DIR
@@ -82,6 +84,8 @@ Options parseArgs(int argc, char** argv) {
       o.seeds = static_cast<int>(a.integer(1, 10000));
     } else if (a.is("--no-noise")) {
       o.noise = false;
+    } else if (a.is("--dead-time")) {
+      o.dead_time_s = a.number(0.0, 1.0);
     } else if (a.is("--band-m")) {
       o.band_m = a.numberAbove(0);
     } else if (a.is("--band-rad")) {

@@ -31,6 +31,7 @@
 #include "shared/util/gnuplot.hpp"
 #include "experiments/circle/circle_experiment.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/robot_plant.hpp"
 
 namespace {
 
@@ -135,6 +136,10 @@ Setup loadSetup(const Options& o) {
   st.base.robot = st.robot;
   st.base.tracker = st.ctl.tracker;
   st.base.noise = o.noise;
+  if (o.dead_time_s > 0.0) {
+    st.base.plant = sim::nominalPlant(st.robot);
+    st.base.plant->left.dead_time_s = st.base.plant->right.dead_time_s = o.dead_time_s;
+  }
   st.base.settle_position_m = o.band_m;
   st.base.settle_angle_rad = o.band_rad;
   st.path_desc = makePath(o)->describe();
