@@ -1,5 +1,6 @@
 #include "sim/hil_mcu.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -32,9 +33,15 @@ void HilMcu::receive(std::span<const uint8_t> bytes, uint64_t now_ms) {
       seq_ = static_cast<uint8_t>(out->input_seq + 1);
     }
     last_ = *out;
+    trackBoardClock(out->mcu_time_ms, now_ms);
     acked_seq_ = out->input_seq;
     heard_ = true;
     late_.record(static_cast<int64_t>(out->tick_late_us) * 1000);
+    if (observer_ && out->tick_late_us >= kLateTickEvent_us) {
+      // A tick this late: the firmware did not run (QEMU's vCPU was not), in the truth log as an event.
+      observer_->onEvent(static_cast<double>(now_ms) / 1000.0, "late_tick",
+                         "mcu_ms=" + std::to_string(out->mcu_time_ms) + " late_us=" + std::to_string(out->tick_late_us));
+    }
   });
 }
 
@@ -64,12 +71,34 @@ void HilMcu::answerPing(uint16_t range_mm) {
   }
 }
 
-void HilMcu::sendEncoders(const PlantState& truth, std::vector<uint8_t>& tx) {
-  const double counts_per_m = settings_.encoder_counts_per_rev / (2.0 * std::numbers::pi * wheel_radius_m_);
+void HilMcu::trackBoardClock(uint32_t mcu_time_ms, uint64_t now_ms) {
+  // mcu_time_ms was the board's clock when it sent; it is at least that now.
+  const int64_t offset = static_cast<int64_t>(mcu_time_ms) - static_cast<int64_t>(now_ms);
+  if (!clock_known_ || offset > clock_offset_ms_) clock_offset_ms_ = offset;  // a less delayed report
+  clock_known_ = true;
+  if (now_ms >= window_start_ms_ + kClockWindow_ms) {
+    // A whole window below the estimate by more than the slack: the board's
+    // clock fell back (it restarts its schedule after a stall of 100 ms).
+    if (window_any_ && window_best_ < clock_offset_ms_ - kClockSlack_ms) clock_offset_ms_ = window_best_;
+    window_any_ = false;
+    window_start_ms_ = now_ms;
+  }
+  if (!window_any_ || offset > window_best_) window_best_ = offset;
+  window_any_ = true;
+}
+
+void HilMcu::sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx) {
+  const double counts_per_rad = settings_.encoder_counts_per_rev / (2.0 * std::numbers::pi);
+  const double counts_per_m = counts_per_rad / wheel_radius_m_;
   auto counter = [&](double travel_m) {
     return static_cast<uint16_t>(static_cast<int64_t>(std::floor(travel_m * counts_per_m)) & 0xFFFF);
   };
-  append(hil::HilEncoders{{counter(truth.wheel_travel_left_m), counter(truth.wheel_travel_right_m)}}, tx);
+  auto rate = [&](double rad_s) { return static_cast<int32_t>(std::lround(rad_s * counts_per_rad)); };
+  hil::HilEncoders e;
+  e.counter = {counter(truth.wheel_travel_left_m), counter(truth.wheel_travel_right_m)};
+  e.rate_counts_s = {rate(truth.wheel.left_rad_s), rate(truth.wheel.right_rad_s)};
+  e.board_ms = static_cast<uint16_t>(static_cast<int64_t>(now_ms) + clock_offset_ms_);
+  append(e, tx);
 }
 
 void HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,

@@ -3,7 +3,10 @@
 // docs/firmware.md): in place of McuEmulator, the simulation stands in for
 // the peripherals the firmware's QEMU board does not have. It reads the
 // board's HilOutputs (shared/hil: PWM duty, brake, pings, servo pulses) and
-// sends it the encoder counters every kInputPeriod_ms (HilEncoders) and the
+// sends it the encoder counters every kInputPeriod_ms (HilEncoders: stamped
+// with the board's clock, which it maps from its own by the HilOutputs'
+// mcu_time_ms; with their rates, so that the board reads them at each
+// tick's instant) and the
 // other peripherals every kSensorPeriod_ms and at each ping's answer
 // (HilSensors: the echo, gas and battery ADC counts, line bits, the switches).
 // The motors: a DC motor per wheel, a first order toward the speed its duty
@@ -27,7 +30,8 @@ namespace inspect::sim {
 
 class HilMcu {
  public:
-  static constexpr uint64_t kInputPeriod_ms = 2;    // encoders, 500 Hz
+  static constexpr uint64_t kInputPeriod_ms = 4;    // encoders, 250 Hz
+  static constexpr uint64_t kPollPeriod_ms = 2;     // the board's outputs (500 Hz) taken and pings answered this often
   static constexpr uint64_t kSensorPeriod_ms = 20;  // the rest, 50 Hz (QEMU takes about 9 KB/s)
   /// Frames sent and not yet taken by the board (HilOutputs::input_seq) at
   /// most: QEMU takes a pty's bytes one at a time, slower than 500 frames a
@@ -35,6 +39,8 @@ class HilMcu {
   /// would give the firmware a stale encoder count. Beyond it the frame is not
   /// sent (the next one carries newer values: every field is absolute).
   static constexpr uint8_t kMaxInFlight = 4;
+  /// A firmware control tick this late (TIM2) is a `late_tick` event in the truth log.
+  static constexpr uint16_t kLateTickEvent_us = 5000;
   /// Below this the drivers' fault current (NAMUR NE 43: a failed transmitter's 2 mA).
   static constexpr float kFailedTransmitterMa = 2.0f;
 
@@ -55,8 +61,16 @@ class HilMcu {
   int pendingPing() const { return answered_count_ != last_.trigger_count && heard_ ? last_.trigger_sensor : -1; }
   /// Answers it with the range the world gives (serial::kNoEcho: nothing in range).
   void answerPing(uint16_t range_mm);
-  /// The encoder counters of `truth`, as a frame appended to tx.
-  void sendEncoders(const PlantState& truth, std::vector<uint8_t>& tx);
+  /// The encoder counters and rates of `truth` at now_ms, stamped with the board's clock, as a frame appended to tx.
+  void sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx);
+  /// The board's clock minus ours (ms): from the least delayed HilOutputs so
+  /// far, lowered only when a whole kClockWindow_ms of reports says it is more
+  /// than kClockSlack_ms too high; 0 before the board speaks. Steady: each
+  /// change shifts the counts the board reads by the wheel's rate x the change
+  /// (one ms at 2 rad/s moved its 20 ms speed estimate by 0.1 rad/s).
+  int64_t boardClockOffsetMs() const { return clock_offset_ms_; }
+  static constexpr uint64_t kClockWindow_ms = 2000;
+  static constexpr int64_t kClockSlack_ms = 2;
   /// What the other peripherals read at now_ms, as a frame appended to tx.
   void sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
                    std::vector<uint8_t>& tx);
@@ -95,6 +109,14 @@ class HilMcu {
   uint64_t held_back_ = 0;
   uint64_t pings_ = 0;
   util::LatencyHistogram late_;
+  // The board's clock offset: the largest mcu_time_ms - now_ms (the least
+  // delayed report), and this window's largest.
+  int64_t clock_offset_ms_ = 0;
+  bool clock_known_ = false;
+  int64_t window_best_ = 0;
+  uint64_t window_start_ms_ = 0;
+  bool window_any_ = false;
+  void trackBoardClock(uint32_t mcu_time_ms, uint64_t now_ms);
 
   void append(const hil::HilMessage& m, std::vector<uint8_t>& tx);
 };

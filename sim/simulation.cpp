@@ -191,14 +191,14 @@ void Simulation::useHilFirmware(const config::RobotConfig& robot) {
 
 void Simulation::stepHil() {
   // A ping is answered at once with the range now (the echo returns within the
-  // firmware's 30 ms slot); the encoders go out every 2 ms, the rest every 20 ms
+  // firmware's 30 ms slot); the encoders go out every 4 ms, the rest every 20 ms
   // and with each answer.
   bool answered = false;
   if (const int s = hil_->pendingPing(); s >= 0) {
     hil_->answerPing(ultrasonic_.measureMm(world_, state_.pose, s, people_.crowd.circles()));
     answered = true;
   }
-  if (t_ms_ % HilMcu::kInputPeriod_ms == 0) hil_->sendEncoders(state_, tx_);
+  if (t_ms_ % HilMcu::kInputPeriod_ms == 0) hil_->sendEncoders(state_, t_ms_, tx_);
   const bool first = hil_->takeFirstSensorsDue();
   if (first || answered || t_ms_ % HilMcu::kSensorPeriod_ms == 0)
     hil_->sendSensors(t_ms_, GrayscaleModel::read(world_, state_.pose), hil_gas_raw_, tx_);

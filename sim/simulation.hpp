@@ -51,13 +51,13 @@ class Simulation {
 
   /// From now on the MCU is the real firmware, hardware-in-the-loop (mcu_sim
   /// --hil, sim/hil_mcu.hpp): receive() takes its board's HIL bytes, takeTx()
-  /// gives what its peripherals read (every HilMcu::kInputPeriod_ms), and the
+  /// gives what its peripherals read (polled every HilMcu::kPollPeriod_ms), and the
   /// motors follow its PWM duty. The emulator stays idle.
   void useHilFirmware(const config::RobotConfig& robot);
   /// The HIL link's end, when useHilFirmware() was called.
   const HilMcu* hilMcu() const { return hil_.get(); }
-  /// How often takeTx() has something: the sensor frame's period, or the HIL inputs'.
-  uint64_t outputPeriodMs() const { return hil_ ? HilMcu::kInputPeriod_ms : kFramePeriod_ms; }
+  /// How often takeTx() may have something: the sensor frame's period, or the HIL link's poll.
+  uint64_t outputPeriodMs() const { return hil_ ? HilMcu::kPollPeriod_ms : kFramePeriod_ms; }
   /// The camera mount's pan and tilt (rad): the emulator's PTZ set-point, or
   /// where the firmware's servo pulses put it.
   std::array<double, 2> cameraPanTilt() const {

@@ -24,11 +24,11 @@ struct McuSettings {
   float wheel_radius_m = 0.2f;
   float track_m = 0.438f;
   float max_wheel_speed_rad_s = 5.0f;
-  float max_wheel_accel_rad_s2 = 10.0f;
   uint32_t encoder_counts_per_rev = 16384;
-  float speed_kp = 1.0f;
+  float speed_kp = 0.2f;
   float speed_ki = 2.0f;
   float speed_ff = 0.154f;
+  float response_tau_s = 0.2f;  // the set-point response the speed loop gives the Pi (robot.yaml motor.time_constant_s)
   // Ultrasonic sensors (robot.yaml ultrasonic, mcu).
   float ultrasonic_min_range_m = 0.02f;
   float ultrasonic_max_range_m = 4.5f;

@@ -1,6 +1,7 @@
 #include "firmware/core/wheel_speed.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace inspect::firmware {
 
@@ -24,7 +25,18 @@ int32_t EncoderTracker::windowCounts() const {
 }
 
 WheelSpeedLoop::WheelSpeedLoop(const McuSettings& s, float period_s)
-    : s_(s), period_s_(period_s), rad_per_count_(kTwoPi / static_cast<float>(s.encoder_counts_per_rev)) {}
+    : s_(s),
+      period_s_(period_s),
+      rad_per_count_(kTwoPi / static_cast<float>(s.encoder_counts_per_rev)),
+      model_alpha_(s.response_tau_s > 0.0f ? 1.0f - std::exp(-period_s / s.response_tau_s) : 1.0f) {}
+
+float WheelSpeedLoop::modelWindowMean(int periods) const {
+  if (periods <= 0) return model_;
+  float sum = 0.0f;
+  for (int k = 0; k < periods; ++k)
+    sum += model_history_[static_cast<std::size_t>((model_head_ - k + EncoderTracker::kWindow) % EncoderTracker::kWindow)];
+  return sum / static_cast<float>(periods);
+}
 
 float WheelSpeedLoop::step(float setpoint_rad_s, bool enabled, uint16_t encoder_counter) {
   enc_.update(encoder_counter);
@@ -32,21 +44,34 @@ float WheelSpeedLoop::step(float setpoint_rad_s, bool enabled, uint16_t encoder_
   speed_rad_s_ = periods > 0 ? static_cast<float>(enc_.windowCounts()) * rad_per_count_ /
                                    (static_cast<float>(periods) * period_s_)
                              : 0.0f;
-  const float target = enabled ? std::clamp(setpoint_rad_s, -s_.max_wheel_speed_rad_s, s_.max_wheel_speed_rad_s) : 0.0f;
-  const float max_step = s_.max_wheel_accel_rad_s2 * period_s_;
-  slewed_ += std::clamp(target - slewed_, -max_step, max_step);
-  if (!enabled || (target == 0.0f && slewed_ == 0.0f)) {
-    // Brake to standstill, or stopped on purpose (the set-point and its ramp
-    // at zero): no drive, nothing remembered. The integral would otherwise
-    // hold the duty that was driving, and the wheel would creep on it after
-    // the stop until it bled away (seen in the loop: -0.1 rad/s for a second).
-    slewed_ = 0.0f;
+  target_ = enabled ? std::clamp(setpoint_rad_s, -s_.max_wheel_speed_rad_s, s_.max_wheel_speed_rad_s) : 0.0f;
+  if (!enabled) {
+    // Braked: nothing remembered; a restart follows on from the wheel as it is.
+    model_ = speed_rad_s_;
+    model_history_.fill(model_);
+    estimate_rad_s_ = speed_rad_s_;
     integral_ = 0.0f;
     duty_ = 0.0f;
     return duty_;
   }
-  const float error = slewed_ - speed_rad_s_;
-  const float unsaturated = s_.speed_ff * slewed_ + s_.speed_kp * error + integral_;
+  // The reference model: the set-point through the first order the robot's
+  // response is (a motor whose own lag is that makes it from the feed-forward
+  // alone; the PI makes up any difference).
+  model_ += (target_ - model_) * model_alpha_;
+  model_head_ = (model_head_ + 1) % EncoderTracker::kWindow;
+  model_history_[static_cast<std::size_t>(model_head_)] = model_;
+  const float error = modelWindowMean(periods) - speed_rad_s_;
+  estimate_rad_s_ = model_ - error;
+  if (target_ == 0.0f) {
+    // Stopped on purpose: no drive, and the wheel runs down as the model
+    // does. The integral would otherwise hold the duty that was driving, and
+    // the wheel would creep on it after the stop until it bled away (seen in
+    // the loop: -0.1 rad/s for a second).
+    integral_ = 0.0f;
+    duty_ = 0.0f;
+    return duty_;
+  }
+  const float unsaturated = s_.speed_ff * target_ + s_.speed_kp * error + integral_;
   duty_ = std::clamp(unsaturated, -1.0f, 1.0f);
   // Anti-windup (conditional integration): the integral grows only while the
   // duty is not saturated, or when the error pulls it back out of saturation.

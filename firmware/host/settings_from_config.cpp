@@ -28,11 +28,11 @@ McuSettings settingsFrom(const config::RobotConfig& r) {
   s.wheel_radius_m = static_cast<float>(r.geometry.wheel_radius_m);
   s.track_m = static_cast<float>(r.geometry.track_m);
   s.max_wheel_speed_rad_s = static_cast<float>(r.limits.max_wheel_speed_rad_s);
-  s.max_wheel_accel_rad_s2 = static_cast<float>(r.limits.max_wheel_accel_rad_s2);
   s.encoder_counts_per_rev = static_cast<uint32_t>(r.mcu.encoder_counts_per_rev);
   s.speed_kp = static_cast<float>(r.mcu.speed_kp);
   s.speed_ki = static_cast<float>(r.mcu.speed_ki);
   s.speed_ff = static_cast<float>(r.mcu.speed_ff);
+  s.response_tau_s = static_cast<float>(r.motor.time_constant_s);
   s.ultrasonic_min_range_m = static_cast<float>(r.ultrasonic.min_range_m);
   s.ultrasonic_max_range_m = static_cast<float>(r.ultrasonic.max_range_m);
   s.ultrasonic_slot_ms = static_cast<uint16_t>(r.mcu.ultrasonic_slot_ms);
@@ -63,11 +63,11 @@ std::string settingsHeader(const McuSettings& s, const std::string& source) {
   f("wheel_radius_m", s.wheel_radius_m);
   f("track_m", s.track_m);
   f("max_wheel_speed_rad_s", s.max_wheel_speed_rad_s);
-  f("max_wheel_accel_rad_s2", s.max_wheel_accel_rad_s2);
   u("encoder_counts_per_rev", s.encoder_counts_per_rev);
   f("speed_kp", s.speed_kp);
   f("speed_ki", s.speed_ki);
   f("speed_ff", s.speed_ff);
+  f("response_tau_s", s.response_tau_s);
   f("ultrasonic_min_range_m", s.ultrasonic_min_range_m);
   f("ultrasonic_max_range_m", s.ultrasonic_max_range_m);
   u("ultrasonic_slot_ms", s.ultrasonic_slot_ms);

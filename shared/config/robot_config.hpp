@@ -77,7 +77,7 @@ struct CameraMount {
 /// them into the firmware's settings header.
 struct McuConfig {
   int encoder_counts_per_rev = 16384;  // quadrature counts per wheel revolution (4096 lines x 4)
-  double speed_kp = 1.0;               // duty per rad/s of wheel speed error
+  double speed_kp = 0.2;               // duty per rad/s of wheel speed error (docs/firmware.md)
   double speed_ki = 2.0;               // duty per rad of integrated error
   double speed_ff = 0.154;             // feed-forward duty per rad/s of set-point (1 / no-load speed at full duty)
   double obstacle_stop_m = 0.15;       // forward motion stopped while a front range is under this (0 = off)

@@ -7,6 +7,8 @@ namespace {
 
 void write(serial::WireWriter& w, const HilEncoders& e) {
   for (auto v : e.counter) w.u16(v);
+  for (auto v : e.rate_counts_s) w.i32(v);
+  w.u16(e.board_ms);
 }
 
 void write(serial::WireWriter& w, const HilSensors& in) {
@@ -34,6 +36,8 @@ void write(serial::WireWriter& w, const HilOutputs& out) {
 
 void read(serial::WireReader& r, HilEncoders& e) {
   for (auto& v : e.counter) v = r.u16();
+  for (auto& v : e.rate_counts_s) v = r.i32();
+  e.board_ms = r.u16();
 }
 
 void read(serial::WireReader& r, HilSensors& in) {

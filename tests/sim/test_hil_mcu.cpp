@@ -38,7 +38,7 @@ std::vector<uint8_t> frameOf(const hil::HilOutputs& o, uint8_t seq = 0) {
 }
 
 TEST(HilLink, EveryMessageRoundTripsAndCorruptionIsCounted) {
-  const hil::HilEncoders enc{{65535, 12}};
+  const hil::HilEncoders enc{{65535, 12}, {-13039, 2000000}, 65000};
   hil::HilSensors in;
   in.echo_count = 7;
   in.echo_flags = hil::HilSensors::kEchoRose | hil::HilSensors::kEchoFell;
@@ -83,6 +83,50 @@ TEST(HilLink, EveryMessageRoundTripsAndCorruptionIsCounted) {
   EXPECT_EQ(got.size(), 3u);
 }
 
+TEST(HilLink, TheBoardReadsItsEncodersAtTheTicksInstantFromASampleAndItsRate) {
+  hil::HilEncoders e{{65530, 100}, {13039, -2000}, 65534};  // board_ms wraps too
+  EXPECT_EQ(e.counterAt(0, 65534), 65530);
+  EXPECT_EQ(e.counterAt(0, 65536 + 4), static_cast<uint16_t>(65530 + 78));  // 6 ms later: 78.2 counts
+  EXPECT_EQ(e.counterAt(1, 65536 + 4), 100 - 12);
+  EXPECT_EQ(e.counterAt(0, 65530), 65530 - 52);  // a sample newer than the tick: back to the tick
+  // A link that stopped: no further than kMaxExtrapolationMs.
+  EXPECT_EQ(e.counterAt(1, 65534 + 1000), 100 - 2 * hil::HilEncoders::kMaxExtrapolationMs);
+}
+
+TEST(HilMcu, EncoderSamplesAreStampedWithTheBoardsClockFromItsLeastDelayedReport) {
+  const auto r = robot();
+  HilMcu mcu(r, nullptr);
+  hil::HilOutputs o;
+  o.mcu_time_ms = 50000;  // the board is 45000 ms ahead of the simulation, plus each report's delay
+  mcu.receive(frameOf(o, 0), 5003);
+  EXPECT_EQ(mcu.boardClockOffsetMs(), 44997);
+  o.mcu_time_ms = 50010;
+  mcu.receive(frameOf(o, 1), 5010);  // no delay: the better estimate
+  EXPECT_EQ(mcu.boardClockOffsetMs(), 45000);
+  o.mcu_time_ms = 50020;
+  mcu.receive(frameOf(o, 2), 5028);  // a late one changes nothing
+  EXPECT_EQ(mcu.boardClockOffsetMs(), 45000);
+  std::vector<uint8_t> tx;
+  mcu.sendEncoders(PlantState{}, 5030, tx);
+  const auto enc = decodeAll<hil::HilEncoders>(tx);
+  ASSERT_EQ(enc.size(), 1u);
+  EXPECT_EQ(enc[0].board_ms, static_cast<uint16_t>(50030));
+  // Reports 1-2 ms later than the best change nothing.
+  for (uint64_t t = 5040; t < 5040 + 3 * HilMcu::kClockWindow_ms; t += 10) {
+    o.mcu_time_ms = static_cast<uint32_t>(t + 45000 - 1 - (t / 10) % 2);
+    mcu.receive(frameOf(o, static_cast<uint8_t>(t / 10)), t);
+  }
+  EXPECT_EQ(mcu.boardClockOffsetMs(), 45000);
+  // The board's clock 100 ms back from now on (it restarted its schedule
+  // after a stall): followed within two windows.
+  const uint64_t from = 5040 + 3 * HilMcu::kClockWindow_ms;
+  for (uint64_t t = from; t < from + 2 * HilMcu::kClockWindow_ms + 10; t += 10) {
+    o.mcu_time_ms = static_cast<uint32_t>(t + 44900);
+    mcu.receive(frameOf(o, static_cast<uint8_t>(t / 10)), t);
+  }
+  EXPECT_EQ(mcu.boardClockOffsetMs(), 44900);
+}
+
 TEST(HilMcu, TheFirmwaresDutyDrivesTheMotorsAndTheBrakeStopsThem) {
   const auto r = robot();
   const auto s = firmware::settingsFrom(r);
@@ -112,11 +156,14 @@ TEST(HilMcu, WhatItSendsReadsBackThroughTheFirmwaresConversions) {
   gas[0] = 250;                  // a reading
   gas[1] = serial::kGasNoData;  // a failed sensor
   std::vector<uint8_t> tx;
-  mcu.sendEncoders(truth, tx);
+  truth.wheel = {2.0, -1.0};
+  mcu.sendEncoders(truth, 0, tx);
   const auto enc = decodeAll<hil::HilEncoders>(tx);
   ASSERT_EQ(enc.size(), 1u);
   EXPECT_EQ(enc[0].counter[0], 1000);
   EXPECT_EQ(enc[0].counter[1], static_cast<uint16_t>(-4));
+  EXPECT_EQ(enc[0].rate_counts_s[0], std::lround(2.0 * s.encoder_counts_per_rev / (2.0 * std::numbers::pi)));
+  EXPECT_EQ(enc[0].rate_counts_s[1], std::lround(-1.0 * s.encoder_counts_per_rev / (2.0 * std::numbers::pi)));
   tx.clear();
   mcu.sendSensors(60000, 0x18, gas, tx);
   const auto in = decodeInputs(tx);
@@ -163,26 +210,26 @@ TEST(HilMcu, NothingBeforeTheBoardSpeaksAndAtMostFourFramesInFlight) {
   const auto r = robot();
   HilMcu mcu(r, nullptr);
   std::vector<uint8_t> tx;
-  mcu.sendEncoders(PlantState{}, tx);
+  mcu.sendEncoders(PlantState{}, 0, tx);
   EXPECT_TRUE(tx.empty());  // the board holds the world still until it speaks
   hil::HilOutputs o;
   o.input_seq = 200;
   mcu.receive(frameOf(o), 0);
-  for (int i = 0; i < 10; ++i) mcu.sendEncoders(PlantState{}, tx);
+  for (int i = 0; i < 10; ++i) mcu.sendEncoders(PlantState{}, 0, tx);
   EXPECT_EQ(decodeAll<hil::HilEncoders>(tx).size(), HilMcu::kMaxInFlight);
   EXPECT_EQ(mcu.framesHeldBack(), 1u + 10u - HilMcu::kMaxInFlight);
   o.input_seq = 200 + HilMcu::kMaxInFlight;  // the board took them all
   mcu.receive(frameOf(o, 1), 2);
   tx.clear();
-  mcu.sendEncoders(PlantState{}, tx);
+  mcu.sendEncoders(PlantState{}, 0, tx);
   EXPECT_EQ(decodeAll<hil::HilEncoders>(tx).size(), 1u);
 }
 
-TEST(HilMcu, TheSimulationInTheLoopSendsEncodersEvery2msSensorsEvery20msAndFollowsTheDuty) {
+TEST(HilMcu, TheSimulationInTheLoopSendsEncodersEvery4msSensorsEvery20msAndFollowsTheDuty) {
   const auto r = robot();
   Simulation sim(r, loadWorldFile(test::srcPath("config/worlds/empty.yaml")), 1);
   sim.useHilFirmware(r);
-  EXPECT_EQ(sim.outputPeriodMs(), 2u);
+  EXPECT_EQ(sim.outputPeriodMs(), HilMcu::kPollPeriod_ms);
   // A board that takes every frame at once and answers every 2 ms.
   hil::HilOutputs o;
   o.duty_1e4 = {3000, 3000};
@@ -200,7 +247,7 @@ TEST(HilMcu, TheSimulationInTheLoopSendsEncodersEvery2msSensorsEvery20msAndFollo
     });
   }
   EXPECT_EQ(board.errors(), 0u);
-  EXPECT_EQ(encoders, 500u);
+  EXPECT_EQ(encoders, 250u);
   EXPECT_EQ(sensors, 50u);
   // 0.3 duty: toward 0.3 / speed_ff = 1.95 rad/s; after 1 s (5 time constants) nearly there.
   const double want = 0.3 / firmware::settingsFrom(r).speed_ff;

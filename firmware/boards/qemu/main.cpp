@@ -57,9 +57,11 @@ class HilPeripherals final : public f4::Peripherals {
     }
   }
 
-  fw::PeripheralInputs read(uint32_t) override {
+  fw::PeripheralInputs read(uint32_t now_ms) override {
     fw::PeripheralInputs in;
-    in.encoder = encoders_.counter;
+    // The encoder timers as read at this tick's due time (shared/hil: from the
+    // latest sample and its rate), however late its bytes came over the link.
+    in.encoder = {encoders_.counterAt(0, now_ms), encoders_.counterAt(1, now_ms)};
     // The echo of this slot's ping, if the simulator has answered that ping.
     if (!heard_ || sensors_.echo_count == out_.trigger_count) {
       in.echo.rose = (sensors_.echo_flags & hil::HilSensors::kEchoRose) != 0;
