@@ -121,12 +121,15 @@ if [ -n "$world" ]; then
   sim_out=$(mktemp)
   setpriv --pdeathsig TERM "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" > >(tee "$sim_out") &
   sim=$!
+  # "hil board answered": the board took mcu_sim's first readings (QEMU reads
+  # the HIL pty only once its 1 s poll saw mcu_sim open it: until then the
+  # board reads the held-still world, gas at 4 mA, oxygen 0 %vol).
   for _ in $(seq 1 200); do
-    grep -q '^mcu_sim: hil link' "$sim_out" && break
+    grep -q '^mcu_sim: hil board answered' "$sim_out" && break
     kill -0 "$sim" 2>/dev/null || break
     sleep 0.05
   done
-  sleep 0.5  # its first readings reach the board (it answers the board's first frame at once)
+  sleep 0.05  # a frame period: the first frame the Pi reads has them
   rm -f "$sim_out"
 fi
 ln -sfn "$usart1" "$link"

@@ -5,7 +5,7 @@
 # recorded gas inspection round, alarms, report), then prints what happened.
 #
 #   scripts/run_demo.sh [--interactive|--batch] [--port N] [--foxglove-port N] [--tuning] [--out DIR]
-#                       [--client-config FILE] [--rate F] [--firmware]
+#                       [--client-config FILE] [--rate F] [--firmware [--elf FILE]]
 #
 # --tuning runs the fuzzy-PID tuning job instead (scripts/demo/tuning.console
 # on config/worlds/tuning_floor.yaml, whose robot has worn, slower motors):
@@ -32,7 +32,8 @@
 # --rate; the robot's loop runs on the MCU's clock, so it controls the same):
 # the demo's test takes 2 to check the same round in less time.
 # --firmware puts the robot's real MCU firmware on the line instead of
-# mcu_sim's emulator: its QEMU image (built when missing) under
+# mcu_sim's emulator: its QEMU image (scripts/build_firmware.sh brings
+# build-firmware/ up to date first; --elf FILE: that image instead) under
 # scripts/mcu_qemu.sh, with mcu_sim --hil keeping the world (docs/firmware.md).
 # Real time only (not with --rate).
 set -euo pipefail
@@ -46,6 +47,7 @@ OUT=
 CLIENT_CONFIG=config/client.yaml
 RATE=
 FIRMWARE=0
+ELF=
 while [ $# -gt 0 ]; do
   case "$1" in
     --interactive) MODE=interactive ;;
@@ -58,7 +60,9 @@ while [ $# -gt 0 ]; do
       CLIENT_CONFIG=${2:?--client-config needs a file}; [ "${CLIENT_CONFIG#/}" != "$CLIENT_CONFIG" ] || CLIENT_CONFIG=$OLDPWD/$CLIENT_CONFIG; shift ;;
     --rate) RATE=${2:?--rate needs a factor}; shift ;;
     --firmware) FIRMWARE=1 ;;
-    -h|--help) sed -n '2,37p' "$0"; exit 0 ;;
+    --elf)  # relative to where the script was called from
+      ELF=${2:?--elf needs a file}; [ "${ELF#/}" != "$ELF" ] || ELF=$OLDPWD/$ELF; shift ;;
+    -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
     *) echo "run_demo: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -98,8 +102,12 @@ if [ -n "$RATE" ]; then SIM_ARGS+=(--rate "$RATE"); fi
 # config/client.yaml), so a busy machine does not starve them into a
 # stale-sensor failsafe (docs/testing.md, "Scheduling").
 if [ "$FIRMWARE" = 1 ]; then
-  [ -f build-firmware/inspect-mcu-qemu.elf ] || bash scripts/build_firmware.sh --settings-gen "$BIN/mcu_settings_gen" | sed 's/^/demo: /'
-  bash scripts/mcu_qemu.sh --serial-link "$OUT/mcu" --elf build-firmware/inspect-mcu-qemu.elf --mcu-sim "$BIN/mcu_sim" \
+  if [ -z "$ELF" ]; then
+    # Incremental: an image older than the firmware's sources or config/robot.yaml is rebuilt.
+    bash scripts/build_firmware.sh --settings-gen "$BIN/mcu_settings_gen" | sed 's/^/demo: /'
+    ELF=build-firmware/inspect-mcu-qemu.elf
+  fi
+  bash scripts/mcu_qemu.sh --serial-link "$OUT/mcu" --elf "$ELF" --mcu-sim "$BIN/mcu_sim" \
     --world "$WORLD" --realtime-priority 20 --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
     --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
 else

@@ -31,6 +31,10 @@ void HilMcu::receive(std::span<const uint8_t> bytes, uint64_t now_ms) {
       first_sensors_due_ = true;
       answered_count_ = out->trigger_count;  // pings before the link came up are gone
       seq_ = static_cast<uint8_t>(out->input_seq + 1);
+      first_seq_ = seq_;
+    } else if (const auto past_first = static_cast<uint8_t>(out->input_seq - first_seq_);
+               !inputs_taken_ && past_first >= 1 && past_first < 128) {
+      inputs_taken_ = true;  // it took the frame after the first: the first readings (sent with or before it) too
     }
     last_ = *out;
     trackBoardClock(out->mcu_time_ms, now_ms);

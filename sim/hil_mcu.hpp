@@ -76,6 +76,11 @@ class HilMcu {
                    std::vector<uint8_t>& tx);
 
   bool heard() const { return heard_; }
+  /// True once the board has taken a frame sent after it spoke (its input_seq
+  /// acknowledges it): its peripherals read the world. QEMU reads a pty only
+  /// once its 1 s poll has seen the other end open, so this came up to a
+  /// second after heard(), the board reading the held-still world meanwhile.
+  bool boardTookInputs() const { return inputs_taken_; }
   /// True once, right after the board first speaks: the other peripherals' readings are due at once
   /// (until then the board holds the world still, gas at its transmitters' 4 mA).
   bool takeFirstSensorsDue() {
@@ -101,6 +106,8 @@ class HilMcu {
   hil::HilOutputs last_;
   bool heard_ = false;
   bool first_sensors_due_ = false;
+  bool inputs_taken_ = false;
+  uint8_t first_seq_ = 0;  // the seq of the first frame sent after the board spoke
   hil::HilSensors echo_;  // the echo fields of the answer to the latest ping
   uint8_t answered_count_ = 0;
   uint8_t seq_ = 0;

@@ -200,6 +200,15 @@ void Simulation::stepHil() {
   }
   if (t_ms_ % HilMcu::kInputPeriod_ms == 0) hil_->sendEncoders(state_, t_ms_, tx_);
   const bool first = hil_->takeFirstSensorsDue();
+  if (first && gas_.last_sample_ms < 0) {
+    // The board spoke before the first sensor frame's step sampled the gas:
+    // sample it now, or its first readings would be zero (an oxygen channel
+    // at 0 %vol raised robot_client's O2 alarms in the circle's runs).
+    McuInputs in;
+    in.truth = state_;
+    sampleGas(in);
+    hil_gas_raw_ = in.gas_raw;
+  }
   if (first || answered || t_ms_ % HilMcu::kSensorPeriod_ms == 0)
     hil_->sendSensors(t_ms_, GrayscaleModel::read(world_, state_.pose), hil_gas_raw_, tx_);
 }

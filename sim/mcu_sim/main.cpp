@@ -73,7 +73,16 @@ int main(int argc, char** argv) {
       truth->onEvent(0.0, "start", detail);
     }
     sim::RealtimeRunner::Options run_opts{opt.rate, opt.duration_s, {}, opt.freeze_on_stall};
-    if (camera) run_opts.on_caught_up = [&camera](const sim::Simulation& s) { camera->publish(s); };
+    bool board_announced = false;
+    run_opts.on_caught_up = [&camera, &board_announced](const sim::Simulation& s) {
+      if (camera) camera->publish(s);
+      if (const sim::HilMcu* hil = s.hilMcu(); hil && !board_announced && hil->boardTookInputs()) {
+        // The board has its first readings of the world: scripts/mcu_qemu.sh links the Pi's line now.
+        std::printf("mcu_sim: hil board answered (its peripherals read the world)\n");
+        std::fflush(stdout);
+        board_announced = true;
+      }
+    };
     sim::RealtimeRunner runner(simulation, port, truth.get(), run_opts);
     // Real-time only now, start-up done: loading the world and the libraries
     // at SCHED_FIFO would hold a core from the other loops on the machine.

@@ -218,8 +218,10 @@ TEST(HilMcu, NothingBeforeTheBoardSpeaksAndAtMostFourFramesInFlight) {
   for (int i = 0; i < 10; ++i) mcu.sendEncoders(PlantState{}, 0, tx);
   EXPECT_EQ(decodeAll<hil::HilEncoders>(tx).size(), HilMcu::kMaxInFlight);
   EXPECT_EQ(mcu.framesHeldBack(), 1u + 10u - HilMcu::kMaxInFlight);
+  EXPECT_FALSE(mcu.boardTookInputs());
   o.input_seq = 200 + HilMcu::kMaxInFlight;  // the board took them all
   mcu.receive(frameOf(o, 1), 2);
+  EXPECT_TRUE(mcu.boardTookInputs());
   tx.clear();
   mcu.sendEncoders(PlantState{}, 0, tx);
   EXPECT_EQ(decodeAll<hil::HilEncoders>(tx).size(), 1u);

@@ -79,17 +79,17 @@ int countLines(const std::string& out, const std::string& text) {
   return n;
 }
 
-}  // namespace
 
-TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
+// run_demo.sh --batch with `mode` (its world's rate, or the firmware) and
+// every check of the round; `timeout_s` for the whole demo.
+void checkGasRound(const std::vector<std::string>& mode, double timeout_s) {
   TempDir dir("demo");
   ::setenv("BUILD_DIR", (binDir() + "/..").c_str(), 1);
-  // The world at twice real time (the robot's loop runs on the MCU clock):
-  // the same round, alarms, holds and report in about half the time.
-  Process demo = Process::spawn({"/bin/bash", srcPath("scripts/run_demo.sh"), "--batch", "--port", "0", "--out",
-                                 dir.path(), "--client-config", sharedHostClientConfig(dir), "--rate", "2"},
-                                dir / "demo.out", dir / "demo.err");
-  const auto rc = demo.wait(240);
+  std::vector<std::string> argv{"/bin/bash", srcPath("scripts/run_demo.sh"), "--batch", "--port", "0", "--out",
+                                dir.path(), "--client-config", sharedHostClientConfig(dir)};
+  argv.insert(argv.end(), mode.begin(), mode.end());
+  Process demo = Process::spawn(argv, dir / "demo.out", dir / "demo.err");
+  const auto rc = demo.wait(timeout_s);
   // CLOCK_MONOTONIC -> Unix time, for the truth log against the catalog.
   const double mono_to_unix_s =
       std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() -
@@ -223,4 +223,21 @@ TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
        it != std::sregex_iterator(); ++it)
     total += std::stol((*it)[1]);
   EXPECT_EQ(count("decoded"), total) << counts;
+}
+
+}  // namespace
+
+TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
+  // The world at twice real time (the robot's loop runs on the MCU clock):
+  // the same round, alarms, holds and report in about half the time.
+  checkGasRound({"--rate", "2"}, 240);
+}
+
+// The same round and checks with the robot's real firmware on the line (its
+// QEMU image under mcu_sim --hil, docs/firmware.md), in real time: about 3
+// minutes. Label `long` (by hand: ctest -L long).
+TEST(FirmwareDemo, GasInspectionRoundThroughTheFirmware) {
+  ASSERT_TRUE(std::filesystem::exists(firmwareImage()))
+      << firmwareImage() << " is missing: ctest -R firmware_mcu_build builds it";
+  checkGasRound({"--firmware", "--elf", firmwareImage()}, 420);
 }
