@@ -4,7 +4,7 @@
 # pseudo-terminal linked at PATH, for robot_client --serial PATH.
 #
 #   scripts/mcu_qemu.sh --serial-link PATH [--elf FILE] [--mcu-sim PROGRAM] [--realtime-priority N]
-#                       [--hil-link PATH2 | --world FILE [mcu_sim options...]]
+#                       [--cpu N] [--hil-link PATH2 | --world FILE [mcu_sim options...]]
 #
 # --world FILE [options]: the simulated world attached: `mcu_sim --hil` on
 #   USART2, the hardware-in-the-loop link, with the world file and the mcu_sim
@@ -19,13 +19,15 @@
 # --realtime-priority N: QEMU (the MCU, a chip of its own) runs SCHED_FIFO at N
 #   in [1, 99] when this user may (root, CAP_SYS_NICE; else a warning), as
 #   mcu_sim --realtime-priority does; 0 = normal (default).
+# --cpu N: QEMU on CPU N alone, mcu_sim on the others (taskset): the chip's
+#   clock is then not held up by the world's steps (docs/firmware.md).
 # Runs until SIGINT/SIGTERM (or mcu_sim's --duration); QEMU's own messages go
 # to stderr. Stops what it started and removes its links.
 set -euo pipefail
 self=$(readlink -f "$0")
 # Paths are the caller's (relative to where it was called from), defaults the tree's.
 root=$(cd "$(dirname "$self")/.." && pwd)
-link="" hil_link="" elf="" world="" mcu_sim=$root/build/bin/mcu_sim priority=0
+link="" hil_link="" elf="" world="" mcu_sim=$root/build/bin/mcu_sim priority=0 cpu=
 sim_args=()
 while [ $# -gt 0 ]; do
   case $1 in
@@ -34,6 +36,7 @@ while [ $# -gt 0 ]; do
     --elf) elf=$2; shift 2 ;;
     --mcu-sim) mcu_sim=$2; shift 2 ;;
     --realtime-priority) priority=$2; shift 2 ;;
+    --cpu) cpu=$2; shift 2 ;;
     --world) world=$2; shift 2; sim_args=("$@"); break ;;
     -h|--help) sed -n '2,25p' "$self" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "mcu_qemu: unknown argument '$1' (try --help)" >&2; exit 2 ;;
@@ -46,6 +49,16 @@ fi
 if ! [[ "$priority" =~ ^[0-9]+$ ]] || [ "$priority" -gt 99 ]; then
   echo "mcu_qemu: --realtime-priority: '$priority' is not a whole number in [0, 99]" >&2
   exit 2
+fi
+pin_qemu=() pin_sim=()
+if [ -n "$cpu" ]; then
+  ncpu=$(nproc --all)
+  if ! [[ "$cpu" =~ ^[0-9]+$ ]] || [ "$cpu" -ge "$ncpu" ] || [ "$ncpu" -lt 2 ]; then
+    echo "mcu_qemu: --cpu: '$cpu' is not one of CPUs 0-$((ncpu - 1)) with another left for mcu_sim" >&2
+    exit 2
+  fi
+  others=$(seq 0 $((ncpu - 1)) | grep -vx "$cpu" | paste -sd,)
+  pin_qemu=(taskset -c "$cpu") pin_sim=(taskset -c "$others")
 fi
 rt=()
 if [ "$priority" -gt 0 ]; then
@@ -80,7 +93,7 @@ log=$(mktemp)
 second=null
 [ -n "$hil_link" ] && second=pty
 # QEMU and mcu_sim end with this script even when it is killed outright (SIGTERM on its death).
-setpriv --pdeathsig TERM "${rt[@]}" qemu-system-arm -M netduinoplus2 -display none -monitor none -serial pty -serial "$second" \
+setpriv --pdeathsig TERM "${pin_qemu[@]}" "${rt[@]}" qemu-system-arm -M netduinoplus2 -display none -monitor none -serial pty -serial "$second" \
   -kernel "$elf" >"$log" 2>&1 &
 qemu=$!
 sim=""
@@ -119,7 +132,7 @@ if [ -n "$world" ]; then
   # so that robot_client never reads the held-still world's frames (gas at 4
   # mA: an oxygen channel would read 0 %vol and raise its alarm).
   sim_out=$(mktemp)
-  setpriv --pdeathsig TERM "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" > >(tee "$sim_out") &
+  setpriv --pdeathsig TERM "${pin_sim[@]}" "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" > >(tee "$sim_out") &
   sim=$!
   # "hil board answered": the board took mcu_sim's first readings (QEMU reads
   # the HIL pty only once its 1 s poll saw mcu_sim open it: until then the

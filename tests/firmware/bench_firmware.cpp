@@ -15,7 +15,8 @@
 // Prints a table; --json FILE writes the same figures.
 // QEMU and mcu_sim run SCHED_FIFO at --realtime-priority (default 20, as in the
 // stack tests and the demo: the MCU is a chip of its own; 0 = normal).
-//   bench_firmware [--seconds S] [--watchdog-trials N] [--elf FILE] [--realtime-priority N] [--json FILE]
+// --cpu N: QEMU on CPU N alone, mcu_sim and the bench on the others (mcu_qemu.sh --cpu).
+//   bench_firmware [--seconds S] [--watchdog-trials N] [--elf FILE] [--realtime-priority N] [--cpu N] [--json FILE]
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -65,18 +66,21 @@ int main(int argc, char** argv) {
   double seconds = 600;
   int trials = 10;
   int priority = 20;
-  std::string elf, json_path;
+  std::string elf, json_path, cpu;
   cli::readOrExit("bench_firmware", argc, argv, [&](cli::ArgReader& a) {
     if (a.isHelp()) {
-      std::printf("usage: bench_firmware [--seconds S] [--watchdog-trials N] [--elf FILE] [--realtime-priority N] [--json FILE]\n"
+      std::printf("usage: bench_firmware [--seconds S] [--watchdog-trials N] [--elf FILE] [--realtime-priority N] [--cpu N]\n"
+                  "                      [--json FILE]\n"
                   "The firmware in QEMU with mcu_sim --hil: frame rate (host and MCU clock), the control\n"
                   "tick's lateness on TIM2, the watchdog's trip time. Default 600 s, 10 trials, the image\n"
-                  "build-firmware/inspect-mcu-qemu.elf, QEMU and mcu_sim at SCHED_FIFO 20 (docs/firmware.md).\n");
+                  "build-firmware/inspect-mcu-qemu.elf, QEMU and mcu_sim at SCHED_FIFO 20 (docs/firmware.md).\n"
+                  "--cpu N: QEMU on CPU N alone, mcu_sim on the others (scripts/mcu_qemu.sh --cpu).\n");
       std::exit(0);
     } else if (a.is("--seconds")) seconds = a.numberAbove(1.0, 86400.0);
     else if (a.is("--watchdog-trials")) trials = static_cast<int>(a.integer(1, 1000));
     else if (a.is("--elf")) elf = a.path();
     else if (a.is("--realtime-priority")) priority = static_cast<int>(a.integer(0, 99));
+    else if (a.is("--cpu")) cpu = std::to_string(a.integer(0, 1023));
     else if (a.is("--json")) json_path = a.path();
     else a.unknown();
   });
@@ -91,10 +95,11 @@ int main(int argc, char** argv) {
   std::string out;
   try {
     const std::string prio = std::to_string(priority);
-    test::QemuBoard board(elf, dir.path(),
-                          {"--realtime-priority", prio, "--mcu-sim", test::binPath("mcu_sim"), "--world",
-                           test::srcPath("config/worlds/square_room.yaml"), "--robot", test::srcPath("config/robot.yaml"),
-                           "--realtime-priority", prio});
+    std::vector<std::string> args{"--realtime-priority", prio};
+    if (!cpu.empty()) args.insert(args.end(), {"--cpu", cpu});
+    args.insert(args.end(), {"--mcu-sim", test::binPath("mcu_sim"), "--world", test::srcPath("config/worlds/square_room.yaml"),
+                             "--robot", test::srcPath("config/robot.yaml"), "--realtime-priority", prio});
+    test::QemuBoard board(elf, dir.path(), args);
     auto& frames = board.frames();
     board.drive(1.0, -500, 500);  // the link up, the loop settled
     frames.clear();
