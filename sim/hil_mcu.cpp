@@ -91,7 +91,7 @@ void HilMcu::trackBoardClock(uint32_t mcu_time_ms, uint64_t now_ms) {
   window_any_ = true;
 }
 
-void HilMcu::sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx) {
+bool HilMcu::sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx) {
   const double counts_per_rad = settings_.encoder_counts_per_rev / (2.0 * std::numbers::pi);
   const double counts_per_m = counts_per_rad / wheel_radius_m_;
   auto counter = [&](double travel_m) {
@@ -102,10 +102,10 @@ void HilMcu::sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<
   e.counter = {counter(truth.wheel_travel_left_m), counter(truth.wheel_travel_right_m)};
   e.rate_counts_s = {rate(truth.wheel.left_rad_s), rate(truth.wheel.right_rad_s)};
   e.board_ms = static_cast<uint16_t>(static_cast<int64_t>(now_ms) + clock_offset_ms_);
-  append(e, tx);
+  return append(e, tx);
 }
 
-void HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
+bool HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
                          std::vector<uint8_t>& tx) {
   hil::HilSensors in = echo_;
   for (std::size_t i = 0; i < serial::kGasChannels; ++i) {
@@ -121,19 +121,20 @@ void HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<ui
   in.battery_adc = firmware::batteryAdcCounts(settings_, McuEmulator::batteryMvAt(now_ms));
   in.grayscale = grayscale;
   in.switches = 0;
-  append(in, tx);
+  return append(in, tx);
 }
 
-void HilMcu::append(const hil::HilMessage& m, std::vector<uint8_t>& tx) {
+bool HilMcu::append(const hil::HilMessage& m, std::vector<uint8_t>& tx) {
   // Nothing before the board speaks (it holds the world still meanwhile), and
   // no more than kMaxInFlight frames it has not taken.
   if (!heard_ || static_cast<uint8_t>(seq_ - acked_seq_ - 1) >= kMaxInFlight) {
     ++held_back_;
-    return;
+    return false;
   }
   const auto frame = hil::encodeHil(m, seq_++);
   tx.insert(tx.end(), frame.bytes.begin(), frame.bytes.begin() + static_cast<std::ptrdiff_t>(frame.size));
   ++frames_sent_;
+  return true;
 }
 
 }  // namespace inspect::sim

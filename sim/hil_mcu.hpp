@@ -38,7 +38,7 @@ class HilMcu {
   /// second when its host is busy, and a frame that waited in the pty's queue
   /// would give the firmware a stale encoder count. Beyond it the frame is not
   /// sent (the next one carries newer values: every field is absolute).
-  static constexpr uint8_t kMaxInFlight = 4;
+  static constexpr uint8_t kMaxInFlight = 2;
   /// A firmware control tick this late (TIM2) is a `late_tick` event in the truth log.
   static constexpr uint16_t kLateTickEvent_us = 5000;
   /// Below this the drivers' fault current (NAMUR NE 43: a failed transmitter's 2 mA).
@@ -61,8 +61,9 @@ class HilMcu {
   int pendingPing() const { return answered_count_ != last_.trigger_count && heard_ ? last_.trigger_sensor : -1; }
   /// Answers it with the range the world gives (serial::kNoEcho: nothing in range).
   void answerPing(uint16_t range_mm);
-  /// The encoder counters and rates of `truth` at now_ms, stamped with the board's clock, as a frame appended to tx.
-  void sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx);
+  /// The encoder counters and rates of `truth` at now_ms, stamped with the board's clock, as a frame
+  /// appended to tx; false when held back (kMaxInFlight).
+  bool sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx);
   /// The board's clock minus ours (ms): from the least delayed HilOutputs so
   /// far, lowered only when a whole kClockWindow_ms of reports says it is more
   /// than kClockSlack_ms too high; 0 before the board speaks. Steady: each
@@ -72,7 +73,8 @@ class HilMcu {
   static constexpr uint64_t kClockWindow_ms = 2000;
   static constexpr int64_t kClockSlack_ms = 2;
   /// What the other peripherals read at now_ms, as a frame appended to tx.
-  void sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
+  /// False when held back (kMaxInFlight): the caller sends them again at its next poll.
+  bool sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
                    std::vector<uint8_t>& tx);
 
   bool heard() const { return heard_; }
@@ -125,7 +127,7 @@ class HilMcu {
   bool window_any_ = false;
   void trackBoardClock(uint32_t mcu_time_ms, uint64_t now_ms);
 
-  void append(const hil::HilMessage& m, std::vector<uint8_t>& tx);
+  bool append(const hil::HilMessage& m, std::vector<uint8_t>& tx);
 };
 
 }  // namespace inspect::sim

@@ -198,7 +198,6 @@ void Simulation::stepHil() {
     hil_->answerPing(ultrasonic_.measureMm(world_, state_.pose, s, people_.crowd.circles()));
     answered = true;
   }
-  if (t_ms_ % HilMcu::kInputPeriod_ms == 0) hil_->sendEncoders(state_, t_ms_, tx_);
   const bool first = hil_->takeFirstSensorsDue();
   if (first && gas_.last_sample_ms < 0) {
     // The board spoke before the first sensor frame's step sampled the gas:
@@ -209,8 +208,15 @@ void Simulation::stepHil() {
     sampleGas(in);
     hil_gas_raw_ = in.gas_raw;
   }
-  if (first || answered || t_ms_ % HilMcu::kSensorPeriod_ms == 0)
-    hil_->sendSensors(t_ms_, GrayscaleModel::read(world_, state_.pose), hil_gas_raw_, tx_);
+  // The other readings first, and again at each poll until the window lets
+  // them through: a ping's answer held back until the next 20 ms period came
+  // after the firmware's 30 ms slot, a missed echo (ULTRASONIC under load).
+  if (first || answered || t_ms_ % HilMcu::kSensorPeriod_ms == 0) hil_sensors_due_ = true;
+  if (hil_sensors_due_ && (t_ms_ % HilMcu::kPollPeriod_ms == 0 || first || answered) &&
+      hil_->sendSensors(t_ms_, GrayscaleModel::read(world_, state_.pose), hil_gas_raw_, tx_))
+    hil_sensors_due_ = false;
+  // The encoders: a frame held back is no loss, the next carries newer counts (and the board extrapolates).
+  if (t_ms_ % HilMcu::kInputPeriod_ms == 0) hil_->sendEncoders(state_, t_ms_, tx_);
 }
 
 void Simulation::emitPedestrians() {

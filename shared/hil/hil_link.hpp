@@ -36,7 +36,9 @@ struct HilEncoders {
   uint16_t board_ms = 0;                    // the board's clock (HilOutputs::mcu_time_ms, low 16 bits)
                                             // at which they were read, as the simulator maps its time to it
   /// Extrapolation of a stale sample stops this far from board_ms (a link that stopped).
-  static constexpr int32_t kMaxExtrapolationMs = 50;
+  /// (200 ms: a starved link delivered samples over 50 ms old, and counts that
+  /// stopped there read as a wheel that stopped.)
+  static constexpr int32_t kMaxExtrapolationMs = 200;
   /// Wheel i's counter at the board's `now_ms`, extrapolated from the sample at its rate.
   uint16_t counterAt(std::size_t i, uint32_t now_ms) const {
     int32_t dt = static_cast<int16_t>(static_cast<uint16_t>(now_ms - board_ms));

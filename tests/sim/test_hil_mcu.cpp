@@ -90,7 +90,7 @@ TEST(HilLink, TheBoardReadsItsEncodersAtTheTicksInstantFromASampleAndItsRate) {
   EXPECT_EQ(e.counterAt(1, 65536 + 4), 100 - 12);
   EXPECT_EQ(e.counterAt(0, 65530), 65530 - 52);  // a sample newer than the tick: back to the tick
   // A link that stopped: no further than kMaxExtrapolationMs.
-  EXPECT_EQ(e.counterAt(1, 65534 + 1000), 100 - 2 * hil::HilEncoders::kMaxExtrapolationMs);
+  EXPECT_EQ(e.counterAt(1, 65534 + 1000), static_cast<uint16_t>(100 - 2 * hil::HilEncoders::kMaxExtrapolationMs));
 }
 
 TEST(HilMcu, EncoderSamplesAreStampedWithTheBoardsClockFromItsLeastDelayedReport) {
@@ -206,7 +206,7 @@ TEST(HilMcu, APingIsAnsweredOnceWithItsEcho) {
   EXPECT_EQ(in[0].echo_flags, hil::HilSensors::kEchoRose);
 }
 
-TEST(HilMcu, NothingBeforeTheBoardSpeaksAndAtMostFourFramesInFlight) {
+TEST(HilMcu, NothingBeforeTheBoardSpeaksAndAtMostTwoFramesInFlight) {
   const auto r = robot();
   HilMcu mcu(r, nullptr);
   std::vector<uint8_t> tx;
