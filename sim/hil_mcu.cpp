@@ -1,6 +1,5 @@
 #include "sim/hil_mcu.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -28,7 +27,7 @@ void HilMcu::receive(std::span<const uint8_t> bytes, uint64_t now_ms) {
                              " tilt_0p1mrad=" + std::to_string(out->ptz_target_0p1mrad[1]));
     }
     if (!heard_) {
-      first_sensors_due_ = true;
+      readings_due_ = true;  // until now the board held the world still, gas at its transmitters' 4 mA
       answered_count_ = out->trigger_count;  // pings before the link came up are gone
       seq_ = static_cast<uint8_t>(out->input_seq + 1);
       first_seq_ = seq_;
@@ -63,6 +62,7 @@ std::array<double, 2> HilMcu::ptzRad() const {
 
 void HilMcu::answerPing(uint16_t range_mm) {
   ++pings_;
+  readings_due_ = true;
   answered_count_ = last_.trigger_count;
   echo_.echo_count = last_.trigger_count;
   if (range_mm == serial::kNoEcho) {
@@ -102,7 +102,9 @@ bool HilMcu::sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<
   e.counter = {counter(truth.wheel_travel_left_m), counter(truth.wheel_travel_right_m)};
   e.rate_counts_s = {rate(truth.wheel.left_rad_s), rate(truth.wheel.right_rad_s)};
   e.board_ms = static_cast<uint16_t>(static_cast<int64_t>(now_ms) + clock_offset_ms_);
-  return append(e, tx);
+  if (append(e, tx)) return true;
+  ++held_back_;  // no loss: the next carries newer counts
+  return false;
 }
 
 bool HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
@@ -121,16 +123,19 @@ bool HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<ui
   in.battery_adc = firmware::batteryAdcCounts(settings_, McuEmulator::batteryMvAt(now_ms));
   in.grayscale = grayscale;
   in.switches = 0;
-  return append(in, tx);
+  if (append(in, tx)) {
+    readings_due_ = readings_held_ = false;
+    return true;
+  }
+  if (!readings_held_) ++held_back_;
+  readings_due_ = readings_held_ = true;
+  return false;
 }
 
 bool HilMcu::append(const hil::HilMessage& m, std::vector<uint8_t>& tx) {
   // Nothing before the board speaks (it holds the world still meanwhile), and
   // no more than kMaxInFlight frames it has not taken.
-  if (!heard_ || static_cast<uint8_t>(seq_ - acked_seq_ - 1) >= kMaxInFlight) {
-    ++held_back_;
-    return false;
-  }
+  if (!heard_ || static_cast<uint8_t>(seq_ - acked_seq_ - 1) >= kMaxInFlight) return false;
   const auto frame = hil::encodeHil(m, seq_++);
   tx.insert(tx.end(), frame.bytes.begin(), frame.bytes.begin() + static_cast<std::ptrdiff_t>(frame.size));
   ++frames_sent_;

@@ -72,8 +72,14 @@ class HilMcu {
   int64_t boardClockOffsetMs() const { return clock_offset_ms_; }
   static constexpr uint64_t kClockWindow_ms = 2000;
   static constexpr int64_t kClockSlack_ms = 2;
+  /// Whether the other peripherals' readings are due at now_ms: every
+  /// kSensorPeriod_ms, at once when the board first speaks and when a ping has
+  /// been answered, and again at every step while the in-flight window holds
+  /// them back (an answer held to the next period came after the firmware's
+  /// 30 ms slot: a missed echo, ULTRASONIC under load).
+  bool sensorsDue(uint64_t now_ms) const { return readings_due_ || now_ms % kSensorPeriod_ms == 0; }
   /// What the other peripherals read at now_ms, as a frame appended to tx.
-  /// False when held back (kMaxInFlight): the caller sends them again at its next poll.
+  /// False when held back (kMaxInFlight): still due, they go at a later step.
   bool sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
                    std::vector<uint8_t>& tx);
 
@@ -83,19 +89,13 @@ class HilMcu {
   /// once its 1 s poll has seen the other end open, so this came up to a
   /// second after heard(), the board reading the held-still world meanwhile.
   bool boardTookInputs() const { return inputs_taken_; }
-  /// True once, right after the board first speaks: the other peripherals' readings are due at once
-  /// (until then the board holds the world still, gas at its transmitters' 4 mA).
-  bool takeFirstSensorsDue() {
-    const bool due = first_sensors_due_;
-    first_sensors_due_ = false;
-    return due;
-  }
   const hil::HilOutputs& lastOutputs() const { return last_; }
   uint32_t framesReceived() const { return decoder_.framesOk(); }
   uint32_t errors() const { return decoder_.errors(); }
   uint64_t framesSent() const { return frames_sent_; }
   uint64_t pings() const { return pings_; }
-  /// Frames not sent: kMaxInFlight were in flight.
+  /// Frames not sent (kMaxInFlight were in flight): encoder frames, and readings
+  /// that had to wait (each once, however many steps it waited).
   uint64_t framesHeldBack() const { return held_back_; }
   /// How late the firmware's control ticks started (TIM2), from its reports.
   const util::LatencyHistogram& tickLateness() const { return late_; }
@@ -107,7 +107,8 @@ class HilMcu {
   hil::HilDecoder decoder_;
   hil::HilOutputs last_;
   bool heard_ = false;
-  bool first_sensors_due_ = false;
+  bool readings_due_ = false;   // due now (first contact, a ping's answer) or held back so far
+  bool readings_held_ = false;  // the due readings were held back at least once (counted in held_back_)
   bool inputs_taken_ = false;
   uint8_t first_seq_ = 0;  // the seq of the first frame sent after the board spoke
   hil::HilSensors echo_;  // the echo fields of the answer to the latest ping

@@ -191,30 +191,22 @@ void Simulation::useHilFirmware(const config::RobotConfig& robot) {
 
 void Simulation::stepHil() {
   // A ping is answered at once with the range now (the echo returns within the
-  // firmware's 30 ms slot); the encoders go out every 4 ms, the rest every 20 ms
-  // and with each answer.
-  bool answered = false;
-  if (const int s = hil_->pendingPing(); s >= 0) {
+  // firmware's 30 ms slot); the other readings go first whenever due
+  // (HilMcu::sensorsDue), the encoders every 4 ms.
+  if (const int s = hil_->pendingPing(); s >= 0)
     hil_->answerPing(ultrasonic_.measureMm(world_, state_.pose, s, people_.crowd.circles()));
-    answered = true;
+  if (hil_->sensorsDue(t_ms_)) {
+    if (gas_.last_sample_ms < 0) {
+      // Due before the first sensor frame's step sampled the gas (the board
+      // spoke first): sample it now, or its first readings would be zero (an
+      // oxygen channel at 0 %vol raised robot_client's O2 alarms).
+      McuInputs in;
+      in.truth = state_;
+      sampleGas(in);
+      hil_gas_raw_ = in.gas_raw;
+    }
+    hil_->sendSensors(t_ms_, GrayscaleModel::read(world_, state_.pose), hil_gas_raw_, tx_);
   }
-  const bool first = hil_->takeFirstSensorsDue();
-  if (first && gas_.last_sample_ms < 0) {
-    // The board spoke before the first sensor frame's step sampled the gas:
-    // sample it now, or its first readings would be zero (an oxygen channel
-    // at 0 %vol raised robot_client's O2 alarms in the circle's runs).
-    McuInputs in;
-    in.truth = state_;
-    sampleGas(in);
-    hil_gas_raw_ = in.gas_raw;
-  }
-  // The other readings first, and again at each poll until the window lets
-  // them through: a ping's answer held back until the next 20 ms period came
-  // after the firmware's 30 ms slot, a missed echo (ULTRASONIC under load).
-  if (first || answered || t_ms_ % HilMcu::kSensorPeriod_ms == 0) hil_sensors_due_ = true;
-  if (hil_sensors_due_ && (t_ms_ % HilMcu::kPollPeriod_ms == 0 || first || answered) &&
-      hil_->sendSensors(t_ms_, GrayscaleModel::read(world_, state_.pose), hil_gas_raw_, tx_))
-    hil_sensors_due_ = false;
   // The encoders: a frame held back is no loss, the next carries newer counts (and the board extrapolates).
   if (t_ms_ % HilMcu::kInputPeriod_ms == 0) hil_->sendEncoders(state_, t_ms_, tx_);
 }

@@ -122,7 +122,6 @@ class Simulation {
   McuEmulator mcu_;
   std::unique_ptr<HilMcu> hil_;
   std::array<uint16_t, serial::kGasChannels> hil_gas_raw_{};  // the gas sensors' last readings, for the HIL inputs
-  bool hil_sensors_due_ = false;  // HIL readings to send, held back so far by the in-flight window
   SimObserver* observer_;
   PlantState state_;
   uint64_t t_ms_ = 0;
