@@ -9,7 +9,9 @@
 #   stack     the real programs together (mcu_sim, robot_client, pc_server) in
 #             real time or a few times faster.
 #   long      not in CI: the long forms of measurements (by hand or -L long).
-#   bench     the smoke runs of the benchmarks (timing figures: run alone).
+#   bench     the smoke runs of the benchmarks (figures printed, not judged):
+#             a stack slot each, like a stack test; SERIAL for the ones
+#             that take a core (QEMU, the CPU-bound measurements).
 #   package   the Debian packages installed into a clean root (root, mirror).
 #   fuzz, sanitize   the second stage of scripts/test.sh (build-asan/).
 # Further labels name an area (faults, link, load, record ...).
@@ -129,7 +131,7 @@ macro(_inspect_test_properties out)
   set(${out} TIMEOUT ${A_TIMEOUT})
   if(A_SERIAL)
     list(APPEND ${out} RUN_SERIAL TRUE)
-  elseif(_kind STREQUAL "stack")
+  elseif(_kind MATCHES "^(stack|bench)$")
     list(APPEND ${out} RESOURCE_GROUPS stack:1)
   endif()
   if(A_LOCK)
@@ -142,7 +144,8 @@ macro(_inspect_test_properties out)
 endmacro()
 
 # inspect_gtests(<program> LABELS <kind> TIMEOUT <s> [SERIAL] [LOCK name] [COST s]
-#                [FILTER <gtest filter>] [SANITIZE] [PROPERTIES <ctest properties...>])
+#                [FILTER <gtest filter>] [SANITIZE [SANITIZE_SKIP <gtest patterns>]]
+#                [PROPERTIES <ctest properties...>])
 # One ctest test per gtest test of <program> (gtest_discover_tests; its
 # PROPERTIES cannot carry a list, hence one label). SANITIZE: the program is
 # also part of the sanitizer stage. The sanitizer build (INSPECT_FUZZ, see
@@ -151,9 +154,12 @@ endmacro()
 # labelled `sanitize`: a process start under ASan costs up to 0.5 s (the video
 # libraries' initialisation), 0.28 s a test on average, and LeakSanitizer then
 # checks the whole run at its exit. The other programs can be built and run
-# there by hand.
+# there by hand. SANITIZE_SKIP: tests of the call left out of the sanitizer
+# stage only (':'-separated gtest patterns): the long numeric sweeps and cost
+# measurements, whose code the stage's other tests run on fewer points; the
+# g++ build runs them all.
 function(inspect_gtests program)
-  cmake_parse_arguments(A "SERIAL;SANITIZE" "TIMEOUT;LOCK;COST;FILTER" "LABELS;PROPERTIES" ${ARGN})
+  cmake_parse_arguments(A "SERIAL;SANITIZE" "TIMEOUT;LOCK;COST;FILTER;SANITIZE_SKIP" "LABELS;PROPERTIES" ${ARGN})
   list(LENGTH A_LABELS n)
   if(NOT n EQUAL 1)
     message(FATAL_ERROR "inspect_gtests(${program}): one label (the kind), got '${A_LABELS}'")
@@ -169,6 +175,14 @@ function(inspect_gtests program)
     set(name ${program})
     if(calls GREATER 1)
       set(name ${program}_${calls})
+    endif()
+    if(A_SANITIZE_SKIP)
+      # gtest's filter is POSITIVE[-NEGATIVE]: one '-', its patterns ':'-separated.
+      if(A_FILTER MATCHES "-")
+        string(APPEND A_FILTER ":${A_SANITIZE_SKIP}")
+      else()
+        string(APPEND A_FILTER "-${A_SANITIZE_SKIP}")
+      endif()
     endif()
     set(filter)
     if(A_FILTER)
