@@ -66,8 +66,9 @@ endmacro()
 
 # Every C++ library and program under <dir> reuses the PCH of its kind: the
 # test programs' (their compile options hold INSPECT_TEST_OPT) or the
-# others'. Not the generated protobuf code, the PCHs' own targets or the
-# fuzz harnesses (tests/fuzz: libFuzzer's options).
+# others'. Not the generated protobuf code, the PCHs' own targets, the
+# fuzz harnesses (tests/fuzz: libFuzzer's options) or a target with the
+# property INSPECT_NO_PCH (other options of its own).
 function(inspect_use_pch dir)
   if(NOT INSPECT_PCH)
     return()
@@ -77,6 +78,10 @@ function(inspect_use_pch dir)
     get_target_property(type ${t} TYPE)
     if(NOT type MATCHES "^(STATIC_LIBRARY|EXECUTABLE|OBJECT_LIBRARY)$" OR t MATCHES "^(inspect_proto|inspect_pch|inspect_test_pch)$"
        OR dir MATCHES "/tests/fuzz$")
+      continue()
+    endif()
+    get_target_property(no_pch ${t} INSPECT_NO_PCH)
+    if(no_pch)
       continue()
     endif()
     get_target_property(opts ${t} COMPILE_OPTIONS)
