@@ -156,10 +156,14 @@ RunSummary RealtimeRunner::run() {
     pollfd pfd{port_.fd(), POLLIN, 0};
     const int r = ppoll(&pfd, 1, &ts, &g_wait_mask);
     if (r > 0 && (pfd.revents & POLLIN)) {
-      catchUp();  // the bytes belong to the current sim time
       for (int i = 0; i < kMaxReadsPerWake; ++i) {
         const std::size_t n = port_.read(rx);
         if (n == 0) break;
+        // The bytes belong to the current sim time, taken after the read: they
+        // had all arrived by then. (Before it, a process not run between the
+        // two stamped a whole backlog of the HIL board's reports with a time
+        // they were sent after, and its clock estimate ran up to 280 ms ahead.)
+        catchUp();
         sim_.receive({rx.data(), n});
       }
     } else if (r > 0) {

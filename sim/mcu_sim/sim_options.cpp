@@ -74,6 +74,8 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     if (o.rate != 1.0) throw cli::UsageError("--rate: the firmware in the loop runs in real time (--hil)");
     if (!o.pty_link.empty()) throw cli::UsageError("--pty-link: with --hil the Pi's line is the board's (scripts/mcu_qemu.sh --serial-link)");
     if (!o.frame_log_path.empty()) throw cli::UsageError("--frame-log: with --hil the firmware sends the frames");
+    if (o.freeze_on_stall)
+      throw cli::UsageError("--freeze-on-stall: with --hil the board's clock runs on through a stall, so the world must too");
   }
   return o;
 }

@@ -83,6 +83,9 @@ TEST(SimOptions, ErrorsNameTheFlag) {
       {{"--world", "w", "--camera", "c", "--camera-size", "32x32"}, "--camera-size: '32x32' is not WxH"},
       {{"--world", "w", "--camera", "c", "--camera-size", "640x480x"}, "--camera-size: '640x480x' is not WxH"},
       {{"--world", "w", "--camera", "c", "--camera-fps", "0"}, "--camera-fps: 0 is out of range [1, 120]"},
+      {{"--world", "w", "--hil", "t", "--rate", "2"}, "--rate: the firmware in the loop runs in real time"},
+      {{"--world", "w", "--hil", "t", "--pty-link", "p"}, "--pty-link: with --hil the Pi's line is the board's"},
+      {{"--world", "w", "--hil", "t", "--freeze-on-stall"}, "--freeze-on-stall: with --hil the board's clock runs on"},
   };
   for (const auto& c : cases) {
     const auto e = errorOf(c.args);

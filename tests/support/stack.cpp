@@ -176,7 +176,9 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
   }
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
   sim_argv.insert(sim_argv.end(), {"--realtime-priority", kHardwarePriority});
-  if (!measure_failsafes_ && !catch_up_) sim_argv.push_back("--freeze-on-stall");
+  // Not with the firmware: its clock runs on through a stall of mcu_sim's, and
+  // a world that waited would be wheels that stopped turning under it.
+  if (!measure_failsafes_ && !catch_up_ && firmware_elf_.empty()) sim_argv.push_back("--freeze-on-stall");
   r->sim = Process::spawn(sim_argv, dir_ / (id + "-sim.out"), dir_ / (id + "-sim.err"));
   waitUntil([&] { return exists(sim_pty); }, firmware_elf_.empty() ? 10.0 : 20.0);
   r->pty = sim_pty;
