@@ -30,7 +30,7 @@ namespace inspect::sim {
 
 class HilMcu {
  public:
-  static constexpr uint64_t kInputPeriod_ms = 4;    // encoders, 250 Hz
+  static constexpr uint64_t kInputPeriod_ms = 10;   // encoders, 100 Hz (the board carries them on between: HilEncoderModel)
   static constexpr uint64_t kPollPeriod_ms = 2;     // the board's outputs (500 Hz) taken and pings answered this often
   static constexpr uint64_t kSensorPeriod_ms = 20;  // the rest, 50 Hz (QEMU takes about 9 KB/s)
   /// Frames sent and not yet taken by the board (HilOutputs::input_seq) at

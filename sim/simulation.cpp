@@ -192,7 +192,7 @@ void Simulation::useHilFirmware(const config::RobotConfig& robot) {
 void Simulation::stepHil() {
   // A ping is answered at once with the range now (the echo returns within the
   // firmware's 30 ms slot); the other readings go first whenever due
-  // (HilMcu::sensorsDue), the encoders every 4 ms.
+  // (HilMcu::sensorsDue), the encoders every 10 ms.
   if (const int s = hil_->pendingPing(); s >= 0)
     hil_->answerPing(ultrasonic_.measureMm(world_, state_.pose, s, people_.crowd.circles()));
   if (hil_->sensorsDue(t_ms_)) {

@@ -17,36 +17,25 @@
 namespace inspect::hil {
 
 enum class HilId : uint8_t {
-  kEncoders = 0x80,  // simulator -> board, every 4 ms
+  kEncoders = 0x80,  // simulator -> board, every 10 ms
   kOutputs = 0x81,   // board -> simulator
   kSensors = 0x82,   // simulator -> board, every 20 ms and at each ping's answer
 };
 
-/// Simulator -> board, every 4 ms (250 Hz): the encoder timers' counters at
+/// Simulator -> board, every 10 ms (100 Hz): the encoder timers' counters at
 /// one instant of the board's clock, and how fast they count. The board reads
-/// its counters at each control tick's due time from them (counterAt), as a
-/// real encoder timer is read: a count that arrived a few ms late over the
-/// link (QEMU takes a pty's bytes one at a time, about 9 KB/s here, and its
-/// vCPU is not always run) is then still the count of the tick's instant, not
-/// of whenever it came. Without this the speed loop's 20 ms estimate saw
-/// counts 2-4 ms old by uneven amounts (docs/firmware.md). Payload 14 bytes.
+/// its counters at each control tick's due time from the latest of them
+/// (HilEncoderModel, shared/hil/encoder_model.hpp), as a real encoder timer is
+/// read: a count that arrived late over the link (QEMU takes a pty's bytes one
+/// at a time, about 9 KB/s here, and its vCPU is not always run) is then still
+/// the count of the tick's instant, not of whenever it came. Without this the
+/// speed loop's 20 ms estimate saw counts 2-4 ms old by uneven amounts
+/// (docs/firmware.md). Payload 14 bytes.
 struct HilEncoders {
   std::array<uint16_t, 2> counter{};        // left, right (wrapping), at board_ms
   std::array<int32_t, 2> rate_counts_s{};   // their rates now, counts per second
   uint16_t board_ms = 0;                    // the board's clock (HilOutputs::mcu_time_ms, low 16 bits)
                                             // at which they were read, as the simulator maps its time to it
-  /// Extrapolation of a stale sample stops this far from board_ms (a link that stopped).
-  /// (200 ms: a starved link delivered samples over 50 ms old, and counts that
-  /// stopped there read as a wheel that stopped.)
-  static constexpr int32_t kMaxExtrapolationMs = 200;
-  /// Wheel i's counter at the board's `now_ms`, extrapolated from the sample at its rate.
-  uint16_t counterAt(std::size_t i, uint32_t now_ms) const {
-    int32_t dt = static_cast<int16_t>(static_cast<uint16_t>(now_ms - board_ms));
-    dt = dt > kMaxExtrapolationMs ? kMaxExtrapolationMs : (dt < -kMaxExtrapolationMs ? -kMaxExtrapolationMs : dt);
-    const int64_t num = static_cast<int64_t>(rate_counts_s[i]) * dt;
-    const int64_t counts = (num >= 0 ? num + 500 : num - 500) / 1000;  // rounded to the nearest count
-    return static_cast<uint16_t>(counter[i] + static_cast<uint16_t>(counts));
-  }
   bool operator==(const HilEncoders&) const = default;
 };
 

@@ -10,6 +10,7 @@
 #include "firmware/core/analog_inputs.hpp"
 #include "firmware/host/settings_from_config.hpp"
 #include "shared/config/robot_config.hpp"
+#include "shared/hil/encoder_model.hpp"
 #include "shared/hil/hil_link.hpp"
 #include "sim/hil_mcu.hpp"
 #include "sim/simulation.hpp"
@@ -84,13 +85,48 @@ TEST(HilLink, EveryMessageRoundTripsAndCorruptionIsCounted) {
 }
 
 TEST(HilLink, TheBoardReadsItsEncodersAtTheTicksInstantFromASampleAndItsRate) {
-  hil::HilEncoders e{{65530, 100}, {13039, -2000}, 65534};  // board_ms wraps too
-  EXPECT_EQ(e.counterAt(0, 65534), 65530);
-  EXPECT_EQ(e.counterAt(0, 65536 + 4), static_cast<uint16_t>(65530 + 78));  // 6 ms later: 78.2 counts
-  EXPECT_EQ(e.counterAt(1, 65536 + 4), 100 - 12);
-  EXPECT_EQ(e.counterAt(0, 65530), 65530 - 52);  // a sample newer than the tick: back to the tick
+  // 16384 counts per turn, 0.154 duty per rad/s: 16931 counts/s per unit of duty; tau 0.2 s.
+  const float per_duty = 16384.0f / (6.28318530718f * 0.154f);
+  hil::HilEncoderModel m(0.154f, 0.2f, 16384);
+  EXPECT_EQ(m.countersAt(1000), (std::array<uint16_t, 2>{0, 0}));  // before any sample: at rest
+  m.take({{65530, 100}, {13039, -2000}, 65534});  // board_ms wraps too
+  // Driven at the duties that hold those rates: the sample's rate carries on.
+  m.drive({13039.0f / per_duty, -2000.0f / per_duty});
+  EXPECT_EQ(m.countersAt(65534), (std::array<uint16_t, 2>{65530, 100}));
+  const auto at6 = m.countersAt(65536 + 4);  // 6 ms later: 78.2 and -12 counts
+  EXPECT_EQ(at6[0], static_cast<uint16_t>(65530 + 78));
+  EXPECT_EQ(at6[1], 100 - 12);
+  // A sample newer than the tick (a late tick catching up): back along the rate.
+  m.take({{65530, 100}, {13039, -2000}, 65534});
+  EXPECT_EQ(m.countersAt(65530)[0], 65530 - 52);
   // A link that stopped: no further than kMaxExtrapolationMs.
-  EXPECT_EQ(e.counterAt(1, 65534 + 1000), static_cast<uint16_t>(100 - 2 * hil::HilEncoders::kMaxExtrapolationMs));
+  m.take({{65530, 100}, {13039, -2000}, 65534});
+  EXPECT_EQ(m.countersAt(65534 + 1000)[1], static_cast<uint16_t>(100 - 2 * hil::HilEncoderModel::kMaxExtrapolationMs));
+}
+
+TEST(HilLink, BetweenSamplesTheCountsFollowTheDutyTheBoardDrivesAsTheSimulatedMotorDoes) {
+  // A step from rest and then no sample for 60 ms (a stalled pty): the counts
+  // are the motor's first order toward the new duty, within a count, not a
+  // wheel frozen at the sample's zero rate.
+  const float per_duty = 16384.0f / (6.28318530718f * 0.154f);
+  hil::HilEncoderModel m(0.154f, 0.2f, 16384);
+  m.take({{1000, 1000}, {0, 0}, 500});
+  const float duty = 2.0f * 0.154f;  // 2 rad/s
+  m.drive({duty, -duty});
+  std::array<uint16_t, 2> c{};
+  for (uint32_t t = 501; t <= 560; ++t) c = m.countersAt(t);  // one read per 1 ms tick
+  const double target = duty * per_duty, t_s = 0.060, tau = 0.2;
+  const double expect = target * t_s - target * tau * (1.0 - std::exp(-t_s / tau));  // 35.3 counts
+  EXPECT_NEAR(static_cast<int16_t>(c[0] - 1000), expect, 1.0);
+  EXPECT_NEAR(static_cast<int16_t>(c[1] - 1000), -expect, 1.0);
+  // The next sample wins over the model.
+  m.take({{1100, 900}, {3000, -3000}, 561});
+  EXPECT_EQ(m.countersAt(561), (std::array<uint16_t, 2>{1100, 900}));
+  // Braked: the motor runs down toward 0.
+  m.drive({0.0f, 0.0f});
+  const auto later = m.countersAt(571);
+  EXPECT_LT(static_cast<int16_t>(later[0] - 1100), 30);  // 3000 counts/s for 10 ms would be 30
+  EXPECT_GT(static_cast<int16_t>(later[0] - 1100), 25);
 }
 
 TEST(HilMcu, EncoderSamplesAreStampedWithTheBoardsClockFromItsLeastDelayedReport) {
@@ -227,7 +263,7 @@ TEST(HilMcu, NothingBeforeTheBoardSpeaksAndAtMostTwoFramesInFlight) {
   EXPECT_EQ(decodeAll<hil::HilEncoders>(tx).size(), 1u);
 }
 
-TEST(HilMcu, TheSimulationInTheLoopSendsEncodersEvery4msSensorsEvery20msAndFollowsTheDuty) {
+TEST(HilMcu, TheSimulationInTheLoopSendsEncodersEvery10msSensorsEvery20msAndFollowsTheDuty) {
   const auto r = robot();
   Simulation sim(r, loadWorldFile(test::srcPath("config/worlds/empty.yaml")), 1);
   sim.useHilFirmware(r);
@@ -249,7 +285,7 @@ TEST(HilMcu, TheSimulationInTheLoopSendsEncodersEvery4msSensorsEvery20msAndFollo
     });
   }
   EXPECT_EQ(board.errors(), 0u);
-  EXPECT_EQ(encoders, 250u);
+  EXPECT_EQ(encoders, 1000u / HilMcu::kInputPeriod_ms);
   EXPECT_EQ(sensors, 50u);
   // 0.3 duty: toward 0.3 / speed_ff = 1.95 rad/s; after 1 s (5 time constants) nearly there.
   const double want = 0.3 / firmware::settingsFrom(r).speed_ff;

@@ -170,9 +170,12 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
                                        srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
   if (!firmware_elf_.empty()) {
     // The firmware in QEMU on the line, mcu_sim --hil behind it (the options after --world are mcu_sim's).
+    // QEMU is the MCU: at the hardware's priority as mcu_sim is, above robot_client's loop. (It ran at
+    // normal priority until the circle through the firmware was measured: 160-530 control ticks
+    // over 5 ms late in a run, and the Pi's wheel loop oscillating on them.)
     sim_argv = {"/bin/bash", srcPath("scripts/mcu_qemu.sh"), "--serial-link", sim_pty, "--elf", firmware_elf_,
-                "--mcu-sim", binPath("mcu_sim"), "--world", world_path, "--robot", srcPath("config/robot.yaml"),
-                "--truth", r->truth};
+                "--realtime-priority", kHardwarePriority, "--mcu-sim", binPath("mcu_sim"), "--world", world_path,
+                "--robot", srcPath("config/robot.yaml"), "--truth", r->truth};
   }
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
   sim_argv.insert(sim_argv.end(), {"--realtime-priority", kHardwarePriority});

@@ -13,6 +13,7 @@
 #include "firmware/boards/stm32f4/uart.hpp"
 #include "firmware/core/analog_inputs.hpp"
 #include "firmware/mcu/firmware_instance.hpp"
+#include "shared/hil/encoder_model.hpp"
 #include "shared/hil/hil_link.hpp"
 
 namespace fw = inspect::firmware;
@@ -34,7 +35,7 @@ f4::Uart g_hil(f4::usart::kUsart2);
 
 class HilPeripherals final : public f4::Peripherals {
  public:
-  explicit HilPeripherals(const fw::McuSettings& s) {
+  explicit HilPeripherals(const fw::McuSettings& s) : encoders_(s.speed_ff, s.response_tau_s, s.encoder_counts_per_rev) {
     // The world held still until the simulator speaks.
     for (std::size_t i = 0; i < inspect::serial::kGasChannels; ++i)
       sensors_.gas_adc[i] = fw::gasAdcCounts(s, s.gas[i], s.gas[i].range_min);
@@ -48,7 +49,7 @@ class HilPeripherals final : public f4::Peripherals {
       decoder_.feed({buf.data(), n}, [this](const hil::HilMessage& m, uint8_t seq) {
         out_.input_seq = seq;
         if (const auto* e = std::get_if<hil::HilEncoders>(&m)) {
-          encoders_ = *e;
+          encoders_.take(*e);
         } else if (const auto* in = std::get_if<hil::HilSensors>(&m)) {
           sensors_ = *in;
           heard_ = true;
@@ -60,8 +61,9 @@ class HilPeripherals final : public f4::Peripherals {
   fw::PeripheralInputs read(uint32_t now_ms) override {
     fw::PeripheralInputs in;
     // The encoder timers as read at this tick's due time (shared/hil: from the
-    // latest sample and its rate), however late its bytes came over the link.
-    in.encoder = {encoders_.counterAt(0, now_ms), encoders_.counterAt(1, now_ms)};
+    // latest sample, carried on by the motor model), however late its bytes came.
+    const std::array<uint16_t, 2> counters = encoders_.countersAt(now_ms);
+    in.encoder = {counters[0], counters[1]};
     // The echo of this slot's ping, if the simulator has answered that ping.
     if (!heard_ || sensors_.echo_count == out_.trigger_count) {
       in.echo.rose = (sensors_.echo_flags & hil::HilSensors::kEchoRose) != 0;
@@ -83,6 +85,7 @@ class HilPeripherals final : public f4::Peripherals {
       out_.servo_us[i] = o.servo_us[i];
     }
     out_.flags = o.brake ? hil::HilOutputs::kBrake : 0;
+    encoders_.drive({o.brake ? 0.0f : o.duty[0], o.brake ? 0.0f : o.duty[1]});
     const std::array<float, 2> sp = fw::firmwareCore().setpoints();  // in force, before the slew
     const std::array<float, 2> ptz = fw::firmwareCore().ptz().targetRad();
     for (std::size_t i = 0; i < 2; ++i) {
@@ -103,7 +106,7 @@ class HilPeripherals final : public f4::Peripherals {
 
  private:
   hil::HilDecoder decoder_;
-  hil::HilEncoders encoders_;
+  hil::HilEncoderModel encoders_;
   hil::HilSensors sensors_;
   bool heard_ = false;
   hil::HilOutputs out_;
