@@ -23,8 +23,7 @@ void HilMcu::receive(std::span<const uint8_t> bytes, uint64_t now_ms) {
     if (observer_ && out->ptz_target_0p1mrad != last_.ptz_target_0p1mrad) {
       // A new camera-mount target: the PtzCommand the firmware took, logged as the emulator logs it.
       observer_->onEvent(static_cast<double>(now_ms) / 1000.0, "ptz",
-                         "pan_0p1mrad=" + std::to_string(out->ptz_target_0p1mrad[0]) +
-                             " tilt_0p1mrad=" + std::to_string(out->ptz_target_0p1mrad[1]));
+                         ptzEventDetail(out->ptz_target_0p1mrad[0], out->ptz_target_0p1mrad[1]));
     }
     if (!heard_) {
       readings_due_ = true;  // until now the board held the world still, gas at its transmitters' 4 mA

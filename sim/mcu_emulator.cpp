@@ -48,9 +48,7 @@ void McuEmulator::apply(const serial::Message& msg, uint8_t seq, uint64_t now_ms
         } else if constexpr (std::is_same_v<T, serial::PtzCommand>) {
           ptz_ = m;
           if (m.flags & 0x01) ptz_.pan_0p1mrad = ptz_.tilt_0p1mrad = 0;
-          event(now_ms, "ptz",
-                "pan_0p1mrad=" + std::to_string(ptz_.pan_0p1mrad) + " tilt_0p1mrad=" + std::to_string(ptz_.tilt_0p1mrad) +
-                    " flags=" + std::to_string(m.flags));
+          event(now_ms, "ptz", ptzEventDetail(ptz_.pan_0p1mrad, ptz_.tilt_0p1mrad, m.flags));
         }
         // A SensorFrame from the host is meaningless to the MCU: ignored.
       },

@@ -1,7 +1,9 @@
 #pragma once
 // What the simulation reports for the ground-truth log (and for tests).
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "shared/control/diff_drive.hpp"
@@ -37,6 +39,15 @@ struct GasSample {
   std::span<const double> true_value;  // background + gas + cross-sensitivities, before the sensor's response
   std::span<const double> reading;     // what the frame carries: raw x scale; NaN = no data (dropout)
 };
+
+/// The detail of a `ptz` event (docs/simulator.md): the camera mount's new
+/// target, and the PtzCommand's flags where they are known (the emulator; the
+/// firmware in the loop reports only the target it took).
+inline std::string ptzEventDetail(int32_t pan_0p1mrad, int32_t tilt_0p1mrad, std::optional<int> flags = std::nullopt) {
+  std::string d = "pan_0p1mrad=" + std::to_string(pan_0p1mrad) + " tilt_0p1mrad=" + std::to_string(tilt_0p1mrad);
+  if (flags) d += " flags=" + std::to_string(*flags);
+  return d;
+}
 
 /// Receives the simulation's ground truth, commands and events. Default: ignore.
 class SimObserver {
