@@ -94,7 +94,7 @@ check_folder_only(firmware/core "^(firmware/core|shared/serial)/" "the firmware'
 check_folder_only(firmware/boards "^(firmware/(boards|core|mcu)|shared/(serial|hil))/" "a board includes the core, the boards' own parts and the serial and HIL links only (it is built for the STM32)")
 check_folder_only(firmware/mcu "^(firmware/(core|mcu)/|mcu_settings_gen[.]hpp$)" "the MCU build's instance includes the core and its generated settings only")
 check_folder_only(shared/serial "^shared/serial/" "the serial codec includes only itself (it is built for the STM32)")
-check_folder_only(shared/hil "^shared/(hil|serial)/" "the HIL link includes only itself and the serial codec (it is built for the STM32)")
+check_folder_only(shared/hil "^(shared/(hil|serial)/|shared/control/first_order[.]hpp$)" "the HIL link includes only itself, the serial codec and the first-order step (it is built for the STM32)")
 check_folder(firmware/host "${programs}" "the firmware's host tools include no program")
 check_folder(firmware/tools "${programs}" "the firmware's host tools include no program")
 check_folder(experiments "^robot_client/|^tests/(.*/)?[a-z_]+\\.hpp$" "an experiment includes no program's code (of tests/ only tests/support/paths.hpp, udp_relay.hpp, postgres_server.hpp)")

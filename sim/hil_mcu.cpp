@@ -90,7 +90,7 @@ void HilMcu::trackBoardClock(uint32_t mcu_time_ms, uint64_t now_ms) {
   window_any_ = true;
 }
 
-bool HilMcu::sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx) {
+void HilMcu::sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx) {
   const double counts_per_rad = settings_.encoder_counts_per_rev / (2.0 * std::numbers::pi);
   const double counts_per_m = counts_per_rad / wheel_radius_m_;
   auto counter = [&](double travel_m) {
@@ -101,12 +101,10 @@ bool HilMcu::sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<
   e.counter = {counter(truth.wheel_travel_left_m), counter(truth.wheel_travel_right_m)};
   e.rate_counts_s = {rate(truth.wheel.left_rad_s), rate(truth.wheel.right_rad_s)};
   e.board_ms = static_cast<uint16_t>(static_cast<int64_t>(now_ms) + clock_offset_ms_);
-  if (append(e, tx)) return true;
-  ++held_back_;  // no loss: the next carries newer counts
-  return false;
+  if (!append(e, tx)) ++held_back_;  // no loss: the next carries newer counts
 }
 
-bool HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
+void HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
                          std::vector<uint8_t>& tx) {
   hil::HilSensors in = echo_;
   for (std::size_t i = 0; i < serial::kGasChannels; ++i) {
@@ -124,11 +122,10 @@ bool HilMcu::sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<ui
   in.switches = 0;
   if (append(in, tx)) {
     readings_due_ = readings_held_ = false;
-    return true;
+    return;
   }
   if (!readings_held_) ++held_back_;
   readings_due_ = readings_held_ = true;
-  return false;
 }
 
 bool HilMcu::append(const hil::HilMessage& m, std::vector<uint8_t>& tx) {

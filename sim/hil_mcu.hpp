@@ -62,8 +62,8 @@ class HilMcu {
   /// Answers it with the range the world gives (serial::kNoEcho: nothing in range).
   void answerPing(uint16_t range_mm);
   /// The encoder counters and rates of `truth` at now_ms, stamped with the board's clock, as a frame
-  /// appended to tx; false when held back (kMaxInFlight).
-  bool sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx);
+  /// appended to tx, unless kMaxInFlight hold it back (no loss: the next carries newer counts).
+  void sendEncoders(const PlantState& truth, uint64_t now_ms, std::vector<uint8_t>& tx);
   /// The board's clock minus ours (ms): from the least delayed HilOutputs so
   /// far, lowered only when a whole kClockWindow_ms of reports says it is more
   /// than kClockSlack_ms too high; 0 before the board speaks. Steady: each
@@ -79,8 +79,8 @@ class HilMcu {
   /// 30 ms slot: a missed echo, ULTRASONIC under load).
   bool sensorsDue(uint64_t now_ms) const { return readings_due_ || now_ms % kSensorPeriod_ms == 0; }
   /// What the other peripherals read at now_ms, as a frame appended to tx.
-  /// False when held back (kMaxInFlight): still due, they go at a later step.
-  bool sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
+  /// Held back by kMaxInFlight, they stay due (sensorsDue) and go at a later step.
+  void sendSensors(uint64_t now_ms, uint8_t grayscale, const std::array<uint16_t, serial::kGasChannels>& gas_raw,
                    std::vector<uint8_t>& tx);
 
   bool heard() const { return heard_; }

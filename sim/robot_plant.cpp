@@ -3,22 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "shared/control/first_order.hpp"
+
 namespace inspect::sim {
-namespace {
-
-struct MotorStep {
-  double speed_rad_s;  // speed at the end of the step
-  double angle_rad;    // angle turned during the step
-};
-
-// Exact solution of tau * w' = sp - w over dt: speed and its integral, so the
-// wheel travel is exact whatever the step size.
-MotorStep motorStep(double w0, double sp, double tau_s, double dt_s) {
-  const double decay = std::exp(-dt_s / tau_s);
-  return {sp + (w0 - sp) * decay, sp * dt_s + (w0 - sp) * tau_s * (1.0 - decay)};
-}
-
-}  // namespace
 
 control::PlantModel nominalPlant(const config::RobotConfig& robot) {
   control::WheelMotorModel m;
@@ -56,16 +43,17 @@ control::WheelSpeeds RobotPlant::clampSetpoint(const control::WheelSpeeds& sp) c
 
 PlantStep RobotPlant::step(const PlantState& s, const control::WheelSpeeds& setpoint, double dt_s) const {
   const auto sp = clampSetpoint(setpoint);
-  const MotorStep l =
-      motorStep(s.wheel.left_rad_s, motors_.left.gain * sp.left_rad_s, motors_.left.time_constant_s, dt_s);
-  const MotorStep r =
-      motorStep(s.wheel.right_rad_s, motors_.right.gain * sp.right_rad_s, motors_.right.time_constant_s, dt_s);
-  const double d_left_m = l.angle_rad * wheel_radius_m_;
-  const double d_right_m = r.angle_rad * wheel_radius_m_;
+  // Each motor's speed and the angle it turned over the step, exactly.
+  const auto l =
+      control::firstOrderStep(s.wheel.left_rad_s, motors_.left.gain * sp.left_rad_s, motors_.left.time_constant_s, dt_s);
+  const auto r = control::firstOrderStep(s.wheel.right_rad_s, motors_.right.gain * sp.right_rad_s,
+                                         motors_.right.time_constant_s, dt_s);
+  const double d_left_m = l.integral * wheel_radius_m_;
+  const double d_right_m = r.integral * wheel_radius_m_;
 
   PlantStep out;
   out.state = s;
-  out.state.wheel = {l.speed_rad_s, r.speed_rad_s};
+  out.state.wheel = {l.value, r.value};
   out.state.wheel_travel_left_m += d_left_m;
   out.state.wheel_travel_right_m += d_right_m;
 

@@ -16,9 +16,9 @@
 #pragma once
 
 #include <array>
-#include <cmath>
 #include <cstdint>
 
+#include "shared/control/first_order.hpp"
 #include "shared/hil/hil_link.hpp"
 
 namespace inspect::hil {
@@ -67,11 +67,10 @@ class HilEncoderModel {
       if (dt_ms < 0.0f || tau_ms_ <= 0.0f) {
         w.counts += w.rate * dt_ms / 1000.0f;
       } else if (dt_ms > 0.0f) {
-        // tau w' = target - w over dt: the exact step, as the simulator's motor (sim/robot_plant).
-        const float target = duty_[i] * counts_s_per_duty_;
-        const float decay = std::exp(-dt_ms / tau_ms_);
-        w.counts += (target * dt_ms + (w.rate - target) * tau_ms_ * (1.0f - decay)) / 1000.0f;
-        w.rate = target + (w.rate - target) * decay;
+        // The exact step of the simulator's motor (sim/robot_plant), in ms.
+        const auto s = control::firstOrderStep(w.rate, duty_[i] * counts_s_per_duty_, tau_ms_, dt_ms);
+        w.counts += s.integral / 1000.0f;
+        w.rate = s.value;
       }
       const float r = w.counts + (w.counts < 0.0f ? -0.5f : 0.5f);
       c[i] = static_cast<uint16_t>(c[i] + static_cast<uint16_t>(static_cast<int32_t>(r)));
