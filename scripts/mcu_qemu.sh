@@ -17,8 +17,9 @@
 #   built by scripts/build_firmware.sh when missing).
 # --mcu-sim PROGRAM: default <tree>/build/bin/mcu_sim.
 # --realtime-priority N: QEMU (the MCU, a chip of its own) runs SCHED_FIFO at N
-#   in [1, 99] when this user may (root, CAP_SYS_NICE; else a warning), as
-#   mcu_sim --realtime-priority does; 0 = normal (default).
+#   in [1, 99] when this user may (root, CAP_SYS_NICE; else a warning), and so
+#   does the attached mcu_sim (its peripherals: an option after --world
+#   overrides); 0 = normal (default).
 # --cpu N: QEMU on CPU N alone, mcu_sim on the others (taskset): the chip's
 #   clock is then not held up by the world's steps (docs/firmware.md).
 # Runs until SIGINT/SIGTERM (or mcu_sim's --duration); QEMU's own messages go
@@ -132,7 +133,11 @@ if [ -n "$world" ]; then
   # so that robot_client never reads the held-still world's frames (gas at 4
   # mA: an oxygen channel would read 0 %vol and raise its alarm).
   sim_out=$(mktemp)
-  setpriv --pdeathsig TERM "${pin_sim[@]}" "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_args[@]}" > >(tee "$sim_out") &
+  # At the MCU's priority too, unless the options after --world say otherwise (the last one counts).
+  sim_prio=()
+  [ "$priority" -gt 0 ] && sim_prio=(--realtime-priority "$priority")
+  setpriv --pdeathsig TERM "${pin_sim[@]}" "$mcu_sim" --hil "$hil_link" --world "$world" "${sim_prio[@]}" "${sim_args[@]}" \
+    > >(tee "$sim_out") &
   sim=$!
   # "hil board answered": the board took mcu_sim's first readings (QEMU reads
   # the HIL pty only once its 1 s poll saw mcu_sim open it: until then the

@@ -107,9 +107,9 @@ if [ "$FIRMWARE" = 1 ]; then
     bash scripts/build_firmware.sh --settings-gen "$BIN/mcu_settings_gen" | sed 's/^/demo: /'
     ELF=build-firmware/inspect-mcu-qemu.elf
   fi
-  # QEMU (the MCU) and mcu_sim both at the hardware's priority, above robot_client's loop.
+  # QEMU (the MCU) and its mcu_sim at the hardware's priority, above robot_client's loop.
   bash scripts/mcu_qemu.sh --serial-link "$OUT/mcu" --elf "$ELF" --mcu-sim "$BIN/mcu_sim" --realtime-priority 20 \
-    --world "$WORLD" --realtime-priority 20 --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
+    --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \
     --truth "$OUT/truth.csv" >"$OUT/mcu_sim.out" 2>"$OUT/mcu_sim.err" &
 else
   "$BIN/mcu_sim" --realtime-priority 20 --world "$WORLD" --robot config/robot.yaml "${SIM_ARGS[@]}" --camera "$CAM" \

@@ -170,15 +170,15 @@ RobotProcs& Stack::startRobot(const std::string& id, const std::string& world,
                                        srcPath("config/robot.yaml"), "--pty-link", sim_pty, "--truth", r->truth};
   if (!firmware_elf_.empty()) {
     // The firmware in QEMU on the line, mcu_sim --hil behind it (the options after --world are mcu_sim's).
-    // QEMU is the MCU: at the hardware's priority as mcu_sim is, above robot_client's loop. (It ran at
-    // normal priority until the circle through the firmware was measured: 160-530 control ticks
-    // over 5 ms late in a run, and the Pi's wheel loop oscillating on them.)
+    // QEMU is the MCU: it and its mcu_sim at the hardware's priority, above robot_client's loop. (QEMU
+    // ran at normal priority until the circle through the firmware was measured: 160-530 control
+    // ticks over 5 ms late in a run, and the Pi's wheel loop oscillating on them.)
     sim_argv = {"/bin/bash", srcPath("scripts/mcu_qemu.sh"), "--serial-link", sim_pty, "--elf", firmware_elf_,
                 "--realtime-priority", kHardwarePriority, "--mcu-sim", binPath("mcu_sim"), "--world", world_path,
                 "--robot", srcPath("config/robot.yaml"), "--truth", r->truth};
   }
   sim_argv.insert(sim_argv.end(), sim_args.begin(), sim_args.end());
-  sim_argv.insert(sim_argv.end(), {"--realtime-priority", kHardwarePriority});
+  if (firmware_elf_.empty()) sim_argv.insert(sim_argv.end(), {"--realtime-priority", kHardwarePriority});
   // Not with the firmware: its clock runs on through a stall of mcu_sim's, and
   // a world that waited would be wheels that stopped turning under it.
   if (!measure_failsafes_ && !catch_up_ && firmware_elf_.empty()) sim_argv.push_back("--freeze-on-stall");
