@@ -12,14 +12,20 @@
 # the test programs' own code). A target whose options differ (the generated
 # protobuf code's -w, the fuzz harnesses) is not given one.
 #
-# With ccache, scripts/build.sh sets the sloppiness ccache needs to cache a
-# unit that uses a PCH (pch_defines, time_macros, include_file_*time).
+# With ccache, cmake/ccache_launcher.sh sets the sloppiness ccache needs to
+# cache a unit that uses a PCH and gives each PCH a checksum ccache hashes
+# instead of it, so that another clone's units hit.
 option(INSPECT_PCH "Precompiled headers for the libraries, programs and tests (faster builds)" ON)
 # clang writes the time it was made into a PCH and refuses it when its headers
 # are newer; ccache cannot cache a unit that uses such a PCH (ccache's manual,
 # "Precompiled headers"): without this, a warm sanitizer build hit 18 of 94.
 if(INSPECT_PCH AND CMAKE_CXX_COMPILER_ID MATCHES "Clang")
   add_compile_options("SHELL:-Xclang -fno-pch-timestamp")
+  # CMake's clang form names the header as `-Xclang -include -Xclang <path>`,
+  # which ccache does not make relative to the tree, so a unit's hash held the
+  # clone's folder. The driver's own `-include <header>` finds <header>.pch
+  # beside it and uses it (as g++ does with .gch), and ccache reads that form.
+  set(CMAKE_CXX_COMPILE_OPTIONS_USE_PCH -include <PCH_HEADER>)
 endif()
 
 set(INSPECT_PCH_HEADERS

@@ -41,21 +41,22 @@ else
 fi
 
 if command -v ccache >/dev/null; then
-  cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
-  # Relative paths under the tree and no working directory in the hash: the
-  # same source in another clone is a hit (the debug info then names the
-  # first clone's folder, which only a debugger would notice).
-  export CCACHE_BASEDIR=$ROOT CCACHE_NOHASHDIR=1
-  # What ccache needs to cache a unit compiled with a precompiled header
-  # (cmake/InspectPch.cmake): the PCH is hashed, not its macros' text or times.
-  export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
+  # Every compile through ccache with the project's settings (relative paths,
+  # the precompiled headers' checksums): cmake/ccache_launcher.sh says which.
+  cmake_args+=("-DCMAKE_CXX_COMPILER_LAUNCHER=$ROOT/cmake/ccache_launcher.sh"
+               "-DCMAKE_C_COMPILER_LAUNCHER=$ROOT/cmake/ccache_launcher.sh")
   # This build's own counters (the cache's totals are shared by every build).
   mkdir -p "$DIR"
   export CCACHE_STATSLOG=$ROOT/$DIR/ccache-stats.log
   rm -f "$CCACHE_STATSLOG"
 fi
 
-if [ ! -f "$DIR/build.ninja" ]; then
+# Configured once; again when the compiler launcher differs from the one
+# above (a folder configured before cmake/ccache_launcher.sh, or ccache
+# installed since).
+launcher=$(sed -n 's/^CMAKE_CXX_COMPILER_LAUNCHER:[A-Z]*=//p' "$DIR/CMakeCache.txt" 2>/dev/null || true)
+wanted=$(command -v ccache >/dev/null && echo "$ROOT/cmake/ccache_launcher.sh" || true)
+if [ ! -f "$DIR/build.ninja" ] || [ "$launcher" != "$wanted" ]; then
   cmake -S . -B "$DIR" "${cmake_args[@]}"
 fi
 cmake --build "$DIR" -j "${JOBS:-$(nproc)}" "${targets[@]}"

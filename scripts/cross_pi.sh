@@ -63,11 +63,9 @@ t_sysroot=$(date +%s); step "arm64 sysroot ($(du -sh "$SYSROOT" | cut -f1))" "$t
 cmake_args=(-G Ninja -DCMAKE_TOOLCHAIN_FILE="$ROOT/cmake/toolchain-aarch64.cmake" -DINSPECT_SYSROOT="$SYSROOT"
             -DINSPECT_ROBOT_ONLY=ON -DCMAKE_BUILD_TYPE=${BUILD_TYPE:-RelWithDebInfo} -DCMAKE_CXX_FLAGS=-Werror)
 if command -v ccache >/dev/null; then
-  cmake_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
-  export CCACHE_BASEDIR=$ROOT CCACHE_NOHASHDIR=1
-  # What ccache needs to cache a unit compiled with a precompiled header
-  # (cmake/InspectPch.cmake): the PCH is hashed, not its macros' text or times.
-  export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
+  # ccache with the project's settings (cmake/ccache_launcher.sh).
+  cmake_args+=("-DCMAKE_CXX_COMPILER_LAUNCHER=$ROOT/cmake/ccache_launcher.sh"
+               "-DCMAKE_C_COMPILER_LAUNCHER=$ROOT/cmake/ccache_launcher.sh")
 fi
 if [ ! -f "$DIR/build.ninja" ]; then cmake -S . -B "$DIR" "${cmake_args[@]}"; fi
 cmake --build "$DIR" -j "${JOBS:-$(nproc)}"
