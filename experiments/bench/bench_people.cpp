@@ -54,7 +54,7 @@ constexpr double kDeg = 180.0 / kPi;
 constexpr const char* kUsage =
     "usage: bench_people [--frames N] [--sizes WxH,...] [--detectors NAME,...] [--seed S] [--noise SIGMA]\n"
     "                    [--exposure-ms MS] [--tilt-deg D] [--video FILE] [--video-frames N] [--threads N]\n"
-    "                    [--png DIR] [--quick] [--json FILE]\n"
+    "                    [--head ptz|wide] [--hfov-deg D] [--z-m M] [--png DIR] [--quick] [--json FILE]\n"
     "Runs the people detector on seeded simulator scenes with truth boxes and reports recall,\n"
     "precision, false boxes per picture, bearing and range error, ms per picture, and recall by\n"
     "distance, bearing, share visible and view. Detectors: hog (OpenCV's default 64x128 people\n"
@@ -65,7 +65,9 @@ constexpr const char* kUsage =
     "neither missed nor found (a box on them is not false). Defaults: 300 pictures per case\n"
     "(--quick: 24, 320x240 only, hog and haar-full), sizes 320x240,640x480, every detector,\n"
     "seed 1, noise 3 grey levels, exposure 8 ms, camera tilt 0 (up positive), --video: opencv-doc's vtest.avi when installed,\n"
-    "120 frames of it; OpenCV on 1 thread (--threads). --png DIR writes annotated pictures (truth green, boxes red).\n";
+    "120 frames of it; OpenCV on 1 thread (--threads). --png DIR writes annotated pictures (truth green, boxes red).\n"
+    "--head wide: the second head of config/robot.yaml (wide_camera) with people at 0.6-6 m and recall in\n"
+    "bins from 0.6 m and to 62 degrees; --hfov-deg and --z-m change the head's field of view and lens height.\n";
 
 struct DetectorSpec {
   std::string name;
@@ -102,8 +104,10 @@ struct Frame {
   sim::CameraScene scene;
 };
 
-// A seeded scene: the robot in free space, 0-4 people in front of it.
-Frame makeScene(const std::vector<sim::World>& worlds, const config::CameraMount& mount, std::mt19937_64& rng, int k) {
+// A seeded scene: the robot in free space, 0-4 people in front of it (the
+// wide head: nearer, 0.6-6 m).
+Frame makeScene(const std::vector<sim::World>& worlds, const config::CameraMount& mount, bool wide, std::mt19937_64& rng,
+                int k) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const sim::World& w = worlds[static_cast<std::size_t>(k) % worlds.size()];
   Frame f{&w, {}};
@@ -136,7 +140,7 @@ Frame makeScene(const std::vector<sim::World>& worlds, const config::CameraMount
   const double half_fov = mount.hfov_deg / 2 / kDeg;
   for (int i = 0; i < n; ++i) {
     for (int tries = 0; tries < 40; ++tries) {
-      const double d = 1.0 + 9.0 * u(rng);
+      const double d = wide ? 0.6 + 5.4 * u(rng) : 1.0 + 9.0 * u(rng);
       const double bearing = (2 * u(rng) - 1) * (half_fov + 0.05);
       const double yaw = f.scene.robot.theta_rad + bearing;
       const Vec2 p = lens + d * geometry::unitAt(yaw);
@@ -203,6 +207,14 @@ Options parseOptions(int argc, char** argv) {
       o.exposure_ms = a.number(0, 100);
     } else if (a.is("--tilt-deg")) {
       o.tilt_deg = a.number(-30, 30);
+    } else if (a.is("--head")) {
+      const std::string h = a.text();
+      if (h != "ptz" && h != "wide") a.fail("must be ptz or wide");
+      o.wide = h == "wide";
+    } else if (a.is("--hfov-deg")) {
+      o.hfov_deg = a.number(10, 150);
+    } else if (a.is("--z-m")) {
+      o.z_m = a.number(0.05, 5);
     } else if (a.is("--video")) {
       o.video_path = a.text();
       video_given = true;
@@ -333,7 +345,7 @@ void scoreFrame(Case& c, const std::vector<perception::PersonBox>& found, const 
 /// against the camera model's truth. Annotated pictures of the first
 /// detector go to --png.
 std::vector<Case> runSynthetic(const Options& o, const std::vector<DetectorSpec>& specs,
-                               const std::vector<sim::World>& worlds, const config::RobotConfig& robot,
+                               const std::vector<sim::World>& worlds, const config::CameraMount& mount,
                                const std::vector<Frame>& scenes, std::vector<std::string>& pngs) {
   sim::CameraViewStyle style;
   style.look_seed = static_cast<uint32_t>(o.seed);
@@ -343,7 +355,7 @@ std::vector<Case> runSynthetic(const Options& o, const std::vector<DetectorSpec>
   for (const auto& sz : o.sizes) {
     // One view per world at this size.
     std::vector<sim::CameraView> views;
-    for (const auto& w : worlds) views.emplace_back(w, robot.camera, sz.width, sz.height, style);
+    for (const auto& w : worlds) views.emplace_back(w, mount, sz.width, sz.height, style);
     for (const auto& spec : specs) {
       if (sz.width > spec.max_width) continue;
       std::optional<perception::PeopleDetector> det;
@@ -359,6 +371,7 @@ std::vector<Case> runSynthetic(const Options& o, const std::vector<DetectorSpec>
       c.settings = perception::describe(spec.opt);
       c.width = sz.width;
       c.height = sz.height;
+      if (o.wide) c.useWideBins();
       for (auto* b : c.all()) b->init();
       cv::Mat pic;
       double cpu = 0;
@@ -376,13 +389,13 @@ std::vector<Case> runSynthetic(const Options& o, const std::vector<DetectorSpec>
         perception::CameraPose cam;
         cam.width = sz.width;
         cam.height = sz.height;
-        cam.mount = robot.camera;
+        cam.mount = mount;
         cam.tilt_rad = fr.scene.tilt_rad;
         scoreFrame(c, found, truth, fr, cam);
         if (!o.png_dir.empty() && (k % std::max(1, o.frames / 4)) == 0 && &spec == &specs.front()) {
           cv::Mat shown = pic.clone();
           drawBoxes(shown, &truth, found);
-          const std::string file = o.png_dir + "/people_" + std::to_string(sz.width) + "x" +
+          const std::string file = o.png_dir + "/people_" + (o.wide ? "wide_" : "") + std::to_string(sz.width) + "x" +
                                    std::to_string(sz.height) + "_" + spec.name + "_" + std::to_string(k) + ".png";
           if (cv::imwrite(file, shown)) pngs.push_back(file);
         }
@@ -470,19 +483,26 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_people: %s\n", e.what());
     return 2;
   }
+  if (o.wide && !robot.wide_camera) {
+    std::fprintf(stderr, "bench_people: --head wide: config/robot.yaml has no wide_camera section\n");
+    return 2;
+  }
+  config::CameraMount mount = o.wide ? *robot.wide_camera : robot.camera;
+  if (o.hfov_deg > 0) mount.hfov_deg = o.hfov_deg;
+  if (o.z_m > 0) mount.z_m = o.z_m;
   std::mt19937_64 rng(o.seed);
   std::vector<Frame> scenes;
   for (int k = 0; k < o.frames; ++k) {
-    scenes.push_back(makeScene(worlds, robot.camera, rng, k));
+    scenes.push_back(makeScene(worlds, mount, o.wide, rng, k));
     scenes.back().scene.tilt_rad = o.tilt_deg / kDeg;
   }
   if (!o.png_dir.empty()) std::filesystem::create_directories(o.png_dir);
 
   std::vector<std::string> pngs;
-  std::vector<Case> cases = runSynthetic(o, *specs, worlds, robot, scenes, pngs);
+  std::vector<Case> cases = runSynthetic(o, *specs, worlds, mount, scenes, pngs);
   const auto vcases = runFootage(o, *specs, pngs);
   if (!vcases) return 1;
-  printTables(o, robot, cases, *vcases, pngs);
-  if (!o.json_path.empty() && !writeJson(o, cases, *vcases)) return 1;
+  printTables(o, mount, cases, *vcases, pngs);
+  if (!o.json_path.empty() && !writeJson(o, mount, cases, *vcases)) return 1;
   return 0;
 }

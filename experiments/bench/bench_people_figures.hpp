@@ -20,6 +20,8 @@ struct Options {
   int frames = 300, video_frames = 120, threads = 1;
   uint64_t seed = 1;
   double noise = 3.0, exposure_ms = 8.0, tilt_deg = 0.0;
+  bool wide = false;                   // --head wide: config/robot.yaml's wide_camera, people at 0.6-6 m
+  double hfov_deg = 0.0, z_m = 0.0;    // --hfov-deg / --z-m: the head's, changed (0 = as configured)
 };
 
 // Recall in bins of one quantity.
@@ -56,6 +58,17 @@ struct Case {
   Bins by_distance_part{"distance m (30-90% visible)", {1, 2, 3, 4, 6, 8, 11}, {"1-2", "2-3", "3-4", "4-6", "6-8", "8-10"}, {}, {}};
   Bins by_view{"view", {0, 45, 135, 181}, {"front", "side", "back"}, {}, {}};
   Bins by_motion{"motion", {0, 0.1, 10}, {"standing", "walking"}, {}, {}};
+  /// The wide head's bins: people from 0.6 m, bearings to 62 degrees.
+  void useWideBins() {
+    const std::vector<double> d{0.6, 1, 1.5, 2, 3, 4, 6.01};
+    const std::vector<std::string> dl{"0.6-1", "1-1.5", "1.5-2", "2-3", "3-4", "4-6"};
+    for (Bins* b : {&by_distance, &by_distance_clear, &by_distance_part}) {
+      b->edges = d;
+      b->labels = dl;
+    }
+    by_bearing.edges = {0, 15, 30, 45, 65};
+    by_bearing.labels = {"0-15", "15-30", "30-45", "45-62"};
+  }
   std::vector<Bins*> all() {
     return {&by_distance, &by_bearing, &by_visible, &by_view, &by_motion, &by_distance_clear, &by_distance_part};
   }
@@ -74,9 +87,10 @@ struct VideoCase {
 double quantile(std::vector<double> v, double q);
 /// The tables for people: the cases, recall by each bin, the signed range
 /// error, the footage, and how each figure is made.
-void printTables(const Options& o, const config::RobotConfig& robot, std::vector<Case>& cases,
+void printTables(const Options& o, const config::CameraMount& mount, std::vector<Case>& cases,
                  const std::vector<VideoCase>& vcases, const std::vector<std::string>& pngs);
 /// The same figures as JSON (--json); false (printed why) when the file cannot be written.
-bool writeJson(const Options& o, std::vector<Case>& cases, const std::vector<VideoCase>& vcases);
+bool writeJson(const Options& o, const config::CameraMount& mount, std::vector<Case>& cases,
+               const std::vector<VideoCase>& vcases);
 
 }  // namespace inspect::bench_people

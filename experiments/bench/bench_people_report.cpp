@@ -29,12 +29,13 @@ double quantile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
 }
 
-void printTables(const Options& o, const config::RobotConfig& robot, std::vector<Case>& cases,
+void printTables(const Options& o, const config::CameraMount& mount, std::vector<Case>& cases,
                  const std::vector<VideoCase>& vcases, const std::vector<std::string>& pngs) {
   std::printf("bench_people: %d pictures per case, seed %llu, noise %.1f grey levels, exposure %.0f ms; worlds warehouse,\n"
-              "narrow_aisle, gas_lab, square_room; camera %.0f deg wide at %.2f m, tilt %+.0f deg; OpenCV threads %d\n\n",
-              o.frames, static_cast<unsigned long long>(o.seed), o.noise, o.exposure_ms, robot.camera.hfov_deg,
-              robot.camera.z_m, o.tilt_deg, o.threads);
+              "narrow_aisle, gas_lab, square_room; %s head %.0f deg wide at %.2f m, tilt %+.0f deg; people at %s m;\n"
+              "OpenCV threads %d\n\n",
+              o.frames, static_cast<unsigned long long>(o.seed), o.noise, o.exposure_ms, o.wide ? "wide" : "PTZ",
+              mount.hfov_deg, mount.z_m, mount.tilt_deg + o.tilt_deg, o.wide ? "0.6-6" : "1-10", o.threads);
   std::printf("| size | detector | people | recall | precision | false / picture | bearing err p50 / p90 deg | "
               "range err p50 / p90 %% | ms p50 / p90 | CPU ms |\n|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& c : cases)
@@ -86,12 +87,17 @@ void printTables(const Options& o, const config::RobotConfig& robot, std::vector
   for (const auto& p : pngs) std::printf("picture: %s\n", p.c_str());
 }
 
-bool writeJson(const Options& o, std::vector<Case>& cases, const std::vector<VideoCase>& vcases) {
+bool writeJson(const Options& o, const config::CameraMount& mount, std::vector<Case>& cases,
+               const std::vector<VideoCase>& vcases) {
   nlohmann::ordered_json j;
   j["pictures_per_case"] = o.frames;
   j["seed"] = o.seed;
   j["noise_sigma"] = o.noise;
   j["exposure_ms"] = o.exposure_ms;
+  j["head"] = o.wide ? "wide" : "ptz";
+  j["hfov_deg"] = mount.hfov_deg;
+  j["z_m"] = mount.z_m;
+  j["mount_tilt_deg"] = mount.tilt_deg;
   j["tilt_deg"] = o.tilt_deg;
   j["opencv_threads"] = o.threads;
   auto& jc = j["cases"];

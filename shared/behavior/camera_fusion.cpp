@@ -95,7 +95,7 @@ void HumanTracker::countCameraMisses(const control::Pose2& pose, const CameraLoo
     if (matched[j]) continue;
     HumanTrack& t = tracks_[j];
     const Polar pr = polarFrom(lens, t);
-    const double recall = c.recallAt(pr.range);
+    const double recall = c.recallAt(pr.range, look.wide);
     if (recall <= 0.0 || std::abs(wrapAngle(pr.bearing - axis)) > half) continue;
     // Hidden behind a closer track on the same bearing?
     bool hidden = false;

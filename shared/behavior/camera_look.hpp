@@ -22,6 +22,7 @@ struct CameraLook {
   double lens_x_m = 0.20, lens_y_m = 0.0;  // the lens in the robot frame
   double axis_rad = 0.0;                    // the optical axis (PTZ pan), robot frame
   double half_fov_rad = 0.5235987755982988; // half the horizontal field of view
+  bool wide = false;                        // the wide, fixed head (its own recall by distance), else the PTZ head
   std::array<CameraPerson, kMaxPeople> people{};
   std::size_t count = 0;
   bool add(const CameraPerson& p) {
@@ -54,12 +55,16 @@ struct CameraFusionParams {
   double edge_margin_deg = 3.0;     // a track this near the picture's edge is not counted as missed
   double occluder_width_m = 0.6;    // a closer track within this width on the same bearing hides a track
   // Recall by distance from the lens: recall[i] for distances up to recall_upto_m[i]
-  // (0 beyond the last); the bench's 640x480 HOG figures.
+  // (0 beyond the last); the bench's 640x480 HOG figures for the PTZ head, and
+  // the wide head's (bench_people --head wide).
   std::array<double, 5> recall_upto_m{3.0, 4.0, 6.0, 8.0, 10.0};
   std::array<double, 5> recall{0.0, 0.34, 0.55, 0.65, 0.45};
-  double recallAt(double d_m) const {
-    for (std::size_t i = 0; i < recall_upto_m.size(); ++i)
-      if (d_m <= recall_upto_m[i]) return recall[i];
+  std::array<double, 5> wide_recall_upto_m{1.0, 1.5, 2.0, 3.0, 4.0};  // bench_people --head wide, 480x360 hog group 1
+  std::array<double, 5> wide_recall{0.06, 0.41, 0.70, 0.57, 0.07};
+  double recallAt(double d_m, bool wide = false) const {
+    const auto& upto = wide ? wide_recall_upto_m : recall_upto_m;
+    for (std::size_t i = 0; i < upto.size(); ++i)
+      if (d_m <= upto[i]) return (wide ? wide_recall : recall)[i];
     return 0.0;
   }
 };

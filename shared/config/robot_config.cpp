@@ -4,6 +4,22 @@
 
 namespace inspect::config {
 
+namespace {
+
+// The wide head's mount when its section leaves a key out (config/robot.yaml's values).
+constexpr CameraMount kWideCameraDefaults{0.24, 0.0, 0.55, 120.0, 0.0};
+
+CameraMount readCameraMount(const ConfigNode& n, CameraMount m) {
+  m.x_m = n.number("x_m", m.x_m, -5.0, 5.0);
+  m.y_m = n.number("y_m", m.y_m, -5.0, 5.0);
+  m.z_m = n.number("z_m", m.z_m, 0.05, 5.0);
+  m.hfov_deg = n.number("hfov_deg", m.hfov_deg, 10.0, 150.0);
+  m.tilt_deg = n.number("tilt_deg", m.tilt_deg, -45.0, 45.0);
+  return m;
+}
+
+}  // namespace
+
 RobotConfig loadRobotConfig(const ConfigNode& root) {
   RobotConfig c;
   const auto g = root.optChild("geometry");
@@ -42,12 +58,8 @@ RobotConfig loadRobotConfig(const ConfigNode& root) {
       (void)mounts[i].string("name", "");
     }
   }
-  const auto cam = root.optChild("camera");
-  c.camera.x_m = cam.number("x_m", c.camera.x_m, -5.0, 5.0);
-  c.camera.y_m = cam.number("y_m", c.camera.y_m, -5.0, 5.0);
-  c.camera.z_m = cam.number("z_m", c.camera.z_m, 0.05, 5.0);
-  c.camera.hfov_deg = cam.number("hfov_deg", c.camera.hfov_deg, 10.0, 150.0);
-  c.camera.tilt_deg = cam.number("tilt_deg", c.camera.tilt_deg, -45.0, 45.0);
+  c.camera = readCameraMount(root.optChild("camera"), c.camera);
+  if (root.has("wide_camera")) c.wide_camera = readCameraMount(root.optChild("wide_camera"), kWideCameraDefaults);
   const auto mcu = root.optChild("mcu");
   auto& f = c.mcu;
   f.encoder_counts_per_rev = static_cast<int>(mcu.integer("encoder_counts_per_rev", f.encoder_counts_per_rev, 16, 1000000));

@@ -2,6 +2,7 @@
 // Robot geometry, limits and sensor layout (config/robot.yaml), shared by
 // robot_client and mcu_sim. Defaults are the paper's robot (PAPER_DIGEST.md).
 #include <array>
+#include <optional>
 #include <string>
 
 #include "shared/config/config_node.hpp"
@@ -97,7 +98,8 @@ struct RobotConfig {
   RobotLimits limits;
   MotorModel motor;
   UltrasonicConfig ultrasonic;
-  CameraMount camera;
+  CameraMount camera;                      // the PTZ head (its pan and tilt move on it)
+  std::optional<CameraMount> wide_camera;  // the second head, wide and fixed (`wide_camera`; absent = none)
   McuConfig mcu;
   GasConfig gas;  // the `gas` section (none when absent; defaultGasConfig() = config/robot.yaml's)
 };

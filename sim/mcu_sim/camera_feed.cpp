@@ -22,9 +22,9 @@ struct CameraFeed::Slot {
   video::FrameSlotWriter writer;
 };
 
-CameraFeed::CameraFeed(const World& world, const config::RobotConfig& robot, CameraFeedOptions opt)
+CameraFeed::CameraFeed(const World& world, const config::CameraMount& mount, CameraFeedOptions opt)
     : opt_(std::move(opt)),
-      view_(world, robot.camera, opt_.width, opt_.height),
+      view_(world, mount, opt_.width, opt_.height),
       slot_(std::make_unique<Slot>(opt_.path, opt_.width, opt_.height, opt_.fps)) {
   snapshot_.robot = world.start;
   snapshot_.people.reserve(world.pedestrians.size());
@@ -38,8 +38,8 @@ void CameraFeed::publish(const Simulation& sim) {
   const auto pan_tilt = sim.cameraPanTilt();
   std::lock_guard lk(mu_);
   snapshot_.robot = sim.state().pose;
-  snapshot_.pan_rad = pan_tilt[0];
-  snapshot_.tilt_rad = pan_tilt[1];
+  snapshot_.pan_rad = opt_.follows_ptz ? pan_tilt[0] : 0.0;
+  snapshot_.tilt_rad = opt_.follows_ptz ? pan_tilt[1] : 0.0;
   snapshot_.sim_time_s = sim.timeS();
   peopleInView(crowd, snapshot_.people);
 }
@@ -131,9 +131,9 @@ std::string CameraFeed::summary() const {
   const CameraFeedStats s = stats();
   char buf[384];
   std::snprintf(buf, sizeof buf,
-                "camera %s %dx%d at %g fps: frames=%llu late=%llu render p50 %.2f ms p99 %.2f ms max %.2f ms, "
+                "%s %s %dx%d at %g fps: frames=%llu late=%llu render p50 %.2f ms p99 %.2f ms max %.2f ms, "
                 "CPU %.2f ms/frame",
-                opt_.path.c_str(), opt_.width, opt_.height, opt_.fps, static_cast<unsigned long long>(s.frames),
+                opt_.follows_ptz ? "camera" : "wide camera", opt_.path.c_str(), opt_.width, opt_.height, opt_.fps, static_cast<unsigned long long>(s.frames),
                 static_cast<unsigned long long>(s.late), s.render_ms_p50, s.render_ms_p99, s.render_ms_max,
                 s.cpu_ms_mean);
   return buf;

@@ -1,6 +1,7 @@
 #pragma once
-// mcu_sim's camera (--camera PATH): what the PTZ camera on the robot sees
-// (sim/camera_view.hpp) rendered at its frame rate on a thread of its own and
+// mcu_sim's cameras (--camera PATH, --wide-camera PATH): what one head on the
+// robot sees, the PTZ head at its pan and tilt or the fixed wide one
+// (sim/camera_view.hpp), rendered at its frame rate on a thread of its own and
 // written into a frame slot (shared/video/frame_slot.hpp) that robot_client
 // reads as its `sim:PATH` video source. The real-time runner leaves a
 // snapshot of the truth (pose, PTZ set-point, pedestrians) after each
@@ -26,6 +27,7 @@ struct CameraFeedOptions {
   int width = 640;
   int height = 480;
   double fps = 30.0;
+  bool follows_ptz = true;  // the PTZ head (pan and tilt set-points); false: a fixed head (the wide one)
 };
 
 /// Render times of the pictures so far.
@@ -42,7 +44,7 @@ class CameraFeed {
  public:
   /// Makes the frame slot (throws video::VideoError naming the path) and the
   /// renderer; nothing runs until start().
-  CameraFeed(const World& world, const config::RobotConfig& robot, CameraFeedOptions opt);
+  CameraFeed(const World& world, const config::CameraMount& mount, CameraFeedOptions opt);
   ~CameraFeed();  // stop(); the slot is closed and its file removed
   CameraFeed(const CameraFeed&) = delete;
   CameraFeed& operator=(const CameraFeed&) = delete;

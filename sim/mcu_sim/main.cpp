@@ -41,13 +41,17 @@ int main(int argc, char** argv) {
     simulation.setPeopleWaitForMotion(opt.people_wait_motion);
     // The camera's slot exists before the serial device is announced, so a
     // client started on that announcement finds both.
-    std::unique_ptr<sim::CameraFeed> camera;
-    if (!opt.camera_path.empty()) {
-      camera = std::make_unique<sim::CameraFeed>(
-          simulation.world(), robot,
-          sim::CameraFeedOptions{opt.camera_path, opt.camera_width, opt.camera_height, opt.camera_fps});
-      camera->publish(simulation);
-      camera->start();
+    if (!opt.wide_camera.path.empty() && !robot.wide_camera)
+      throw config::ConfigError(opt.robot_path + ": --wide-camera needs a wide_camera section (docs/human-awareness.md)");
+    std::vector<std::unique_ptr<sim::CameraFeed>> cameras;  // the PTZ head, the wide head
+    for (const bool wide : {false, true}) {
+      const sim::CameraOutput& out = wide ? opt.wide_camera : opt.camera;
+      if (out.path.empty()) continue;
+      cameras.push_back(std::make_unique<sim::CameraFeed>(
+          simulation.world(), wide ? *robot.wide_camera : robot.camera,
+          sim::CameraFeedOptions{out.path, out.width, out.height, out.fps, !wide}));
+      cameras.back()->publish(simulation);
+      cameras.back()->start();
     }
     std::unique_ptr<sim::PtyPort> port_owner;
     if (opt.hil_device.empty()) {
@@ -60,10 +64,14 @@ int main(int argc, char** argv) {
       std::printf("mcu_sim: hil link %s (the MCU is the firmware on its board)\n", opt.hil_device.c_str());
     }
     sim::PtyPort& port = *port_owner;
-    if (camera)
+    if (!opt.camera.path.empty())
       std::printf("mcu_sim: camera %s (%dx%d at %g fps; robot_client --video-source sim:%s)\n",
-                  opt.camera_path.c_str(), opt.camera_width, opt.camera_height, opt.camera_fps,
-                  opt.camera_path.c_str());
+                  opt.camera.path.c_str(), opt.camera.width, opt.camera.height, opt.camera.fps,
+                  opt.camera.path.c_str());
+    if (!opt.wide_camera.path.empty())
+      std::printf("mcu_sim: wide camera %s (%dx%d at %g fps; a sim:%s video source)\n",
+                  opt.wide_camera.path.c_str(), opt.wide_camera.width, opt.wide_camera.height, opt.wide_camera.fps,
+                  opt.wide_camera.path.c_str());
     std::fflush(stdout);
 
     if (truth) {
@@ -74,8 +82,8 @@ int main(int argc, char** argv) {
     }
     sim::RealtimeRunner::Options run_opts{opt.rate, opt.duration_s, {}, opt.freeze_on_stall};
     bool board_announced = false;
-    run_opts.on_caught_up = [&camera, &board_announced](const sim::Simulation& s) {
-      if (camera) camera->publish(s);
+    run_opts.on_caught_up = [&cameras, &board_announced](const sim::Simulation& s) {
+      for (auto& c : cameras) c->publish(s);
       if (const sim::HilMcu* hil = s.hilMcu(); hil && !board_announced && hil->boardTookInputs()) {
         // The board has its first readings of the world: scripts/mcu_qemu.sh links the Pi's line now.
         std::printf("mcu_sim: hil board answered (its peripherals read the world)\n");
@@ -89,13 +97,13 @@ int main(int argc, char** argv) {
     if (const std::string why = util::enterRealtime(opt.realtime_priority); !why.empty())
       std::fprintf(stderr, "mcu_sim: warning: running at normal priority: %s\n", why.c_str());
     const sim::RunSummary r = runner.run();
-    if (camera) camera->stop();
+    for (auto& c : cameras) c->stop();
 
     const std::string stats = sim::formatSerialStats(r.stats);
     std::printf("mcu_sim: final pose x=%.4f y=%.4f theta=%.4f\n", r.final_pose.x_m, r.final_pose.y_m,
                 r.final_pose.theta_rad);
     std::printf("mcu_sim: %s\n", stats.c_str());
-    if (camera) std::printf("mcu_sim: %s\n", camera->summary().c_str());
+    for (const auto& c : cameras) std::printf("mcu_sim: %s\n", c->summary().c_str());
     if (const sim::HilMcu* hil = simulation.hilMcu()) {
       std::printf("mcu_sim: hil frames_in=%u errors=%u inputs_out=%llu held_back=%llu pings=%llu; %s\n",
                   hil->framesReceived(), hil->errors(), static_cast<unsigned long long>(hil->framesSent()),

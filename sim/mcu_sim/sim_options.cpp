@@ -31,6 +31,11 @@ std::string simUsage() {
          "                   for robot_client --video-source sim:PATH (docs/video.md)\n"
          "  --camera-size WxH  its picture size, each in [64, 4096] (default 640x480; needs --camera)\n"
          "  --camera-fps N   its frame rate on the wall clock, N in [1, 120] (default 30; needs --camera)\n"
+         "  --wide-camera PATH  render what the robot's second, wide and fixed head sees (the robot\n"
+         "                   config's wide_camera; docs/human-awareness.md) into the frame slot PATH, a\n"
+         "                   sim:PATH video source\n"
+         "  --wide-camera-size WxH, --wide-camera-fps N  its picture size and rate (default 640x480,\n"
+         "                   15 fps; need --wide-camera)\n"
          "  --realtime-priority N  run the simulation loop SCHED_FIFO at priority N in [1, 99] once\n"
          "                   started (it stands for the MCU, a chip of its own: above robot_client's\n"
          "                   loop, e.g. 20; needs root or CAP_SYS_NICE, else a warning); 0 = normal (default)\n"
@@ -44,7 +49,7 @@ std::string simUsage() {
 SimOptions parseSimOptions(const std::vector<std::string>& args) {
   SimOptions o;
   bool have_world = false;
-  bool camera_size = false, camera_fps = false;
+  bool camera_size = false, camera_fps = false, wide_size = false, wide_fps = false;
   cli::ArgReader a(args);
   while (a.next()) {
     if (a.isHelp()) o.help = true;
@@ -60,13 +65,20 @@ SimOptions parseSimOptions(const std::vector<std::string>& args) {
     else if (a.is("--seed")) o.seed = a.unsignedInteger();
     else if (a.is("--realtime-priority")) o.realtime_priority = static_cast<int>(a.integer(0, 99));
     else if (a.is("--freeze-on-stall")) o.freeze_on_stall = true;
-    else if (a.is("--camera")) o.camera_path = a.path();
-    else if (a.is("--camera-size")) std::tie(o.camera_width, o.camera_height) = a.pictureSize(), camera_size = true;
-    else if (a.is("--camera-fps")) o.camera_fps = a.number(1.0, 120.0), camera_fps = true;
+    else if (a.is("--camera")) o.camera.path = a.path();
+    else if (a.is("--camera-size")) std::tie(o.camera.width, o.camera.height) = a.pictureSize(), camera_size = true;
+    else if (a.is("--camera-fps")) o.camera.fps = a.number(1.0, 120.0), camera_fps = true;
+    else if (a.is("--wide-camera")) o.wide_camera.path = a.path();
+    else if (a.is("--wide-camera-size")) std::tie(o.wide_camera.width, o.wide_camera.height) = a.pictureSize(), wide_size = true;
+    else if (a.is("--wide-camera-fps")) o.wide_camera.fps = a.number(1.0, 120.0), wide_fps = true;
     else a.unknown();
   }
-  if (!o.help && o.camera_path.empty() && camera_size) throw cli::UsageError("--camera-size: needs --camera");
-  if (!o.help && o.camera_path.empty() && camera_fps) throw cli::UsageError("--camera-fps: needs --camera");
+  if (!o.help && o.camera.path.empty() && camera_size) throw cli::UsageError("--camera-size: needs --camera");
+  if (!o.help && o.camera.path.empty() && camera_fps) throw cli::UsageError("--camera-fps: needs --camera");
+  if (!o.help && o.wide_camera.path.empty() && wide_size) throw cli::UsageError("--wide-camera-size: needs --wide-camera");
+  if (!o.help && o.wide_camera.path.empty() && wide_fps) throw cli::UsageError("--wide-camera-fps: needs --wide-camera");
+  if (!o.help && !o.camera.path.empty() && o.camera.path == o.wide_camera.path)
+    throw cli::UsageError("--wide-camera: must not be --camera's slot");
   if (!o.help && (!have_world || o.world_path.empty())) throw cli::UsageError("--world: required");
   if (!o.help && !o.frame_log_path.empty() && o.truth_path.empty()) throw cli::UsageError("--frame-log: needs --truth");
   if (!o.help && !o.hil_device.empty()) {

@@ -9,6 +9,14 @@
 
 namespace inspect::sim {
 
+/// One camera head's pictures (--camera, --wide-camera).
+struct CameraOutput {
+  std::string path;  // empty: not rendered; else the frame slot its view is written to
+  int width = 640;   // --camera-size / --wide-camera-size WxH, each in [64, 4096]
+  int height = 480;
+  double fps = 30.0; // [1, 120]
+};
+
 /// Parsed mcu_sim arguments.
 struct SimOptions {
   std::string world_path;
@@ -23,10 +31,8 @@ struct SimOptions {
   int realtime_priority = 0;         // SCHED_FIFO priority of the simulation loop once started; 0: normal
   bool freeze_on_stall = false;      // a stall of this process pauses the world instead of a catch-up
   bool people_wait_motion = false;   // pedestrians' clock starts at the robot's first wheel motion
-  std::string camera_path;           // empty: no camera; else the frame slot the camera's view is written to
-  int camera_width = 640;            // --camera-size WxH, each in [64, 4096]
-  int camera_height = 480;
-  double camera_fps = 30.0;          // [1, 120]
+  CameraOutput camera;               // the PTZ head
+  CameraOutput wide_camera{"", 640, 480, 15.0};  // the robot config's wide_camera head
   bool help = false;
 };
 

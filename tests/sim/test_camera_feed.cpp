@@ -44,7 +44,7 @@ TEST(CameraFeed, TakesThePoseThePtzSetPointAndThePeopleFromTheSimulation) {
   const config::RobotConfig robot;
   Simulation sim(robot, test::worldOf(kWorld), 1);
   test::TempDir dir("camera_feed");
-  CameraFeed feed(sim.world(), robot, {dir / "cam.slot", 160, 120, 30});
+  CameraFeed feed(sim.world(), robot.camera, {dir / "cam.slot", 160, 120, 30});
   sim.receive(bytesOf(serial::PtzCommand{5236, -1745, 0}));  // 0.5236 rad left, 0.1745 rad down
   sim.advanceTo(20);
   feed.publish(sim);
@@ -66,12 +66,30 @@ TEST(CameraFeed, TakesThePoseThePtzSetPointAndThePeopleFromTheSimulation) {
   EXPECT_EQ(s.tilt_rad, 0.0);
 }
 
+TEST(CameraFeed, AFixedHeadLooksAheadWhereverThePtzPoints) {
+  const config::RobotConfig robot = config::loadRobotConfigFile(test::srcPath("config/robot.yaml"));
+  ASSERT_TRUE(robot.wide_camera);
+  Simulation sim(robot, test::worldOf(kWorld), 1);
+  test::TempDir dir("camera_feed");
+  CameraFeedOptions opt{dir / "wide.slot", 160, 120, 30};
+  opt.follows_ptz = false;
+  CameraFeed feed(sim.world(), *robot.wide_camera, opt);
+  sim.receive(bytesOf(serial::PtzCommand{5236, -1745, 0}));
+  sim.advanceTo(20);
+  feed.publish(sim);
+  const CameraScene s = feed.snapshot();
+  EXPECT_EQ(s.pan_rad, 0.0);
+  EXPECT_EQ(s.tilt_rad, 0.0);
+  EXPECT_NEAR(s.robot.theta_rad, sim.state().pose.theta_rad, 1e-12);
+  EXPECT_EQ(s.people.size(), 1u);
+}
+
 TEST(CameraFeed, WritesPicturesWithTheirTimeCodeAndRemovesTheSlotWhenDestroyed) {
   const config::RobotConfig robot;
   Simulation sim(robot, test::worldOf(kWorld), 1);
   test::TempDir dir("camera_feed");
   const std::string path = dir / "cam.slot";
-  auto feed = std::make_unique<CameraFeed>(sim.world(), robot, CameraFeedOptions{path, 320, 240, 50});
+  auto feed = std::make_unique<CameraFeed>(sim.world(), robot.camera, CameraFeedOptions{path, 320, 240, 50});
   ASSERT_TRUE(test::exists(path)) << "the slot exists before the first picture";
   feed->publish(sim);
   feed->start();
@@ -107,11 +125,11 @@ TEST(CameraFeed, WritesPicturesWithTheirTimeCodeAndRemovesTheSlotWhenDestroyed) 
 
 TEST(CameraFeed, McuSimRendersItsCameraIntoTheSlotOfCamera) {
   test::TempDir dir("mcu_sim_camera");
-  const std::string path = dir / "cam.slot";
+  const std::string path = dir / "cam.slot", wide = dir / "wide.slot";
   test::Process sim = test::Process::spawn(
       {test::binPath("mcu_sim"), "--world", test::srcPath("config/worlds/gas_lab.yaml"), "--robot",
        test::srcPath("config/robot.yaml"), "--camera", path, "--camera-size", "320x240", "--camera-fps", "20",
-       "--duration", "3"},
+       "--wide-camera", wide, "--wide-camera-size", "320x180", "--duration", "3"},
       dir / "out.txt", dir / "err.txt");
   ASSERT_TRUE(test::waitUntil([&] { return test::exists(path); }, 10.0)) << test::readFile(dir / "err.txt");
   video::FrameSlotReader reader(path);
@@ -125,6 +143,14 @@ TEST(CameraFeed, McuSimRendersItsCameraIntoTheSlotOfCamera) {
   cv::Scalar mean, dev;
   cv::meanStdDev(pic, mean, dev);
   EXPECT_GT(dev[1], 10.0);
+  // The wide head's slot beside it, at its own size.
+  ASSERT_TRUE(test::waitUntil([&] { return test::exists(wide); }, 10.0)) << test::readFile(dir / "err.txt");
+  video::FrameSlotReader wide_reader(wide);
+  EXPECT_EQ(wide_reader.width(), 320);
+  EXPECT_EQ(wide_reader.height(), 180);
+  cv::Mat wide_pic(180, 320, CV_8UC3);
+  ASSERT_TRUE(wide_reader.readNewer(0, wide_pic.data, wide_pic.step, 3000ms));
+  EXPECT_TRUE(video::readTimecode(wide_pic));
   const auto rc = sim.wait(20.0);
   ASSERT_TRUE(rc.has_value());
   EXPECT_EQ(*rc, 0) << test::readFile(dir / "err.txt");
@@ -133,7 +159,11 @@ TEST(CameraFeed, McuSimRendersItsCameraIntoTheSlotOfCamera) {
             std::string::npos)
       << out;
   EXPECT_NE(out.find("mcu_sim: camera " + path + " 320x240 at 20 fps: frames="), std::string::npos) << out;
+  EXPECT_NE(out.find("mcu_sim: wide camera " + wide + " (320x180 at 15 fps; a sim:" + wide + " video source)"),
+            std::string::npos)
+      << out;
   EXPECT_FALSE(test::exists(path)) << "removed at the end";
+  EXPECT_FALSE(test::exists(wide)) << "removed at the end";
 }
 
 TEST(CameraFeed, McuSimRefusesASlotPathItCannotUse) {

@@ -44,15 +44,22 @@ TEST(SimOptions, AllFlags) {
 
 TEST(SimOptions, Camera) {
   const auto none = parseSimOptions({"--world", "w"});
-  EXPECT_TRUE(none.camera_path.empty());
-  EXPECT_EQ(none.camera_width, 640);
-  EXPECT_EQ(none.camera_height, 480);
-  EXPECT_DOUBLE_EQ(none.camera_fps, 30.0);
-  const auto o = parseSimOptions({"--world", "w", "--camera", "/dev/shm/cam", "--camera-size=320x240", "--camera-fps", "15"});
-  EXPECT_EQ(o.camera_path, "/dev/shm/cam");
-  EXPECT_EQ(o.camera_width, 320);
-  EXPECT_EQ(o.camera_height, 240);
-  EXPECT_DOUBLE_EQ(o.camera_fps, 15.0);
+  EXPECT_TRUE(none.camera.path.empty());
+  EXPECT_EQ(none.camera.width, 640);
+  EXPECT_EQ(none.camera.height, 480);
+  EXPECT_DOUBLE_EQ(none.camera.fps, 30.0);
+  EXPECT_TRUE(none.wide_camera.path.empty());
+  EXPECT_DOUBLE_EQ(none.wide_camera.fps, 15.0);
+  const auto o = parseSimOptions({"--world", "w", "--camera", "/dev/shm/cam", "--camera-size=320x240", "--camera-fps", "15",
+                                  "--wide-camera", "/dev/shm/wide", "--wide-camera-size", "800x600", "--wide-camera-fps", "5"});
+  EXPECT_EQ(o.camera.path, "/dev/shm/cam");
+  EXPECT_EQ(o.camera.width, 320);
+  EXPECT_EQ(o.camera.height, 240);
+  EXPECT_DOUBLE_EQ(o.camera.fps, 15.0);
+  EXPECT_EQ(o.wide_camera.path, "/dev/shm/wide");
+  EXPECT_EQ(o.wide_camera.width, 800);
+  EXPECT_EQ(o.wide_camera.height, 600);
+  EXPECT_DOUBLE_EQ(o.wide_camera.fps, 5.0);
 }
 
 TEST(SimOptions, HelpNeedsNoWorld) { EXPECT_TRUE(parseSimOptions({"--help"}).help); }
@@ -64,6 +71,8 @@ TEST(SimOptions, ErrorsNameTheFlag) {
   };
   const std::vector<Case> cases = {
       {{}, "--world: required"},
+      {{"--world", "w", "--wide-camera-fps", "5"}, "--wide-camera-fps: needs --wide-camera"},
+      {{"--world", "w", "--camera", "/dev/shm/c", "--wide-camera", "/dev/shm/c"}, "--wide-camera: must not be --camera's slot"},
       {{"--world", "w", "--bogus"}, "--bogus: unknown option"},
       {{"--world", "w", "--rate", "0.05"}, "--rate: 0.05 is out of range [0.1, 100]"},
       {{"--world", "w", "--rate", "101"}, "--rate: 101 is out of range"},

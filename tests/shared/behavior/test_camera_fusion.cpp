@@ -170,6 +170,39 @@ TEST(CameraFusion, AMovingEchoTheCameraLooksAtAndNeverFindsIsNotAPerson) {
   EXPECT_TRUE(fused.tracks()[0].camera_denied);
 }
 
+TEST(CameraFusion, TheWideHeadDeniesAnEchoAtTwoMetresWhereThePtzHeadSaysNothing) {
+  // The cart of the test above, from 2.4 m, 20 degrees off the axis: inside
+  // the PTZ head's view but nearer than its detector finds anyone (recall 0
+  // to 3 m): its pictures change nothing. The wide head (recall 0.57-0.70 at
+  // 1.5-3 m) looking and not finding it is evidence against a person.
+  const config::UltrasonicConfig u;
+  HumanTracker ptz(u, {}), wide(u, {});
+  std::mt19937 rng_a(4), rng_b(4);
+  const control::Pose2 robot{0, 0, 0};
+  CameraLook wide_look;
+  wide_look.lens_x_m = 0.24;
+  wide_look.half_fov_rad = 60.0 * kDeg;
+  wide_look.wide = true;
+  for (int k = 0; k <= 200; ++k) {
+    const double t = k * 0.01;
+    const double r = 2.4 - 0.4 * t;
+    const Circle cart{r * std::cos(20 * kDeg), r * std::sin(20 * kDeg), 0.3};
+    ptz.step(robot, echoes(u, robot, {cart}, {}, &rng_a), t);
+    wide.step(robot, echoes(u, robot, {cart}, {}, &rng_b), t);
+    if (k % 25 == 0) {
+      ptz.observeCamera(robot, CameraLook{});
+      wide.observeCamera(robot, wide_look);
+    }
+  }
+  EXPECT_EQ(ptz.counters().camera_misses, 0u) << "the PTZ head neither sees it nor could find it there";
+  EXPECT_GE(wide.counters().camera_misses, 4u);
+  EXPECT_GE(wide.counters().camera_denials, 1u);
+  EXPECT_NE(ptz.nearest(robot), nullptr) << "with the PTZ head's pictures alone the sonars make it a person";
+  EXPECT_EQ(wide.nearest(robot), nullptr) << "the wide head looked and found nobody";
+  ASSERT_FALSE(wide.tracks().empty()) << "still tracked, not a person";
+  EXPECT_TRUE(wide.tracks()[0].camera_denied);
+}
+
 TEST(CameraFusion, AStandingPersonTheCameraFindsIsAPersonAndOneHiddenBehindIsNotCountedMissed) {
   const config::UltrasonicConfig u;
   HumanTracker tr(u, {});
@@ -289,6 +322,12 @@ TEST(CameraFusion, ConfigReadsTheRecallTableAndNamesWhatIsWrong) {
   fails("{recall_upto_m: [2, 4, 6, 8, 12], recall: [0.1, 0.4]}", "recall");
   fails("{recall_upto_m: [2, 4, 3, 8, 12], recall: [0.1, 0.4, 0.6, 0.7, 0.5]}", "recall_upto_m");
   fails("{recall_upto_m: [2, 4, 6, 8, 12], recall: [0.1, 1.4, 0.6, 0.7, 0.5]}", "recall");
+  const auto w = load("{wide_recall_upto_m: [0.5, 1, 2, 3, 4], wide_recall: [0, 0.3, 0.7, 0.6, 0.1]}");
+  EXPECT_DOUBLE_EQ(w.tracker.camera.recallAt(1.5, true), 0.7);
+  EXPECT_DOUBLE_EQ(w.tracker.camera.recallAt(1.5, false), 0.0) << "the PTZ head's table is its own";
+  EXPECT_DOUBLE_EQ(w.tracker.camera.recallAt(4.5, true), 0.0);
+  fails("{wide_recall_upto_m: [0.5, 1, 2, 3, 4]}", "wide_recall");
+  fails("{wide_recall_upto_m: [0.5, 1, 2, 3, 4], wide_recall: [0, 0.3, 0.7, -0.6, 0.1]}", "wide_recall");
   fails("{deny_logodds: 0, person_logodds: 0}", "deny_logodds");
   fails("{deny_logodds: -2, doubt_logodds: -3}", "doubt_logodds");
   fails("{bearing_sigma: 1}", "bearing_sigma");

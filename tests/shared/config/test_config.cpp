@@ -74,6 +74,24 @@ TEST(Config, CameraMount) {
   EXPECT_NE(robotConfigError("camera:\n  height_m: 1\n").find("camera.height_m: unknown key"), std::string::npos);
 }
 
+TEST(Config, WideCameraIsOptionalAndCheckedLikeThePtzHead) {
+  EXPECT_FALSE(loadRobotConfig(ConfigNode::loadString("", "x.yaml")).wide_camera);
+  const auto shipped = loadRobotConfigFile(inspect::test::srcPath("config/robot.yaml"));
+  ASSERT_TRUE(shipped.wide_camera);
+  EXPECT_DOUBLE_EQ(shipped.wide_camera->hfov_deg, 120.0);
+  // Keys left out take the shipped head's values, not the PTZ head's.
+  const auto c = loadRobotConfig(ConfigNode::loadString("wide_camera:\n  z_m: 0.4\n", "x.yaml"));
+  ASSERT_TRUE(c.wide_camera);
+  EXPECT_DOUBLE_EQ(c.wide_camera->z_m, 0.4);
+  EXPECT_DOUBLE_EQ(c.wide_camera->hfov_deg, shipped.wide_camera->hfov_deg);
+  EXPECT_DOUBLE_EQ(c.wide_camera->x_m, shipped.wide_camera->x_m);
+  EXPECT_DOUBLE_EQ(c.camera.hfov_deg, 60.0) << "the PTZ head is untouched";
+  const auto e = robotConfigError("wide_camera:\n  hfov_deg: 170\n");
+  EXPECT_NE(e.find("wide_camera.hfov_deg"), std::string::npos) << e;
+  EXPECT_NE(e.find("out of range"), std::string::npos) << e;
+  EXPECT_NE(robotConfigError("wide_camera:\n  fov: 1\n").find("wide_camera.fov: unknown key"), std::string::npos);
+}
+
 TEST(Config, WrongMountCount) {
   const auto e = robotConfigError("ultrasonic:\n  mounts:\n    - {x_m: 0, y_m: 0, yaw_rad: 0}\n");
   EXPECT_NE(e.find("exactly 4"), std::string::npos) << e;
