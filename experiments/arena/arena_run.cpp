@@ -28,7 +28,7 @@ class ArenaObserver final : public sim::RunObserver {
  public:
   ArenaObserver(const Episode& e, const sim::ScenarioContext& ctx, bool oracle, const ArenaCamera& camera)
       : world_(e.spec.world), ctx_(ctx), oracle_(oracle), avoid_m_(ctx.awareness.speed.max_avoidance_m),
-        camera_(world_, ctx.robot.camera, camera, e.seed) {}
+        camera_(world_, ctx.robot, camera, e.seed) {}
 
   void beforeFrame(const sim::Simulation& sim, behavior::HumanAwareness& aw, double t_s) override {
     camera_.beforeFrame(sim, aw, t_s);

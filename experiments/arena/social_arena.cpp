@@ -53,6 +53,8 @@ sim time with the robot's decision core over the serial codec.
                           model calibrated on bench_people (default), the simulator's camera
                           rendered and the robot's detector run on it (about 70 ms a picture),
                           or none (sonars alone)
+  --heads both|ptz        the camera heads: the PTZ head and, when the robot config has a
+                          wide_camera, the wide fixed one (default both), or the PTZ head alone
   --cross-check N         the model against the real camera and detector on episodes 0..N-1
                           (strategy and the two references, each camera): a table of both
                           figures, their difference and the stated margin (docs/scenarios.md)
@@ -103,6 +105,8 @@ Options parse(int argc, char** argv) {
         const std::string c = a.choice({"model", "real", "none"});
         o.camera.enabled = c != "none";
         o.camera.real = c == "real";
+      } else if (a.is("--heads")) {
+        o.camera.wide_head = a.choice({"both", "ptz"}) == "both";
       } else if (a.is("--cross-check")) {
         o.cross_check = static_cast<int>(a.integer(1, 10000));
       } else if (a.is("--quiet")) {

@@ -11,10 +11,11 @@ namespace inspect::sim {
 /// The simulator's camera and the robot's people detector.
 class CameraLooks::Real {
  public:
-  Real(const World& w, const config::CameraMount& mount, const ScenarioCamera& c, uint64_t seed)
-      : view_(w, mount, c.width, c.height, style(c, seed)), detector_(c.detector) {
-    cam_.width = c.width;
-    cam_.height = c.height;
+  Real(const World& w, const config::CameraMount& mount, bool wide, const ScenarioCamera& c, uint64_t seed)
+      : view_(w, mount, wide ? c.wide_width : c.width, wide ? c.wide_height : c.height, style(c, seed)),
+        detector_(wide ? c.wide_detector : c.detector), wide_(wide) {
+    cam_.width = wide ? c.wide_width : c.width;
+    cam_.height = wide ? c.wide_height : c.height;
     cam_.mount = mount;
   }
 
@@ -29,6 +30,7 @@ class CameraLooks::Real {
     look.lens_y_m = cam_.mount.y_m;
     look.axis_rad = 0.0;
     look.half_fov_rad = cam_.mount.hfov_deg * M_PI / 360.0;
+    look.wide = wide_;
     for (const auto& b : detector_.detect(frame_)) {
       const auto s = perception::sightingOf(b.box, cam_);
       look.add({s.bearing_rad, s.range_m.value_or(-1.0)});
@@ -50,23 +52,25 @@ class CameraLooks::Real {
   CameraScene scene_;
   cv::Mat frame_;
   uint32_t frame_index_ = 0;
+  bool wide_;
 };
 
-CameraLooks::CameraLooks(const World& world, const config::CameraMount& mount, const ScenarioCamera& camera,
+CameraLooks::CameraLooks(const World& world, const config::RobotConfig& robot, const ScenarioCamera& camera,
                          uint64_t seed)
-    : world_(world), mount_(mount), camera_(camera), rng_(seed * 7919 + 17) {
-  if (camera.enabled && camera.real) real_ = std::make_unique<Real>(world, mount, camera, seed);
+    : world_(world), camera_(camera) {
+  if (!camera.enabled) return;
+  heads_.push_back({robot.camera, false, &camera.model, std::mt19937_64(seed * 7919 + 17), nullptr});
+  if (camera.wide_head && robot.wide_camera)
+    heads_.push_back({*robot.wide_camera, true, &camera.wide_model, std::mt19937_64(seed * 7919 + 29), nullptr});
+  if (camera.real)
+    for (auto& h : heads_) h.real = std::make_unique<Real>(world, h.mount, h.wide, camera, seed);
 }
 
 CameraLooks::~CameraLooks() = default;
 
 void CameraLooks::beforeFrame(const Simulation& sim, behavior::HumanAwareness& aw, double t_s) {
-  if (!camera_.enabled || t_s + 1e-9 < next_look_s_) return;
+  if (heads_.empty() || t_s + 1e-9 < next_look_s_) return;
   next_look_s_ = t_s + 1.0 / camera_.rate_hz;
-  if (real_) {
-    aw.observeCamera(sim.state().pose, real_->look(sim, t_s));
-    return;
-  }
   // The model on the true scene; the tracker places it at the true pose (the
   // odometry's drift over a 9 m run is centimetres).
   discs_.clear();
@@ -76,7 +80,15 @@ void CameraLooks::beforeFrame(const Simulation& sim, behavior::HumanAwareness& a
       const auto& a = crowd.agent(i);
       discs_.push_back({a.position_m.x(), a.position_m.y(), a.radius_m});
     }
-  aw.observeCamera(sim.state().pose, detectPeople(world_, sim.state().pose, mount_, 0.0, discs_, camera_.model, rng_));
+  for (auto& h : heads_) {
+    if (h.real) {
+      aw.observeCamera(sim.state().pose, h.real->look(sim, t_s));
+      continue;
+    }
+    behavior::CameraLook look = detectPeople(world_, sim.state().pose, h.mount, 0.0, discs_, *h.model, h.rng);
+    look.wide = h.wide;
+    aw.observeCamera(sim.state().pose, look);
+  }
 }
 
 }  // namespace inspect::sim

@@ -30,28 +30,46 @@ struct ScenarioCamera {
   int width = 640, height = 480;
   double noise_sigma = 3.0, exposure_ms = 8.0;  // bench_people's defaults
   perception::PeopleDetectorOptions detector;   // robot_client's default (config/client.yaml)
+  // The wide, fixed head (the robot config's wide_camera), when the robot has
+  // one: its own model, picture size and detector (docs/human-awareness.md
+  // "The wide head"), at the same rate.
+  bool wide_head = true;
+  DetectorModelParams wide_model = wideHeadModel();
+  int wide_width = 480, wide_height = 360;
+  perception::PeopleDetectorOptions wide_detector = [] {
+    perception::PeopleDetectorOptions o;
+    o.group_threshold = 1;
+    return o;
+  }();
 };
 
-/// Feeds one run's camera pictures to the tracker; `seed` draws the model's
-/// misses and noise (and the rendered people's looks).
+/// Feeds one run's camera pictures to the tracker, of each head the robot
+/// has (the PTZ head looking ahead; the wide head when the robot config has
+/// one and `wide_head` is on); `seed` draws the model's misses and noise (and
+/// the rendered people's looks).
 class CameraLooks {
  public:
-  CameraLooks(const World& world, const config::CameraMount& mount, const ScenarioCamera& camera, uint64_t seed);
+  CameraLooks(const World& world, const config::RobotConfig& robot, const ScenarioCamera& camera, uint64_t seed);
   ~CameraLooks();
   CameraLooks(const CameraLooks&) = delete;
   CameraLooks& operator=(const CameraLooks&) = delete;
 
   /// Call every tick before the frame reaches the decision core: a picture
-  /// when one is due.
+  /// of each head when one is due.
   void beforeFrame(const Simulation& sim, behavior::HumanAwareness& aw, double t_s);
 
  private:
   class Real;
+  struct Head {
+    config::CameraMount mount;
+    bool wide = false;
+    const DetectorModelParams* model = nullptr;
+    std::mt19937_64 rng;
+    std::unique_ptr<Real> real;
+  };
   const World& world_;
-  config::CameraMount mount_;
   const ScenarioCamera& camera_;
-  std::mt19937_64 rng_;
-  std::unique_ptr<Real> real_;
+  std::vector<Head> heads_;
   double next_look_s_ = 0.0;
   std::vector<PersonDisc> discs_;
 };
