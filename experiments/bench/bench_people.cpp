@@ -208,9 +208,7 @@ Options parseOptions(int argc, char** argv) {
     } else if (a.is("--tilt-deg")) {
       o.tilt_deg = a.number(-30, 30);
     } else if (a.is("--head")) {
-      const std::string h = a.text();
-      if (h != "ptz" && h != "wide") a.fail("must be ptz or wide");
-      o.wide = h == "wide";
+      o.wide = a.choice({"ptz", "wide"}) == "wide";
     } else if (a.is("--hfov-deg")) {
       o.hfov_deg = a.number(10, 150);
     } else if (a.is("--z-m")) {

@@ -75,7 +75,7 @@ void CameraLooks::beforeFrame(const Simulation& sim, behavior::HumanAwareness& a
   // odometry's drift over a 9 m run is centimetres).
   discs_.clear();
   const auto& crowd = sim.pedestrians();
-  for (std::size_t i = 0; i < crowd.size(); ++i)
+  for (std::size_t i = 0; i < crowd.size() && !camera_.real; ++i)
     if (crowd.present(i)) {
       const auto& a = crowd.agent(i);
       discs_.push_back({a.position_m.x(), a.position_m.y(), a.radius_m});

@@ -32,6 +32,18 @@ struct CameraLook {
   }
 };
 
+/// A detector's recall by distance from the lens: recall[i] for distances up
+/// to upto_m[i], 0 beyond the last.
+struct RecallTable {
+  std::array<double, 5> upto_m{};
+  std::array<double, 5> recall{};
+  double at(double d_m) const {
+    for (std::size_t i = 0; i < upto_m.size(); ++i)
+      if (d_m <= upto_m[i]) return recall[i];
+    return 0.0;
+  }
+};
+
 /// How the tracker weighs the camera (config/behavior.yaml `tracker.camera`).
 /// Each track keeps the log-odds that it is a person: a detection adds
 /// hit_logodds (the detector's precision), a picture that should have shown
@@ -54,19 +66,12 @@ struct CameraFusionParams {
   double max_new_range_m = 10.0;    // new tracks only from detections this close
   double edge_margin_deg = 3.0;     // a track this near the picture's edge is not counted as missed
   double occluder_width_m = 0.6;    // a closer track within this width on the same bearing hides a track
-  // Recall by distance from the lens: recall[i] for distances up to recall_upto_m[i]
-  // (0 beyond the last); the bench's 640x480 HOG figures for the PTZ head, and
-  // the wide head's (bench_people --head wide).
-  std::array<double, 5> recall_upto_m{3.0, 4.0, 6.0, 8.0, 10.0};
-  std::array<double, 5> recall{0.0, 0.34, 0.55, 0.65, 0.45};
-  std::array<double, 5> wide_recall_upto_m{1.0, 1.5, 2.0, 3.0, 4.0};  // bench_people --head wide, 480x360 hog group 1
-  std::array<double, 5> wide_recall{0.06, 0.41, 0.70, 0.57, 0.07};
-  double recallAt(double d_m, bool wide = false) const {
-    const auto& upto = wide ? wide_recall_upto_m : recall_upto_m;
-    for (std::size_t i = 0; i < upto.size(); ++i)
-      if (d_m <= upto[i]) return (wide ? wide_recall : recall)[i];
-    return 0.0;
-  }
+  // Recall by distance from the lens, one table per head: the bench's 640x480
+  // HOG figures for the PTZ head, bench_people --head wide's 480x360 HOG
+  // (one window agreeing) for the wide head.
+  RecallTable recall{{3.0, 4.0, 6.0, 8.0, 10.0}, {0.0, 0.34, 0.55, 0.65, 0.45}};
+  RecallTable wide_recall{{1.0, 1.5, 2.0, 3.0, 4.0}, {0.06, 0.41, 0.70, 0.57, 0.07}};
+  double recallAt(double d_m, bool wide = false) const { return (wide ? wide_recall : recall).at(d_m); }
 };
 
 }  // namespace inspect::behavior

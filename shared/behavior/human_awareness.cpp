@@ -137,18 +137,16 @@ void HumanAwareness::predict(const control::Pose2& pose, const HumanTrack& n, Aw
 namespace {
 // A recall-by-distance table of `tracker.camera` (<prefix>recall_upto_m and
 // <prefix>recall, both or neither): distances rising, recalls within [0, 1].
-template <std::size_t N>
-void readRecallTable(const config::ConfigNode& n, const std::string& prefix, std::array<double, N>& upto_out,
-                     std::array<double, N>& recall_out) {
+void readRecallTable(const config::ConfigNode& n, const std::string& prefix, RecallTable& t) {
   const std::string upto_key = prefix + "recall_upto_m", recall_key = prefix + "recall";
   if (!n.has(upto_key) && !n.has(recall_key)) return;
-  const auto upto = n.numbers(upto_key, static_cast<int>(N));
-  const auto recall = n.numbers(recall_key, static_cast<int>(N));
+  const auto upto = n.numbers(upto_key, static_cast<int>(t.upto_m.size()));
+  const auto recall = n.numbers(recall_key, static_cast<int>(t.recall.size()));
   for (std::size_t i = 0; i < upto.size(); ++i) {
     if (i > 0 && !(upto[i] > upto[i - 1])) n.fail(upto_key, "distances must rise");
     if (!(recall[i] >= 0 && recall[i] <= 1)) n.fail(recall_key, "each recall must be within [0, 1]");
-    upto_out[i] = upto[i];
-    recall_out[i] = recall[i];
+    t.upto_m[i] = upto[i];
+    t.recall[i] = recall[i];
   }
 }
 
@@ -169,8 +167,8 @@ CameraFusionParams readCameraFusion(const config::ConfigNode& n) {
   c.max_new_range_m = n.number("max_new_range_m", c.max_new_range_m, 0, 50);
   c.edge_margin_deg = n.number("edge_margin_deg", c.edge_margin_deg, 0, 30);
   c.occluder_width_m = n.number("occluder_width_m", c.occluder_width_m, 0, 3);
-  readRecallTable(n, "", c.recall_upto_m, c.recall);
-  readRecallTable(n, "wide_", c.wide_recall_upto_m, c.wide_recall);
+  readRecallTable(n, "", c.recall);
+  readRecallTable(n, "wide_", c.wide_recall);
   if (!(c.deny_logodds < c.person_logodds)) n.fail("deny_logodds", "must be below person_logodds");
   if (!(c.deny_logodds <= c.doubt_logodds)) n.fail("doubt_logodds", "must be at or above deny_logodds");
   return c;
