@@ -4,7 +4,7 @@
 #   1. the normal build (g++, build/) and every test but the long ones
 #      (ctest -L long runs those by hand), in two phases: the unit-level
 #      tests (label `unit`, ctest -j <2 x cores>), then the real-time stack
-#      tests (`stack`, at most three at once) and the benchmarks' smoke runs
+#      tests (`stack`, at most four at once) and the benchmarks' smoke runs
 #      (`bench`, alone); tests/InspectTest.cmake says how tests are scheduled;
 #   2. the sanitizer build (clang, ASan + UBSan, build-asan/): the fuzz
 #      harnesses, each for a short while from its seed corpus (label `fuzz`),
@@ -22,7 +22,7 @@ cd "$(dirname "$0")/.."
 quick=0
 if [ "${1:-}" = --quick ]; then quick=1; shift; fi
 jobs=$((2 * $(nproc)))
-# At most three stack tests at once, whatever -j (tests/InspectTest.cmake).
+# At most four stack tests at once, whatever -j (tests/InspectTest.cmake).
 resources=(--resource-spec-file "$PWD/tests/ctest_resources.json")
 # The tests' folders (logs, truth files, recordings) in memory when the
 # machine has /dev/shm: the recorder's fdatasync of MCAP chunks on a shared
@@ -90,7 +90,7 @@ echo "test: build took $((t_built - t_setup)) s (ccache hits ${hits1:-?})"
 # stalls them for 100-250 ms whatever their priority (measured here, a
 # virtual machine: docs/testing.md), which a robot takes for a dead sensor
 # line. So they do not share the machine: first the unit phase, all cores
-# busy; then the stack phase, at most three stack tests at once (the resource
+# busy; then the stack phase, at most four stack tests at once (the resource
 # spec) beside nothing CPU-bound, the benchmarks and latency measurements alone.
 t_unit=$t_built
 if [ $stage1 -eq 0 ]; then

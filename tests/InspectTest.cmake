@@ -18,15 +18,18 @@
 #
 # Scheduling: scripts/test.sh runs the unit tests first (ctest -j <2 x cores>),
 # then the stack and bench tests with the resource spec
-# tests/ctest_resources.json, which has 3 `stack` slots: a stack test takes
-# one (RESOURCE_GROUPS stack:1), so at most three run at once. They never
+# tests/ctest_resources.json, which has 4 `stack` slots: a stack test takes
+# one (RESOURCE_GROUPS stack:1), so at most four run at once (they mostly
+# wait on real time: 53-61 % of the 2 cores busy with three or four). They never
 # share the machine with CPU-bound tests: on this 2-core virtual machine two
 # busy cores stall every process for 100-250 ms whatever its priority (nice,
 # SCHED_IDLE: measured, docs/testing.md), and a robot takes that for a dead
 # sensor line. LOCK names a RESOURCE_LOCK: tests holding the same lock never
 # overlap (`cores`: the tuning host's optimiser takes both cores for seconds,
 # and the tracking comparison needs them free to hold its band of link
-# latency). SERIAL
+# latency). SLOTS n: a stack or bench test that takes n of the 4 slots (QEMU's
+# firmware runs take 3: beside one other stack test they keep their figures,
+# beside two they starved). SERIAL
 # (RUN_SERIAL) is for tests that measure latencies or saturate the machine on
 # purpose. COST (expected seconds) starts the long tests first on a clean
 # tree, where ctest has no timings of its own yet. Without the resource spec
@@ -129,10 +132,16 @@ macro(_inspect_test_properties out)
     message(FATAL_ERROR "a test's first label is its kind: unit, stack, bench, package or long, not '${_kind}'")
   endif()
   set(${out} TIMEOUT ${A_TIMEOUT})
+  if(A_SERIAL AND A_SLOTS)
+    message(FATAL_ERROR "a test is SERIAL or takes SLOTS, not both")
+  endif()
   if(A_SERIAL)
     list(APPEND ${out} RUN_SERIAL TRUE)
   elseif(_kind MATCHES "^(stack|bench)$")
-    list(APPEND ${out} RESOURCE_GROUPS stack:1)
+    if(NOT A_SLOTS)
+      set(A_SLOTS 1)
+    endif()
+    list(APPEND ${out} RESOURCE_GROUPS stack:${A_SLOTS})
   endif()
   if(A_LOCK)
     list(APPEND ${out} RESOURCE_LOCK ${A_LOCK})
@@ -143,7 +152,7 @@ macro(_inspect_test_properties out)
   list(APPEND ${out} ${A_PROPERTIES})
 endmacro()
 
-# inspect_gtests(<program> LABELS <kind> TIMEOUT <s> [SERIAL] [LOCK name] [COST s]
+# inspect_gtests(<program> LABELS <kind> TIMEOUT <s> [SERIAL | SLOTS n] [LOCK name] [COST s]
 #                [FILTER <gtest filter>] [SANITIZE [SANITIZE_SKIP <gtest patterns>]]
 #                [PROPERTIES <ctest properties...>])
 # One ctest test per gtest test of <program> (gtest_discover_tests; its
@@ -159,7 +168,7 @@ endmacro()
 # measurements, whose code the stage's other tests run on fewer points; the
 # g++ build runs them all.
 function(inspect_gtests program)
-  cmake_parse_arguments(A "SERIAL;SANITIZE" "TIMEOUT;LOCK;COST;FILTER;SANITIZE_SKIP" "LABELS;PROPERTIES" ${ARGN})
+  cmake_parse_arguments(A "SERIAL;SANITIZE" "TIMEOUT;LOCK;COST;SLOTS;FILTER;SANITIZE_SKIP" "LABELS;PROPERTIES" ${ARGN})
   list(LENGTH A_LABELS n)
   if(NOT n EQUAL 1)
     message(FATAL_ERROR "inspect_gtests(${program}): one label (the kind), got '${A_LABELS}'")
@@ -225,11 +234,11 @@ function(inspect_gtests program)
 endfunction()
 
 # inspect_test(NAME <name> COMMAND <command...> LABELS <kind> [<area>...] TIMEOUT <s>
-#              [SERIAL] [LOCK name] [COST s] [WORKING_DIRECTORY dir]
+#              [SERIAL | SLOTS n] [LOCK name] [COST s] [WORKING_DIRECTORY dir]
 #              [FIXTURES_REQUIRED <fixture>...] [PROPERTIES <single-valued ctest properties...>])
 # One ctest test running a command (a program of the build with arguments, a script).
 function(inspect_test)
-  cmake_parse_arguments(A "SERIAL" "NAME;TIMEOUT;LOCK;COST;WORKING_DIRECTORY"
+  cmake_parse_arguments(A "SERIAL" "NAME;TIMEOUT;LOCK;COST;SLOTS;WORKING_DIRECTORY"
                         "COMMAND;LABELS;FIXTURES_REQUIRED;PROPERTIES" ${ARGN})
   if(INSPECT_FUZZ)
     return()  # the sanitizer build runs the SANITIZE programs and the fuzz harnesses only
