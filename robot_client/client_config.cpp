@@ -11,6 +11,25 @@ namespace inspect::client {
 
 bool validRobotId(const std::string& id) { return net::validRobotId(id); }
 
+namespace {
+// A head's detection settings (perception: the PTZ head; wide_head).
+void readDetection(const config::ConfigNode& n, DetectionParams& d) {
+  d.detector = n.oneOf("detector", d.detector, {"hog", "hog-daimler", "haar-fullbody", "haar-upperbody"});
+  d.width = static_cast<int>(n.integer("width", d.width, 64, 4096));
+  d.height = static_cast<int>(n.integer("height", d.height, 64, 4096));
+  d.rate_hz = n.number("rate_hz", d.rate_hz, 0.1, 30);
+  d.max_core_share = n.number("max_core_share", d.max_core_share, 0.05, 1.0);
+  d.hit_threshold = n.number("hit_threshold", d.hit_threshold, -1.0, 3.0);
+  d.group_threshold = static_cast<int>(n.integer("group_threshold", d.group_threshold, 0, 20));
+}
+
+std::string readPixelFormat(const config::ConfigNode& n, const std::string& dflt) {
+  std::string f = n.string("pixel_format", dflt);
+  if (!f.empty() && f.size() != 4) n.fail("pixel_format", "a FOURCC is 4 characters, e.g. MJPG");
+  return f;
+}
+}  // namespace
+
 ClientConfig loadClientConfig(const config::ConfigNode& root) {
   ClientConfig c;
   c.robot_id = root.string("robot_id", c.robot_id);
@@ -64,8 +83,7 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   vp.height = static_cast<int>(v.integer("height", vp.height, 64, 4096));
   if (vp.width % 2 || vp.height % 2) v.fail("width", "width and height must be even (4:2:0 video)");
   vp.fps = v.number("fps", vp.fps, 1, 120);
-  vp.pixel_format = v.string("pixel_format", vp.pixel_format);
-  if (!vp.pixel_format.empty() && vp.pixel_format.size() != 4) v.fail("pixel_format", "a FOURCC is 4 characters, e.g. MJPG");
+  vp.pixel_format = readPixelFormat(v, vp.pixel_format);
   vp.encoder = v.string("encoder", vp.encoder);
   if (vp.encoder != "libx264" && vp.encoder != "h264_v4l2m2m" && vp.encoder != "auto")
     v.fail("encoder", "'" + vp.encoder + "' is not one of libx264, h264_v4l2m2m, auto");
@@ -90,18 +108,20 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   const auto pe = root.optChild("perception");
   auto& pp = c.perception;
   pp.enabled = pe.boolean("enabled", pp.enabled);
-  pp.detector = pe.oneOf("detector", pp.detector, {"hog", "hog-daimler", "haar-fullbody", "haar-upperbody"});
-  pp.width = static_cast<int>(pe.integer("width", pp.width, 64, 4096));
-  pp.height = static_cast<int>(pe.integer("height", pp.height, 64, 4096));
-  pp.rate_hz = pe.number("rate_hz", pp.rate_hz, 0.1, 30);
-  pp.max_core_share = pe.number("max_core_share", pp.max_core_share, 0.05, 1.0);
-  pp.hit_threshold = pe.number("hit_threshold", pp.hit_threshold, -1.0, 3.0);
-  pp.group_threshold = static_cast<int>(pe.integer("group_threshold", pp.group_threshold, 0, 20));
+  readDetection(pe, pp);
   pp.stale_s = pe.number("stale_s", pp.stale_s, 0.1, 10);
   pp.ahead_deg = pe.number("ahead_deg", pp.ahead_deg, 1, 90);
   pp.look_ahead = pe.boolean("look_ahead", pp.look_ahead);
   pp.look_ahead_within_m = pe.number("look_ahead_within_m", pp.look_ahead_within_m, 0.5, 20);
   pp.look_ahead_hold_s = pe.number("look_ahead_hold_s", pp.look_ahead_hold_s, 0, 60);
+  const auto wh = root.optChild("wide_head");
+  auto& wp = c.wide_head;
+  wp.source = wh.string("source", wp.source);
+  if (wp.source == "synthetic") wh.fail("source", "the synthetic picture shows nobody: a camera, a file or sim:PATH, or \"\" for none");
+  readDetection(wh, wp);
+  if (wp.width % 2 || wp.height % 2) wh.fail("width", "width and height must be even");
+  wp.fps = wh.number("fps", wp.fps, 1, 120);
+  wp.pixel_format = readPixelFormat(wh, wp.pixel_format);
   return c;
 }
 

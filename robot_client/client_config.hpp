@@ -31,10 +31,9 @@ struct VideoParams {
   int adapt_max_kbps = 0;            // ceiling; 0 = bitrate_kbps
 };
 
-/// People detection on the camera's pictures (docs/human-awareness.md,
-/// "Detection on the robot"); becomes client::WatcherSettings.
-struct PerceptionParams {
-  bool enabled = true;               // runs when the video source can show people (not "synthetic")
+/// How one head's pictures are detected (perception: the PTZ head;
+/// wide_head: the wide one); becomes client::WatcherSettings.
+struct DetectionParams {
   std::string detector = "hog";      // hog | hog-daimler | haar-fullbody | haar-upperbody
   int width = 640;                   // the picture is resized to this before detection
   int height = 480;
@@ -42,11 +41,31 @@ struct PerceptionParams {
   double max_core_share = 0.5;       // ...and never more than this share of one core
   double hit_threshold = 0.0;        // HOG's SVM margin
   int group_threshold = 2;           // windows that must agree
+};
+
+/// People detection on the camera's pictures (docs/human-awareness.md,
+/// "Detection on the robot").
+struct PerceptionParams : DetectionParams {
+  bool enabled = true;               // runs when the video source can show people (not "synthetic"); both heads
   double stale_s = 1.0;              // detections older than this are not reported (sonar only)
   double ahead_deg = 15.0;           // the camera counts as looking ahead within this pan
   bool look_ahead = true;            // turn the camera ahead while people are near and the robot moves
   double look_ahead_within_m = 4.0;  // ...a tracked person this near
   double look_ahead_hold_s = 3.0;    // ...and give the PTZ back this long after nobody is near or it stops
+};
+
+/// The wide, fixed head (robot.yaml's wide_camera; docs/human-awareness.md
+/// "The wide head"): its own source, captured and detected on the robot,
+/// not streamed. The bench's choice: HOG at 480x360, one window agreeing.
+struct WideHeadParams : DetectionParams {
+  WideHeadParams() {
+    width = 480;
+    height = 360;
+    group_threshold = 1;
+  }
+  std::string source;                // "" = no wide head; "v4l2:/dev/videoN", "file:PATH", "sim:PATH"
+  double fps = 15.0;                 // captured at most this often (detection takes rate_hz of them)
+  std::string pixel_format;          // V4L2 FOURCC asked of a camera; "" = driver's
 };
 
 /// Mutual TLS on the link (docs/security.md); relative paths are from the working directory.
@@ -83,6 +102,7 @@ struct ClientConfig {
   robot::SafetyParams safety;
   VideoParams video;
   PerceptionParams perception;
+  WideHeadParams wide_head;
   TlsParams tls;
   EventsParams events;
   std::string map_file;  // world file whose walls people tracking ignores ("" = no map); --map overrides

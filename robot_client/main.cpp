@@ -64,6 +64,9 @@ options:
                        v4l2:/dev/videoN, file:PATH or sim:PATH (the simulated
                        camera of mcu_sim --camera PATH)
   --video-port PORT    UDP port of the server's video receiver (overrides video.port)
+  --wide-video-source URI  the wide, fixed head's pictures, detected on the robot and not
+                       streamed (overrides wide_head.source; needs wide_camera in the robot
+                       config): v4l2:/dev/videoN, file:PATH or sim:PATH (mcu_sim --wide-camera PATH)
   --no-video           do not stream video (overrides video.enabled)
   --version            print the version and exit
   --help               print this help and exit
@@ -87,7 +90,7 @@ bool fileExists(const char* p) {
 /// The command line's choices (kUsage); unset ones leave the config files' values.
 struct CliArgs {
   std::string config_path, robot_path, control_path, behavior_path;
-  std::string serial_dev, server, id, cmd_log, map_path, video_source, certs_dir;
+  std::string serial_dev, server, id, cmd_log, map_path, video_source, wide_video_source, certs_dir;
   std::optional<int> video_port, realtime_priority;
   std::optional<std::string> journal;
   std::optional<inspect::robot::GasReaction> gas_reaction;
@@ -122,6 +125,7 @@ CliArgs parseArgs(int argc, char** argv) {
       else if (a.is("--journal")) o.journal = a.text();
       else if (a.is("--map")) o.map_path = a.path();
       else if (a.is("--video-source")) o.video_source = a.path();
+      else if (a.is("--wide-video-source")) o.wide_video_source = a.path();
       else if (a.is("--video-port")) o.video_port = static_cast<int>(a.integer(1, 65535));
       else if (a.is("--certs")) o.certs_dir = a.path();
       else if (a.is("--realtime-priority")) o.realtime_priority = static_cast<int>(a.integer(0, 99));
@@ -173,6 +177,11 @@ void applyArgs(const CliArgs& o, inspect::client::ClientConfig& cfg) {
     log::warn("main", net::kPlaintextWarning);
   }
   if (!o.video_source.empty()) cfg.video.source = o.video_source;
+  if (!o.wide_video_source.empty()) {
+    if (o.wide_video_source == "synthetic")
+      throw config::ConfigError("--wide-video-source: the synthetic picture shows nobody: a camera, a file or sim:PATH");
+    cfg.wide_head.source = o.wide_video_source;
+  }
   if (o.no_video) cfg.video.enabled = false;
   if (o.video_port) cfg.video.port = *o.video_port;
   if (o.realtime_priority) cfg.realtime_priority = *o.realtime_priority;

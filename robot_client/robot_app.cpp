@@ -45,7 +45,7 @@ video::SenderSettings senderSettings(const ClientConfig& cfg) {
 // A source that can show people: a camera, a file, the simulator's camera (not the synthetic test picture).
 bool showsPeople(const std::string& source) { return source != "synthetic"; }
 
-WatcherSettings watcherSettings(const PerceptionParams& p, const config::CameraMount& mount) {
+WatcherSettings watcherSettings(const DetectionParams& p, const config::CameraMount& mount) {
   WatcherSettings w;
   if (!perception::parseDetectorMethod(p.detector, w.detector.method))
     throw std::invalid_argument("perception.detector: '" + p.detector + "' is not known");
@@ -110,6 +110,41 @@ RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::
   } else if (cfg.perception.enabled && video_) {
     log::info("perception", "video source ", cfg.video.source, " shows no people: no detection (sonars only)");
   }
+  openWideHead(robot);
+}
+
+void RobotApp::openWideHead(const config::RobotConfig& robot) {
+  const WideHeadParams& w = cfg_.wide_head;
+  if (w.source.empty()) return;
+  if (!cfg_.perception.enabled) {
+    log::info("perception", "wide head: perception.enabled is false: not used");
+    return;
+  }
+  if (!robot.wide_camera) {
+    log::error("perception", "wide_head.source is ", w.source,
+               " but the robot config has no wide_camera (its mount and field of view): no wide head");
+    return;
+  }
+  wide_mount_ = *robot.wide_camera;
+  video::SenderSettings s;
+  s.stream = false;
+  s.source.uri = w.source;
+  s.source.width = w.width;
+  s.source.height = w.height;
+  s.source.fps = w.fps;
+  s.source.pixel_format = w.pixel_format;
+  try {
+    wide_video_ = std::make_unique<video::VideoSender>(s);
+    wide_watcher_ = std::make_unique<PeopleWatcher>(watcherSettings(w, wide_mount_));
+    wide_video_->setPictureTap([p = wide_watcher_.get()](const cv::Mat& bgr, uint64_t us) { p->offer(bgr, us); });
+    log::info("perception", "wide head ", w.source, " (", wide_mount_.hfov_deg, " deg): people detector ",
+              wide_watcher_->stats().detector, " at ", w.width, "x", w.height, ", at most ", w.rate_hz, " Hz and ",
+              w.max_core_share * 100, " % of a core");
+  } catch (const std::exception& e) {
+    log::error("perception", "wide head: ", e.what(), ": not used");
+    wide_watcher_.reset();
+    wide_video_.reset();
+  }
 }
 
 RobotApp::~RobotApp() {
@@ -153,6 +188,8 @@ void RobotApp::start() {
   mcuHeartbeat();
   if (watcher_) watcher_->start();
   if (video_) video_->start();
+  if (wide_watcher_) wide_watcher_->start();
+  if (wide_video_) wide_video_->start();
 }
 
 void RobotApp::stop() {
@@ -161,6 +198,8 @@ void RobotApp::stop() {
   mcu_hb_timer_.cancel();
   if (video_) video_->stop();
   if (watcher_) watcher_->stop();
+  if (wide_video_) wide_video_->stop();
+  if (wide_watcher_) wide_watcher_->stop();
   // Leave the motors commanded to zero before going.
   if (serial_.isOpen()) sendWheels(serial::WheelCommand{});
   link_.stop();
@@ -297,19 +336,25 @@ void RobotApp::lookAhead(double now_s) {
 }
 
 void RobotApp::feedCamera() {
-  if (!watcher_ || watcher_->latestSeq() == camera_fed_seq_) return;
-  const auto view = watcher_->latest();
+  if (watcher_) feedHead(*watcher_, camera_mount_, false, camera_fed_seq_);
+  if (wide_watcher_) feedHead(*wide_watcher_, wide_mount_, true, wide_fed_seq_);
+}
+
+void RobotApp::feedHead(const PeopleWatcher& w, const config::CameraMount& mount, bool wide, uint64_t& fed) {
+  if (w.latestSeq() == fed) return;
+  const auto view = w.latest();
   if (!view) return;
-  camera_fed_seq_ = view->seq;
+  fed = view->seq;
   // Old pictures, and pictures of the floor or the ceiling, say nothing of
   // the people around now.
   if (monoNowUs() > view->capture_us + static_cast<uint64_t>(cfg_.perception.stale_s * 1e6)) return;
   if (std::abs(view->tilt_rad) > M_PI / 6) return;
   behavior::CameraLook look;
-  look.lens_x_m = camera_mount_.x_m;
-  look.lens_y_m = camera_mount_.y_m;
+  look.lens_x_m = mount.x_m;
+  look.lens_y_m = mount.y_m;
   look.axis_rad = view->pan_rad;
-  look.half_fov_rad = camera_mount_.hfov_deg * M_PI / 360.0;
+  look.half_fov_rad = mount.hfov_deg * M_PI / 360.0;
+  look.wide = wide;
   for (const auto& s : view->people) look.add({s.at.bearing_rad, s.at.range_m.value_or(-1.0)});
   core_.onCameraLook(look);
 }
@@ -317,31 +362,41 @@ void RobotApp::feedCamera() {
 void RobotApp::fillPerception(v1::Telemetry& t) const {
   if (!watcher_) {
     t.clear_perception();
-    return;
+  } else {
+    auto* p = t.mutable_perception();
+    fillHead(*watcher_, *p);
+    p->set_looking_ahead(looking_ahead_);
+    const bool ahead =
+        std::abs(ptz_pan_rad_) <= cfg_.perception.ahead_deg * M_PI / 180 && std::abs(ptz_tilt_rad_) <= M_PI / 6;
+    if (p->mode() == v1::CAMERA_AND_SONAR && !ahead) p->set_mode(v1::CAMERA_ELSEWHERE);
   }
-  auto* p = t.mutable_perception();
-  const WatcherStats st = watcher_->stats();
-  p->set_detector(st.detector);
-  p->set_rate_hz(st.rate_hz);
-  p->set_detect_ms(st.detect_ms);
-  p->set_detections(st.detections);
-  p->set_error(st.error);
-  p->set_looking_ahead(looking_ahead_);
-  p->clear_people();
-  const auto view = watcher_->latest();
+  if (!wide_watcher_)
+    t.clear_wide_perception();
+  else
+    fillHead(*wide_watcher_, *t.mutable_wide_perception());
+}
+
+void RobotApp::fillHead(const PeopleWatcher& w, v1::Perception& p) const {
+  const WatcherStats st = w.stats();
+  p.set_detector(st.detector);
+  p.set_rate_hz(st.rate_hz);
+  p.set_detect_ms(st.detect_ms);
+  p.set_detections(st.detections);
+  p.set_error(st.error);
+  p.clear_people();
+  const auto view = w.latest();
   const uint64_t now_us = monoNowUs();
   const bool fresh = view && now_us < view->capture_us + static_cast<uint64_t>(cfg_.perception.stale_s * 1e6);
-  const bool ahead = std::abs(ptz_pan_rad_) <= cfg_.perception.ahead_deg * M_PI / 180 && std::abs(ptz_tilt_rad_) <= M_PI / 6;
-  p->set_mode(!fresh ? v1::SONAR_ONLY : ahead ? v1::CAMERA_AND_SONAR : v1::CAMERA_ELSEWHERE);
+  p.set_mode(fresh ? v1::CAMERA_AND_SONAR : v1::SONAR_ONLY);
   if (!view) return;
-  p->set_capture_us(view->capture_us);
-  p->set_width(static_cast<uint32_t>(view->width));
-  p->set_height(static_cast<uint32_t>(view->height));
-  p->set_pan_rad(view->pan_rad);
-  p->set_tilt_rad(view->tilt_rad);
+  p.set_capture_us(view->capture_us);
+  p.set_width(static_cast<uint32_t>(view->width));
+  p.set_height(static_cast<uint32_t>(view->height));
+  p.set_pan_rad(view->pan_rad);
+  p.set_tilt_rad(view->tilt_rad);
   if (!fresh) return;
   for (const auto& s : view->people) {
-    auto* q = p->add_people();
+    auto* q = p.add_people();
     q->set_bearing_rad(s.at.bearing_rad);
     if (s.at.range_m) {
       q->set_range_m(*s.at.range_m);

@@ -58,8 +58,14 @@ class RobotApp {
   void lookAhead(double now_s);
   /// Sends a set-point to the MCU and tells the people watcher; "" or why not.
   std::string sendPtz(const v1::Ptz& p);
-  /// Gives the people tracker the watcher's newest detection (once each).
+  /// Gives the people tracker each head's newest detection (once each).
   void feedCamera();
+  /// One head's newest detection to the tracker; `fed` the last one given.
+  void feedHead(const PeopleWatcher& w, const config::CameraMount& mount, bool wide, uint64_t& fed);
+  /// One head's detection figures and its fresh people into `p`.
+  void fillHead(const PeopleWatcher& w, v1::Perception& p) const;
+  /// Sets up the wide head (wide_head.source): its capture and its watcher.
+  void openWideHead(const config::RobotConfig& robot);
 
   boost::asio::io_context& io_;
   ClientConfig cfg_;
@@ -82,6 +88,11 @@ class RobotApp {
   v1::Ptz ptz_before_look_;          // the set-point to give back
   config::CameraMount camera_mount_;
   uint64_t camera_fed_seq_ = 0;      // the last detection given to the people tracker
+  // The wide, fixed head (wide_head.source): captured without streaming, detected.
+  std::unique_ptr<video::VideoSender> wide_video_;
+  std::unique_ptr<PeopleWatcher> wide_watcher_;
+  config::CameraMount wide_mount_;
+  uint64_t wide_fed_seq_ = 0;
   v1::Envelope telemetry_env_;  // reused to avoid reallocating repeated fields
   std::vector<robot::CoreEvent> events_;  // flushEvents' buffer, swapped with the core's
   // Sensor frame read -> its wheel command handed to the serial port

@@ -52,6 +52,14 @@ std::string seenPeople(const v1::Perception& p) {
   return s;
 }
 
+// One head's detection: what it sees now, its detector and pace.
+std::string headFigures(const v1::Perception& p) {
+  return std::string(perceptionName(p.mode())) + ", " + seenPeople(p) + "; " + p.detector() + " on " +
+         std::to_string(p.width()) + "x" + std::to_string(p.height()) + ", " + fmtFixed(p.rate_hz(), 1) + " Hz, " +
+         fmtFixed(p.detect_ms(), 1) + " ms, " + std::to_string(p.detections()) + " pictures" +
+         (p.looking_ahead() ? ", looking ahead for people" : "") + (p.error().empty() ? "" : ", error: " + p.error());
+}
+
 std::string videoFigures(const RobotSnapshot& snap, const VideoHub* video) {
   if (!snap.telemetry.has_video()) return {};
   const auto& tv = snap.telemetry.video();
@@ -98,17 +106,11 @@ std::string videoReport(const std::string& robot_id, const std::optional<RobotSn
                                  std::to_string(v.not_in_history()));
     }
     if (!v.error().empty()) line("robot error", v.error());
-    if (snap->telemetry.has_perception()) {
-      const auto& p = snap->telemetry.perception();
-      line("robot people", std::string(perceptionName(p.mode())) + ", " + seenPeople(p) + "; " + p.detector() + " on " +
-                               std::to_string(p.width()) + "x" + std::to_string(p.height()) + ", " +
-                               fmtFixed(p.rate_hz(), 1) + " Hz, " + fmtFixed(p.detect_ms(), 1) + " ms, " +
-                               std::to_string(p.detections()) + " pictures" +
-                               (p.looking_ahead() ? ", looking ahead for people" : "") +
-                               (p.error().empty() ? "" : ", error: " + p.error()));
-    } else {
+    if (snap->telemetry.has_perception())
+      line("robot people", headFigures(snap->telemetry.perception()));
+    else
       line("robot people", "sonar only (no detector on the robot)");
-    }
+    if (snap->telemetry.has_wide_perception()) line("robot wide head", headFigures(snap->telemetry.wide_perception()));
   } else {
     line("robot", "no video in telemetry");
   }
@@ -184,6 +186,7 @@ std::string statusLine(const std::string& robot_id, const std::optional<RobotSna
          " speed x" + known(t.has_speed_factor(), t.speed_factor(), fmtFixed, 2);
   }
   if (t.has_perception()) s += std::string(" | ") + perceptionName(t.perception().mode()) + " " + seenPeople(t.perception());
+  if (t.has_wide_perception()) s += " | wide head " + seenPeople(t.wide_perception());
   if (t.ultrasonic_m_size() > 0) {
     s += " | us";
     for (double r : t.ultrasonic_m()) s += r < 0 ? " --" : " " + fmtFixed(r);

@@ -72,6 +72,8 @@ uint32_t randomSsrc() {
 }  // namespace
 
 std::string validate(const SenderSettings& s) {
+  // Capture only: the source's size and rate (checked as the encoder's).
+  if (!s.stream) return validate(effectiveEncoder(s));
   if (s.mtu < 256 || s.mtu > 9000) return "video.mtu: " + std::to_string(s.mtu) + " out of range [256, 9000]";
   if (s.port == 0) return "video.port: 0 is not a destination port";
   if (s.host.empty()) return "video.host: empty";
@@ -110,6 +112,7 @@ VideoSender::VideoSender(SenderSettings s) : s_(std::move(s)), net_(std::make_un
   ssrc_ = s_.ssrc ? s_.ssrc : randomSsrc();
   do rtx_ssrc_ = randomSsrc();
   while (rtx_ssrc_ == ssrc_);
+  if (!s_.stream) return;  // capture only: no destination, no socket
   net_->history = RetransmissionHistory(s_.retransmission ? s_.history_packets : 0,
                                         static_cast<uint64_t>(s_.history_s * 1e6));
   net_->rtx_seq = static_cast<uint16_t>(rtx_ssrc_);
@@ -139,6 +142,7 @@ void VideoSender::start() {
     pthread_setname_np(pthread_self(), "video-capture");
     captureLoop();
   });
+  if (!s_.stream) return;
   encode_thread_ = std::thread([this] {
     pthread_setname_np(pthread_self(), "video-encode");
     encodeLoop();
@@ -276,6 +280,11 @@ void VideoSender::captureLoop() {
     if (src->paced()) capture_us = monoNowUs();  // a camera's frame is ready when read() returns
     if (tap_) tap_(frame, capture_us);
     lk.lock();
+    if (!s_.stream) {
+      ++index;
+      ++st_.captured;
+      continue;
+    }
     if (slot_full_) ++st_.dropped;
     slot_ = std::move(frame);
     slot_capture_us_ = capture_us;

@@ -6,7 +6,8 @@
 // itself) and leaves each picture in a one-slot mailbox; the encode thread
 // takes the newest picture, encodes, packetizes and sends it. A picture the
 // encoder had no time for is replaced by the next one and counted as
-// dropped: frames are never queued, so latency cannot grow.
+// dropped: frames are never queued, so latency cannot grow. With
+// `stream` false only the capture thread runs, feeding the picture tap.
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -29,6 +30,10 @@ namespace inspect::video {
 
 struct SenderSettings {
   bool enabled = true;
+  /// false: capture only, for the picture tap (a head whose pictures are
+  /// detected on the robot and not sent): no encoder, no socket, no RTCP; the
+  /// network and encoder settings are not used.
+  bool stream = true;
   SourceSettings source;    // its width/height/fps are the stream's
   EncoderSettings encoder;  // width/height/fps are taken from `source`
   std::string host = "127.0.0.1";  // destination (the server), numeric or a name

@@ -90,3 +90,31 @@ TEST(ClientConfig, Perception) {
   EXPECT_NE(clientConfigError("perception:\n  lookahead: true\n").find("perception.lookahead: unknown key"),
             std::string::npos);
 }
+
+TEST(ClientConfig, WideHead) {
+  const auto c = client::loadClientConfigFile(inspect::test::srcPath("config/client.yaml"));
+  EXPECT_EQ(c.wide_head.source, "") << "no wide head unless configured";
+  EXPECT_EQ(c.wide_head.width, 480);
+  EXPECT_EQ(c.wide_head.height, 360);
+  EXPECT_EQ(c.wide_head.group_threshold, 1);
+  EXPECT_EQ(c.wide_head.detector, "hog");
+  EXPECT_DOUBLE_EQ(c.wide_head.fps, 15.0);
+  // Without the section: the same defaults.
+  const auto d = client::loadClientConfig(config::ConfigNode::loadString("robot_id: r\n", "client.yaml"));
+  EXPECT_EQ(d.wide_head.width, 480);
+  EXPECT_EQ(d.wide_head.group_threshold, 1);
+  const auto e = client::loadClientConfig(
+      config::ConfigNode::loadString("wide_head:\n  source: sim:/dev/shm/w\n  rate_hz: 4\n", "client.yaml"));
+  EXPECT_EQ(e.wide_head.source, "sim:/dev/shm/w");
+  EXPECT_DOUBLE_EQ(e.wide_head.rate_hz, 4.0);
+  EXPECT_NE(clientConfigError("wide_head:\n  source: synthetic\n").find("wide_head.source: the synthetic picture shows nobody"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("wide_head:\n  width: 481\n").find("wide_head.width: width and height must be even"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("wide_head:\n  detector: yolo\n").find("wide_head.detector: 'yolo' is not one of"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("wide_head:\n  fps: 0\n").find("wide_head.fps: 0 is out of range"), std::string::npos);
+  EXPECT_NE(clientConfigError("wide_head:\n  pixel_format: MJPEG\n").find("wide_head.pixel_format: a FOURCC"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("wide_head:\n  stream: true\n").find("wide_head.stream: unknown key"), std::string::npos);
+}
