@@ -185,6 +185,52 @@ std::string wallsYaml(const Geometry& g) {
   return s;
 }
 
+// The x of the robot aisle's end walls, beyond the crossing's corners.
+void placeEnds(Geometry& g) {
+  double lo = 0, hi = 0;
+  for (double t : {-g.h2, g.h2})
+    for (double y : {-g.h1, g.h1}) {
+      lo = std::min(lo, g.crossAt(t, y).x);
+      hi = std::max(hi, g.crossAt(t, y).x);
+    }
+  g.x_back = std::min(-3.0, lo - 1.0);
+  g.x_end = std::max(g.line_m + 3.0, hi + 1.0);
+}
+
+// The episode's world file (kept as its spec's description), its world and task.
+void finish(Episode& e, const Geometry& g, std::vector<Plan>& plans, const std::string& name, const std::string& how,
+            const std::string& spec_name) {
+  std::string yaml = "name: " + name + "\n";
+  char head[256];
+  std::snprintf(head, sizeof head, "description: %s (%s, width %.1f m%s)\n", how.c_str(), toString(g.layout),
+                e.width_m,
+                g.layout == Layout::kCrossing
+                    ? (", cross aisle " + num(e.cross_width_m) + " m at " + num(e.cross_angle_deg) + " deg").c_str()
+                    : "");
+  yaml += head;
+  yaml += "start: {x_m: 0.0, y_m: 0.0, theta_rad: 0.0}\n";
+  yaml += wallsYaml(g);
+  yaml += "pedestrians:\n";
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    auto& p = plans[i];
+    p.who.id = "p" + std::to_string(i) + "_" + toString(p.who.behaviour);
+    yaml += "  - id: " + p.who.id + "\n";
+    yaml += "    speed_m_s: " + num(p.who.speed_m_s) + "\n";
+    yaml += "    start_s: " + num(p.start_s) + "\n";
+    yaml += "    route_m: " + points(p.route) + "\n";
+    if (p.pause_at >= 0) yaml += "    pauses: [{at: " + std::to_string(p.pause_at) + ", s: " + num(p.pause_s) + "}]\n";
+    if (p.who.behaviour == Behaviour::kNotReacting) yaml += "    notices_robot: false\n";
+    e.people.push_back(p.who);
+  }
+  e.spec.name = spec_name;
+  e.spec.description = yaml;  // the world file (worldYaml)
+  e.spec.world = world::loadWorldText(yaml, e.spec.name);
+  e.spec.task.kind = sim::ScenarioTask::Kind::kLine;
+  e.spec.task.length_m = g.line_m;
+  e.spec.task.speed_m_s = kRobotSpeed_m_s;
+  e.spec.time_limit_s = kTimeLimit_s;
+}
+
 }  // namespace
 
 const char* toString(Behaviour b) {
@@ -220,14 +266,7 @@ Episode generateEpisode(uint64_t run_seed, int index) {
     g.alpha = e.cross_angle_deg * kDeg;
     g.xc = d.uniform(3.5, 6.0);
     g.line_m = g.xc + 4.0;
-    double lo = 0, hi = 0;  // the corners' x, so the aisle's end walls lie beyond them
-    for (double t : {-g.h2, g.h2})
-      for (double y : {-g.h1, g.h1}) {
-        lo = std::min(lo, g.crossAt(t, y).x);
-        hi = std::max(hi, g.crossAt(t, y).x);
-      }
-    g.x_back = std::min(-3.0, lo - 1.0);
-    g.x_end = std::max(g.line_m + 3.0, hi + 1.0);
+    placeEnds(g);
   } else {
     g.line_m = 9.0;
     g.x_back = -3.0;
@@ -273,39 +312,63 @@ Episode generateEpisode(uint64_t run_seed, int index) {
     }
   }
 
-  std::string yaml;
   char head[256];
-  std::snprintf(head, sizeof head, "name: arena_%llu_%d\n", static_cast<unsigned long long>(run_seed), index);
-  yaml += head;
-  std::snprintf(head, sizeof head,
-                "description: social_arena --seed %llu --episode %d (%s, width %.1f m%s)\n",
-                static_cast<unsigned long long>(run_seed), index, toString(g.layout), e.width_m,
-                g.layout == Layout::kCrossing
-                    ? (", cross aisle " + num(e.cross_width_m) + " m at " + num(e.cross_angle_deg) + " deg").c_str()
-                    : "");
-  yaml += head;
-  yaml += "start: {x_m: 0.0, y_m: 0.0, theta_rad: 0.0}\n";
-  yaml += wallsYaml(g);
-  yaml += "pedestrians:\n";
-  for (std::size_t i = 0; i < plans.size(); ++i) {
-    auto& p = plans[i];
-    p.who.id = "p" + std::to_string(i) + "_" + toString(p.who.behaviour);
-    yaml += "  - id: " + p.who.id + "\n";
-    yaml += "    speed_m_s: " + num(p.who.speed_m_s) + "\n";
-    yaml += "    start_s: " + num(p.start_s) + "\n";
-    yaml += "    route_m: " + points(p.route) + "\n";
-    if (p.pause_at >= 0) yaml += "    pauses: [{at: " + std::to_string(p.pause_at) + ", s: " + num(p.pause_s) + "}]\n";
-    if (p.who.behaviour == Behaviour::kNotReacting) yaml += "    notices_robot: false\n";
-    e.people.push_back(p.who);
-  }
+  std::snprintf(head, sizeof head, "social_arena --seed %llu --episode %d", static_cast<unsigned long long>(run_seed),
+                index);
+  finish(e, g, plans, "arena_" + std::to_string(run_seed) + "_" + std::to_string(index), head,
+         "arena_" + std::to_string(index));
+  return e;
+}
 
-  e.spec.name = "arena_" + std::to_string(index);
-  e.spec.description = yaml;  // the world file (worldYaml)
-  e.spec.world = world::loadWorldText(yaml, e.spec.name);
-  e.spec.task.kind = sim::ScenarioTask::Kind::kLine;
-  e.spec.task.length_m = g.line_m;
-  e.spec.task.speed_m_s = kRobotSpeed_m_s;
-  e.spec.time_limit_s = kTimeLimit_s;
+std::vector<CrossingCase> crossingCases() {
+  std::vector<CrossingCase> out;
+  for (const double angle : {45.0, 135.0})
+    for (const double speed : {1.4, 0.4})
+      for (const bool yields : {true, false}) out.push_back({angle, speed, yields});
+  return out;
+}
+
+std::string CrossingCase::name() const {
+  char b[64];
+  std::snprintf(b, sizeof b, "cross%.0f_%s_%s", angle_deg, speed_m_s >= 1.0 ? "fast" : "slow",
+                yields ? "yields" : "does_not_yield");
+  return b;
+}
+
+Episode crossingEpisode(const CrossingCase& c) {
+  Episode e;
+  e.run_seed = 0;
+  e.index = -1;
+  e.seed = 0;
+  Geometry g;
+  g.layout = Layout::kCrossing;
+  e.width_m = 3.0;
+  g.h1 = e.width_m / 2;
+  e.cross_width_m = 2.4;
+  g.h2 = e.cross_width_m / 2;
+  e.cross_angle_deg = c.angle_deg;
+  g.alpha = c.angle_deg * kDeg;
+  g.xc = 5.0;
+  g.line_m = 9.0;
+  placeEnds(g);
+  e.layout = g.layout;
+  // One person on the cross aisle's centre line, walking +u (heading
+  // angle_deg relative to the robot's), timed to reach the crossing point
+  // when the robot would if nobody slowed.
+  Plan p;
+  p.who.speed_m_s = c.speed_m_s;
+  p.who.heading_deg = c.angle_deg;
+  p.who.behaviour = c.yields ? Behaviour::kRegular : Behaviour::kNotReacting;
+  const Pt through = g.crossAt(0.0, 0.0), from = g.crossAt(0.0, -kFarY_m), to = g.crossAt(0.0, kFarY_m);
+  const double far = std::hypot(through.x - from.x, through.y - from.y);
+  const double meet_t = robotTimeAt(through.x);
+  p.start_s = std::max(0.0, meet_t - far / c.speed_m_s);
+  const double dist = std::max(std::min(far, c.speed_m_s * (meet_t - p.start_s)), std::min(far, g.h1 + 1.0));
+  const Pt dir = (1.0 / far) * (through - from);
+  p.route = {through - dist * dir, to};
+  p.meet = through;
+  std::vector<Plan> plans{p};
+  finish(e, g, plans, c.name(), "social_arena --crossings, case " + c.name(), c.name());
   return e;
 }
 

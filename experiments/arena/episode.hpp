@@ -49,6 +49,21 @@ struct Episode {
 /// only on a bug (every generated world is validated by the world reader).
 Episode generateEpisode(uint64_t run_seed, int index);
 
+/// The crossing set (issue 61): one person crossing the robot's path at an
+/// angle (45 or 135 degrees to its heading), fast (1.4 m/s) or slow
+/// (0.4 m/s), yielding (the social force model) or not (keeps their line),
+/// timed to reach the crossing point when the robot would; a 3.0 m aisle
+/// and a 2.4 m cross aisle meeting 5 m ahead, the task a 9 m line.
+struct CrossingCase {
+  double angle_deg = 45.0;
+  double speed_m_s = 1.4;
+  bool yields = true;
+  std::string name() const;  // e.g. "cross45_fast_yields"
+};
+/// The eight cases: 45 / 135 degrees x fast / slow x yields / does not.
+std::vector<CrossingCase> crossingCases();
+Episode crossingEpisode(const CrossingCase& c);
+
 /// The episode as a world file (docs/world-format.md): `mcu_sim --world` and
 /// loadWorldText read it back to the same world.
 std::string worldYaml(const Episode& e);

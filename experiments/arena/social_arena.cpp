@@ -58,6 +58,9 @@ sim time with the robot's decision core over the serial codec.
   --cross-check N         the model against the real camera and detector on episodes 0..N-1
                           (strategy and the two references, each camera): a table of both
                           figures, their difference and the stated margin (docs/scenarios.md)
+  --crossings             the eight crossing cases instead of the episodes: 45 and 135 degrees,
+                          1.4 and 0.4 m/s, a walker who yields and one who does not; what the
+                          robot reports on the observable crossing ticks (docs/scenarios.md)
   --quiet                 no progress bar
   --help                  print this help
 Exit status: 0 when the run finished (the targets are reported, not enforced),
@@ -109,6 +112,8 @@ Options parse(int argc, char** argv) {
         o.camera.wide_head = a.choice({"both", "ptz"}) == "both";
       } else if (a.is("--cross-check")) {
         o.cross_check = static_cast<int>(a.integer(1, 10000));
+      } else if (a.is("--crossings")) {
+        o.crossings = true;
       } else if (a.is("--quiet")) {
         o.quiet = true;
       } else {
@@ -119,6 +124,7 @@ Options parse(int argc, char** argv) {
     usageError(e.what());
   }
   if (o.print_world && o.only < 0) usageError("--print-world needs --episode K");
+  if (o.crossings && (o.only >= 0 || o.cross_check)) usageError("--crossings runs its own cases: not with --episode or --cross-check");
   if (o.cross_check && (o.only >= 0 || !o.camera.enabled || o.camera.real))
     usageError("--cross-check compares the model with the real camera: not with --episode or --camera real|none");
   return o;
@@ -199,6 +205,7 @@ int main(int argc, char** argv) {
   }
 
   if (o.cross_check) return crossCheck(o, contexts);
+  if (o.crossings) return crossings(o, contexts);
 
   double wall_s = 0;
   const auto results = runEpisodes(o, indices, contexts, wall_s);

@@ -2,7 +2,7 @@
 // social_arena's parts (experiments/arena/social_arena.cpp runs the episodes;
 // social_arena_report.cpp prints, plots and writes their figures;
 // social_arena_cross_check.cpp compares the detector model with the real
-// camera): its options, one episode's results, a policy's summary.
+// camera; social_arena_crossings.cpp runs the crossing cases): its options, one episode's results, a policy's summary.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -26,6 +26,7 @@ struct Options {
   bool quiet = false;
   arena::ArenaCamera camera;
   int cross_check = 0;
+  bool crossings = false;
 };
 
 constexpr std::size_t kP = arena::kPolicies.size();
@@ -71,5 +72,8 @@ void report(const Options& o, const std::vector<EpisodeResult>& results,
 /// --cross-check: the detector model against the real camera and detector
 /// on episodes 0..N-1; 0, or 2 when an episode failed.
 int crossCheck(const Options& o, const std::vector<sim::ScenarioContext>& contexts);
+/// --crossings: the eight crossing cases (arena::crossingCases) with the
+/// strategy and the oracle; 0, or 2 when a case failed.
+int crossings(const Options& o, const std::vector<sim::ScenarioContext>& contexts);
 
 }  // namespace inspect::arena_cli

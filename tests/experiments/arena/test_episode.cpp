@@ -85,3 +85,34 @@ TEST(ArenaEpisode, TogetherIsTwoPeopleSideBySide) {
     }
   }
 }
+
+// social_arena --crossings: eight distinct cases, each one person crossing
+// the robot's path at its angle and speed, yielding or not, timed to reach
+// the crossing point (5, 0) when the robot would (1 s + 5 m / 0.5 m/s).
+TEST(ArenaEpisode, CrossingCasesCrossThePathAtTheirAngleWhenTheRobotArrives) {
+  const auto cases = arena::crossingCases();
+  ASSERT_EQ(cases.size(), 8u);
+  std::set<std::string> names;
+  for (const auto& c : cases) {
+    names.insert(c.name());
+    const auto e = arena::crossingEpisode(c);
+    ASSERT_EQ(e.spec.world.pedestrians.size(), 1u) << c.name();
+    const auto& p = e.spec.world.pedestrians[0];
+    EXPECT_DOUBLE_EQ(p.speed_m_s, c.speed_m_s);
+    EXPECT_EQ(p.notices_robot, c.yields) << c.name();
+    ASSERT_EQ(p.route.size(), 2u);
+    const auto a = p.route[0], b = p.route[1];
+    EXPECT_NEAR(std::atan2(b.y - a.y, b.x - a.x) * 180 / M_PI, c.angle_deg, 1e-6) << c.name();
+    EXPECT_LT(a.y, -1.5) << "starts outside the robot's aisle: " << c.name();
+    EXPECT_GT(b.y, 1.5) << c.name();
+    // Where the route meets y = 0, and when.
+    const double s = -a.y / (b.y - a.y);
+    EXPECT_NEAR(a.x + s * (b.x - a.x), 5.0, 1e-3) << c.name();
+    const double walk = s * std::hypot(b.x - a.x, b.y - a.y);
+    const double arrive = p.start_s + walk / c.speed_m_s;
+    EXPECT_NEAR(arrive, 11.0, 0.01) << c.name();
+    EXPECT_EQ(arena::worldYaml(e), arena::worldYaml(arena::crossingEpisode(c)));
+  }
+  EXPECT_EQ(names.size(), 8u);
+  EXPECT_EQ(names.count("cross135_slow_does_not_yield"), 1u);
+}
