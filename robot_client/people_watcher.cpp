@@ -30,7 +30,7 @@ void PeopleWatcher::start() {
   if (running_ || thread_.joinable()) return;
   running_ = true;
   thread_ = std::thread([this] {
-    pthread_setname_np(pthread_self(), "people-detect");
+    pthread_setname_np(pthread_self(), s_.thread_name.substr(0, 15).c_str());
     loop();
   });
 }

@@ -34,6 +34,7 @@ struct WatcherSettings {
   double rate_hz = 5.0;
   double max_core_share = 0.5;
   config::CameraMount mount;
+  std::string thread_name = "people-detect";  // at most 15 characters
 };
 
 /// One person in one picture.

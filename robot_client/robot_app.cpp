@@ -128,6 +128,7 @@ void RobotApp::openWideHead(const config::RobotConfig& robot) {
   wide_mount_ = *robot.wide_camera;
   video::SenderSettings s;
   s.stream = false;
+  s.thread_prefix = "wide";
   s.source.uri = w.source;
   s.source.width = w.width;
   s.source.height = w.height;
@@ -135,7 +136,9 @@ void RobotApp::openWideHead(const config::RobotConfig& robot) {
   s.source.pixel_format = w.pixel_format;
   try {
     wide_video_ = std::make_unique<video::VideoSender>(s);
-    wide_watcher_ = std::make_unique<PeopleWatcher>(watcherSettings(w, wide_mount_));
+    WatcherSettings ws = watcherSettings(w, wide_mount_);
+    ws.thread_name = "wide-detect";
+    wide_watcher_ = std::make_unique<PeopleWatcher>(ws);
     wide_video_->setPictureTap([p = wide_watcher_.get()](const cv::Mat& bgr, uint64_t us) { p->offer(bgr, us); });
     log::info("perception", "wide head ", w.source, " (", wide_mount_.hfov_deg, " deg): people detector ",
               wide_watcher_->stats().detector, " at ", w.width, "x", w.height, ", at most ", w.rate_hz, " Hz and ",

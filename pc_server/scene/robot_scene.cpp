@@ -139,6 +139,10 @@ Geometry geometryOf(const config::RobotConfig& c) {
   g.camera_x_m = c.camera.x_m;
   g.camera_y_m = c.camera.y_m;
   g.camera_z_m = c.camera.z_m;
+  if (c.wide_camera) {
+    g.wide_camera_x_m = c.wide_camera->x_m;
+    g.wide_camera_y_m = c.wide_camera->y_m;
+  }
   return g;
 }
 
@@ -362,27 +366,33 @@ void RobotScene::addPeople(::foxglove::SceneUpdate& u, const v1::Telemetry& t, u
 }
 
 void RobotScene::addCameraPeople(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const {
-  // The camera's detections of the latest picture (robot frame): a ray along each bearing from
-  // the lens, to the feet when the range is known, else dimmed to kBearingRayM.
+  // Each head's detections of its latest picture (robot frame): a ray along each bearing from
+  // the lens, to the feet when the range is known, else dimmed to kBearingRayM. The PTZ head's
+  // orange, labelled "camera"; the wide head's cyan, labelled "wide".
   auto* seen = entity(u, "camera_people", frame("base_link"), ns);
-  if (t.has_perception()) {
-    constexpr double kBearingRayM = 8.0;
-    for (const auto& s : t.perception().people()) {
+  constexpr double kBearingRayM = 8.0;
+  const auto rays = [&](const v1::Perception& p, double lens_x, double lens_y, const char* label, double r, double g,
+                        double b) {
+    for (const auto& s : p.people()) {
       const bool ranged = s.has_range_m();
-      const double x1 = ranged ? s.x_m() : g_.camera_x_m + kBearingRayM * std::cos(s.bearing_rad());
-      const double y1 = ranged ? s.y_m() : g_.camera_y_m + kBearingRayM * std::sin(s.bearing_rad());
+      const double x1 = ranged ? s.x_m() : lens_x + kBearingRayM * std::cos(s.bearing_rad());
+      const double y1 = ranged ? s.y_m() : lens_y + kBearingRayM * std::sin(s.bearing_rad());
       auto* ray = seen->add_lines();
       ray->set_type(::foxglove::LinePrimitive::LINE_STRIP);
       setPose(ray->mutable_pose(), 0, 0, 0.05);
       ray->set_thickness(0.03);
-      setColor(ray->mutable_color(), 1.0, 0.55, 0.1, ranged ? 0.9 : 0.45);
-      addPoint(ray, g_.camera_x_m, g_.camera_y_m, 0);
+      setColor(ray->mutable_color(), r, g, b, ranged ? 0.9 : 0.45);
+      addPoint(ray, lens_x, lens_y, 0);
       addPoint(ray, x1, y1, 0);
       const double deg = s.bearing_rad() * 180 / std::numbers::pi;
-      addText(seen, "camera " + std::string(deg >= 0 ? "+" : "") + fmt(deg, 0) + " deg" + (ranged ? " " + fmt(s.range_m()) + " m" : ""),
+      addText(seen, std::string(label) + " " + (deg >= 0 ? "+" : "") + fmt(deg, 0) + " deg" +
+                        (ranged ? " " + fmt(s.range_m()) + " m" : ""),
               x1, y1, 0.3, 0.14);
     }
-  }
+  };
+  if (t.has_perception()) rays(t.perception(), g_.camera_x_m, g_.camera_y_m, "camera", 1.0, 0.55, 0.1);
+  if (t.has_wide_perception())
+    rays(t.wide_perception(), g_.wide_camera_x_m, g_.wide_camera_y_m, "wide", 0.1, 0.8, 0.9);
 }
 
 void RobotScene::addRoute(::foxglove::SceneUpdate& u, const v1::Telemetry& t, uint64_t ns) const {

@@ -45,6 +45,7 @@ struct Geometry {
   double sonar_z_m = 0.25;
   double camera_x_m = config::CameraMount{}.x_m, camera_y_m = config::CameraMount{}.y_m,
          camera_z_m = config::CameraMount{}.z_m;
+  double wide_camera_x_m = 0.24, wide_camera_y_m = 0.0;  // the wide head's lens (robot.yaml wide_camera)
 };
 Geometry geometryOf(const config::RobotConfig& c);
 

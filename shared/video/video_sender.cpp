@@ -139,17 +139,17 @@ void VideoSender::start() {
   // Named, so that top -H and bench_loop's CPU per thread say which is which
   // (the encoder's own threads inherit "video-encode").
   capture_thread_ = std::thread([this] {
-    pthread_setname_np(pthread_self(), "video-capture");
+    pthread_setname_np(pthread_self(), (s_.thread_prefix + "-capture").substr(0, 15).c_str());
     captureLoop();
   });
   if (!s_.stream) return;
   encode_thread_ = std::thread([this] {
-    pthread_setname_np(pthread_self(), "video-encode");
+    pthread_setname_np(pthread_self(), (s_.thread_prefix + "-encode").substr(0, 15).c_str());
     encodeLoop();
   });
   if (s_.retransmission)
     feedback_thread_ = std::thread([this] {
-      pthread_setname_np(pthread_self(), "video-rtcp");
+      pthread_setname_np(pthread_self(), (s_.thread_prefix + "-rtcp").substr(0, 15).c_str());
       feedbackLoop();
     });
 }

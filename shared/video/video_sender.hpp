@@ -34,6 +34,8 @@ struct SenderSettings {
   /// detected on the robot and not sent): no encoder, no socket, no RTCP; the
   /// network and encoder settings are not used.
   bool stream = true;
+  /// Its threads are "<prefix>-capture", "-encode", "-rtcp" (top -H, bench_loop); at most 7 characters.
+  std::string thread_prefix = "video";
   SourceSettings source;    // its width/height/fps are the stream's
   EncoderSettings encoder;  // width/height/fps are taken from `source`
   std::string host = "127.0.0.1";  // destination (the server), numeric or a name

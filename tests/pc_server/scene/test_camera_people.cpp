@@ -157,3 +157,34 @@ TEST(RobotScene, DrawsTheCamerasBearingRaysAndMarksPeopleItSees) {
     }
   EXPECT_EQ(entities, 1);
 }
+
+TEST(RobotScene, DrawsTheWideHeadsRaysFromItsOwnLensBesideThePtzHeads) {
+  config::RobotConfig rc;
+  rc.wide_camera = config::CameraMount{};
+  rc.wide_camera->x_m = 0.3;
+  rc.wide_camera->y_m = 0.05;
+  const Geometry g = geometryOf(rc);
+  EXPECT_DOUBLE_EQ(g.wide_camera_x_m, 0.3);
+  RobotScene s("robot1", g);
+  v1::Telemetry t;
+  t.set_mode(v1::IDLE);
+  *t.mutable_perception() = twoPeople();
+  auto* w = t.mutable_wide_perception()->add_people();
+  w->set_bearing_rad(std::numbers::pi / 4);
+  w->set_range_m(1.7);
+  w->set_x_m(0.3 + 1.2);
+  w->set_y_m(0.05 + 1.2);
+  s.onTelemetry(t);
+  const auto u = s.scene(1'000'000'000);
+  const ::foxglove::SceneEntity* rays = nullptr;
+  for (const auto& x : u.entities())
+    if (x.id() == "camera_people") rays = &x;
+  ASSERT_NE(rays, nullptr);
+  ASSERT_EQ(rays->lines_size(), 3) << "two of the PTZ head, one of the wide head";
+  const auto& wide = rays->lines(2);
+  EXPECT_DOUBLE_EQ(wide.points(0).x(), 0.3);
+  EXPECT_DOUBLE_EQ(wide.points(0).y(), 0.05);
+  EXPECT_DOUBLE_EQ(wide.points(1).x(), 1.5);
+  EXPECT_NE(wide.color().b(), rays->lines(0).color().b()) << "the heads in their own colours";
+  EXPECT_EQ(rays->texts(2).text(), "wide +45 deg 1.70 m");
+}

@@ -61,6 +61,7 @@ struct Options {
   int cpu = -1;  // -1: the last core
   bool smoke = false;
   bool people = false;  // the simulated camera with people in view: the people detector runs too
+  bool wide_head = false;  // ...and the wide head's camera and detector (issue 61)
   std::string json;
 };
 
@@ -161,6 +162,8 @@ encoder's time per frame, and the budget on a Raspberry Pi 4 and 5
   --cpu N       the core for robot_client (default: the last one)
   --people      the camera is mcu_sim's (sim:) with two people walking round the
                 robot's circle, so robot_client's people detector runs as well
+  --wide-head   with --people: the wide head too (mcu_sim --wide-camera, robot_client
+                --wide-video-source): both heads' detectors on the one core
   --json FILE   write the figures as JSON
   --help        this text
 )";
@@ -184,12 +187,18 @@ int main(int argc, char** argv) {
       o.cpu = static_cast<int>(a.integer(0, 4095));
     } else if (a.is("--people")) {
       o.people = true;
+    } else if (a.is("--wide-head")) {
+      o.wide_head = true;
     } else if (a.is("--json")) {
       o.json = a.path();
     } else {
       a.unknown();
     }
   });
+  if (o.wide_head && !o.people) {
+    std::fprintf(stderr, "bench_loop: --wide-head needs --people\n");
+    return 2;
+  }
   const int ncpu = static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN));
   if (o.cpu < 0) o.cpu = ncpu - 1;
   if (o.cpu >= ncpu) {
@@ -219,6 +228,10 @@ int main(int argc, char** argv) {
     const std::string slot = "/dev/shm/inspect-bench-loop-" + std::to_string(::getpid());
     sim_args = {"--camera", slot};
     client_args = {"--video-source", "sim:" + slot};
+    if (o.wide_head) {
+      sim_args.insert(sim_args.end(), {"--wide-camera", slot + "-wide"});
+      client_args.insert(client_args.end(), {"--wide-video-source", "sim:" + slot + "-wide"});
+    }
   }
   auto& robot = s.startRobot("robot1", world, {}, sim_args, client_args);
   // Measure once the robot drives and the stream runs.
@@ -270,8 +283,8 @@ int main(int argc, char** argv) {
   }
   std::sort(threads.begin(), threads.end(), [](const ThreadCpu& a, const ThreadCpu& b) { return a.percent > b.percent; });
 
-  std::printf("\nbench_loop: %.0f s, robot_client on core %d of %d with libx264 640x480 at 30 fps\n\n", wall_s, o.cpu,
-              ncpu);
+  std::printf("\nbench_loop: %.0f s, robot_client on core %d of %d with libx264 640x480 at 30 fps%s\n\n", wall_s, o.cpu,
+              ncpu, o.wide_head ? ", both heads' people detectors" : o.people ? ", the PTZ head's people detector" : "");
   const double ref_p50 = static_cast<double>(ref.quantileNs(0.5)) * 1e-6,
                ref_p99 = static_cast<double>(ref.quantileNs(0.99)) * 1e-6, ref_max = static_cast<double>(ref.maxNs()) * 1e-6;
   std::printf("| | robot_client: sensor frame in -> wheel command out | reference: 10 ms wake-up, how late |\n|---|---|---|\n");
@@ -285,6 +298,20 @@ int main(int argc, char** argv) {
   std::printf("| robot_client thread | CPU %% of one core |\n|---|---|\n");
   for (const auto& t : threads) std::printf("| %s | %.1f |\n", t.name.c_str(), t.percent);
   std::printf("| all | %.1f |\n\nencoder: %.2f ms per frame (libx264, the server's video stats)\n", total_pct, encode_ms);
+  // Each head's detection pace, from the server's `video stats` (the robot's telemetry).
+  std::string heads_json;
+  for (const auto& [label, key] : {std::pair{"robot people: ", "ptz"}, std::pair{"robot wide head: ", "wide"}}) {
+    const auto at = server_out.rfind(label);
+    if (at == std::string::npos) continue;
+    const std::string line = server_out.substr(at, server_out.find('\n', at) - at);
+    std::smatch m;
+    if (!std::regex_search(line, m, std::regex(R"(on ([0-9]+x[0-9]+), ([0-9.]+) Hz, ([0-9.]+) ms, ([0-9]+) pictures)")))
+      continue;
+    std::printf("%s head: %s at %s Hz, %s ms a picture, %s pictures\n", key, m[1].str().c_str(), m[2].str().c_str(),
+                m[3].str().c_str(), m[4].str().c_str());
+    heads_json += std::string(heads_json.empty() ? "" : ", ") + "\"" + key + "\": {\"size\": \"" + m[1].str() +
+                  "\", \"hz\": " + m[2].str() + ", \"ms\": " + m[3].str() + ", \"pictures\": " + m[4].str() + "}";
+  }
 
   std::string json = "{\n  \"seconds\": " + std::to_string(wall_s) + ",\n  \"cpu\": " + std::to_string(o.cpu) +
                      ",\n  \"frames\": " + std::to_string(static_cast<long long>(n)) +
@@ -298,6 +325,8 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < threads.size(); ++i)
     json += (i ? ", \"" : "\"") + threads[i].name + "\": " + std::to_string(threads[i].percent);
   json += "},\n  \"total_cpu_percent\": " + std::to_string(total_pct);
+  json += ",\n  \"people\": " + std::string(o.people ? "true" : "false") + ",\n  \"wide_head\": " +
+          (o.wide_head ? "true" : "false") + ",\n  \"detection\": {" + heads_json + "}";
 
   if (!o.smoke) {
     const double eps = sysbenchEps(10);
