@@ -28,7 +28,7 @@ class ArenaObserver final : public sim::RunObserver {
  public:
   ArenaObserver(const Episode& e, const sim::ScenarioContext& ctx, bool oracle, const ArenaCamera& camera)
       : world_(e.spec.world), ctx_(ctx), oracle_(oracle), avoid_m_(ctx.awareness.speed.max_avoidance_m),
-        camera_(world_, ctx.robot, camera, e.seed) {}
+        camera_(world_, ctx.robot, ctx.awareness, camera, e.seed) {}
 
   void beforeFrame(const sim::Simulation& sim, behavior::HumanAwareness& aw, double t_s) override {
     camera_.beforeFrame(sim, aw, t_s);
@@ -137,6 +137,8 @@ class ArenaObserver final : public sim::RunObserver {
 
   void finish() {
     m.path_m = path_m_;
+    m.looks = static_cast<uint32_t>(camera_.activeLook().looks);
+    m.ptz_off_path_s = camera_.activeLook().off_path_s;
     const double needed = std::abs(control::wrapAngle(last_.theta_rad - first_theta_));
     m.irregularity_rad_m = path_m_ > 0.1 ? std::max(0.0, turned_rad_ - needed) / path_m_ : 0.0;
     std::array<uint64_t, kPatterns> truth{}, reported{};

@@ -64,6 +64,8 @@ struct EpisodeMetrics {
   int reported_dominant = -1;       // most frequent reported pattern other than none over them (-1: none)
   uint32_t false_people = 0;        // person tracks that appeared where nobody was (> 1 m from everyone)
   FalseWhere false_where{};         // ...by where they were when they became people
+  uint32_t looks = 0;               // active looks started (the PTZ head turned to an undecided track)
+  double ptz_off_path_s = 0;        // ...the time it pointed off the path (pan beyond its half field of view)
 };
 
 /// The robot's camera in the arena (experiments/scenarios/scenario_camera.hpp):

@@ -58,6 +58,8 @@ sim time with the robot's decision core over the serial codec.
   --cross-check N         the model against the real camera and detector on episodes 0..N-1
                           (strategy and the two references, each camera): a table of both
                           figures, their difference and the stated margin (docs/scenarios.md)
+  --active-look on|off    the PTZ head turned to undecided sonar tracks beside the robot
+                          (config/behavior.yaml active_look.enabled; default: the config's)
   --crossings             the eight crossing cases instead of the episodes: 45 and 135 degrees,
                           1.4 and 0.4 m/s, a walker who yields and one who does not; what the
                           robot reports on the observable crossing ticks (docs/scenarios.md)
@@ -112,6 +114,8 @@ Options parse(int argc, char** argv) {
         o.camera.wide_head = a.choice({"both", "ptz"}) == "both";
       } else if (a.is("--cross-check")) {
         o.cross_check = static_cast<int>(a.integer(1, 10000));
+      } else if (a.is("--active-look")) {
+        o.active_look = a.choice({"on", "off"}) == "on" ? 1 : 0;
       } else if (a.is("--crossings")) {
         o.crossings = true;
       } else if (a.is("--quiet")) {
@@ -199,7 +203,10 @@ int main(int argc, char** argv) {
 
   std::vector<sim::ScenarioContext> contexts;
   try {
-    for (int t = 0; t < o.threads; ++t) contexts.push_back(sim::loadScenarioContext(o.robot, o.control, o.behavior));
+    for (int t = 0; t < o.threads; ++t) {
+      contexts.push_back(sim::loadScenarioContext(o.robot, o.control, o.behavior));
+      if (o.active_look >= 0) contexts.back().awareness.active_look.enabled = o.active_look == 1;
+    }
   } catch (const std::exception& e) {
     usageError(e.what());
   }

@@ -27,6 +27,7 @@ struct Options {
   arena::ArenaCamera camera;
   int cross_check = 0;
   bool crossings = false;
+  int active_look = -1;  // -1: config/behavior.yaml's active_look.enabled; 0 off, 1 on
 };
 
 constexpr std::size_t kP = arena::kPolicies.size();

@@ -139,6 +139,10 @@ struct FalsePeople {
   uint32_t false_map = 0, false_nomap = 0;
   double min_map = 0, min_nomap = 0;
   arena::FalseWhere where_nomap{}, where_people{};
+  // Active looking: looks started and the PTZ head's time off the path, in the
+  // strategy's runs and in the no-map references.
+  uint32_t looks = 0, looks_nomap = 0;
+  double off_path_s = 0, off_path_nomap_s = 0, min_strategy = 0;
 };
 
 FalsePeople falsePeople(const std::vector<EpisodeResult>& results) {
@@ -148,6 +152,11 @@ FalsePeople falsePeople(const std::vector<EpisodeResult>& results) {
     fp.min_map += r.reference.duration_s / 60.0;
     fp.false_nomap += r.reference_no_map.false_people;
     fp.min_nomap += r.reference_no_map.duration_s / 60.0;
+    fp.looks += r.by_policy[0].looks;
+    fp.off_path_s += r.by_policy[0].ptz_off_path_s;
+    fp.min_strategy += r.by_policy[0].duration_s / 60.0;
+    fp.looks_nomap += r.reference_no_map.looks;
+    fp.off_path_nomap_s += r.reference_no_map.ptz_off_path_s;
     for (int k = 0; k < arena::kFalseWhereKinds; ++k) {
       fp.where_nomap[static_cast<std::size_t>(k)] += r.reference_no_map.false_where[static_cast<std::size_t>(k)];
       fp.where_people[static_cast<std::size_t>(k)] += r.by_policy[0].false_where[static_cast<std::size_t>(k)];
@@ -341,6 +350,13 @@ void writeJson(const Options& o, const std::vector<EpisodeResult>& results, cons
   }
   j["false_people"] = {{"with_map", fp.false_map},       {"with_map_min", fp.min_map},
                        {"without_map", fp.false_nomap}, {"without_map_min", fp.min_nomap}};
+  if (fp.looks + fp.looks_nomap > 0)
+    j["active_look"] = {{"looks", fp.looks},
+                        {"off_path_s", fp.off_path_s},
+                        {"minutes", fp.min_strategy},
+                        {"looks_no_map", fp.looks_nomap},
+                        {"off_path_no_map_s", fp.off_path_nomap_s},
+                        {"minutes_no_map", fp.min_nomap}};
   for (int k = 0; k < arena::kFalseWhereKinds; ++k) {
     j["false_people"]["without_map_where"][arena::falseWhereName(k)] = fp.where_nomap[static_cast<std::size_t>(k)];
     j["false_people"]["strategy_where"][arena::falseWhereName(k)] = fp.where_people[static_cast<std::size_t>(k)];
@@ -361,6 +377,12 @@ void report(const Options& o, const std::vector<EpisodeResult>& results,
   printPatterns(sums);
   const FalsePeople fp = falsePeople(results);
   printFalsePeople(fp, sums);
+  if (fp.looks + fp.looks_nomap > 0)
+    std::printf("active look: strategy %u looks, the PTZ head off the path %.1f s of %.1f min (%.1f %%); no-map "
+                "references %u looks, off the path %.1f %%\n",
+                fp.looks, fp.off_path_s, fp.min_strategy,
+                fp.min_strategy > 0 ? 100.0 * fp.off_path_s / (60.0 * fp.min_strategy) : 0.0, fp.looks_nomap,
+                fp.min_nomap > 0 ? 100.0 * fp.off_path_nomap_s / (60.0 * fp.min_nomap) : 0.0);
   printVsBaselines(sums);
   const std::vector<std::size_t> order = worstFirst(results);
   const std::size_t worst_n = std::min<std::size_t>(static_cast<std::size_t>(std::max(o.worst, 0)), order.size());

@@ -20,17 +20,19 @@ class CameraLooks::Real {
   }
 
   /// One picture of the robot's view now (the camera ahead), detected.
-  behavior::CameraLook look(const Simulation& sim, double t_s) {
+  behavior::CameraLook look(const Simulation& sim, double pan_rad, double t_s) {
     scene_.robot = sim.state().pose;
+    scene_.pan_rad = pan_rad;
     scene_.sim_time_s = t_s;
     peopleInView(sim.pedestrians(), scene_.people);
     view_.render(scene_, static_cast<uint64_t>(t_s * 1e6), frame_index_++, frame_);
     behavior::CameraLook look;
     look.lens_x_m = cam_.mount.x_m;
     look.lens_y_m = cam_.mount.y_m;
-    look.axis_rad = 0.0;
+    look.axis_rad = pan_rad;
     look.half_fov_rad = cam_.mount.hfov_deg * M_PI / 360.0;
     look.wide = wide_;
+    cam_.pan_rad = pan_rad;
     for (const auto& b : detector_.detect(frame_)) {
       const auto s = perception::sightingOf(b.box, cam_);
       look.add({s.bearing_rad, s.range_m.value_or(-1.0)});
@@ -55,9 +57,9 @@ class CameraLooks::Real {
   bool wide_;
 };
 
-CameraLooks::CameraLooks(const World& world, const config::RobotConfig& robot, const ScenarioCamera& camera,
-                         uint64_t seed)
-    : world_(world), camera_(camera) {
+CameraLooks::CameraLooks(const World& world, const config::RobotConfig& robot,
+                         const behavior::AwarenessConfig& awareness, const ScenarioCamera& camera, uint64_t seed)
+    : world_(world), camera_(camera), look_(awareness.active_look), ptz_recall_(awareness.tracker.camera.recall) {
   if (!camera.enabled) return;
   heads_.push_back({robot.camera, false, &camera.model, std::mt19937_64(seed * 7919 + 17), nullptr});
   if (camera.wide_head && robot.wide_camera)
@@ -81,11 +83,18 @@ void CameraLooks::beforeFrame(const Simulation& sim, behavior::HumanAwareness& a
       discs_.push_back({a.position_m.x(), a.position_m.y(), a.radius_m});
     }
   for (auto& h : heads_) {
+    // The PTZ head where the active look points it (ahead when off); no picture while it turns.
+    double pan = 0.0;
+    if (!h.wide && look_.enabled) {
+      pan = behavior::activeLookPan(look_state_, look_, aw.tracker().tracks(), sim.state().pose, h.mount.x_m,
+                                    h.mount.y_m, h.mount.hfov_deg * M_PI / 360.0, ptz_recall_, t_s);
+      if (behavior::activeLookTurning(look_state_, t_s)) continue;
+    }
     if (h.real) {
-      aw.observeCamera(sim.state().pose, h.real->look(sim, t_s));
+      aw.observeCamera(sim.state().pose, h.real->look(sim, pan, t_s));
       continue;
     }
-    behavior::CameraLook look = detectPeople(world_, sim.state().pose, h.mount, 0.0, discs_, *h.model, h.rng);
+    behavior::CameraLook look = detectPeople(world_, sim.state().pose, h.mount, pan, discs_, *h.model, h.rng);
     look.wide = h.wide;
     aw.observeCamera(sim.state().pose, look);
   }

@@ -49,7 +49,11 @@ struct ScenarioCamera {
 /// the rendered people's looks).
 class CameraLooks {
  public:
-  CameraLooks(const World& world, const config::RobotConfig& robot, const ScenarioCamera& camera, uint64_t seed);
+  /// `awareness`: the robot's behaviour config: its active look (the PTZ
+  /// head turned to undecided tracks beside the robot, when enabled) and the
+  /// PTZ head's recall by distance.
+  CameraLooks(const World& world, const config::RobotConfig& robot, const behavior::AwarenessConfig& awareness,
+              const ScenarioCamera& camera, uint64_t seed);
   ~CameraLooks();
   CameraLooks(const CameraLooks&) = delete;
   CameraLooks& operator=(const CameraLooks&) = delete;
@@ -57,6 +61,8 @@ class CameraLooks {
   /// Call every tick before the frame reaches the decision core: a picture
   /// of each head when one is due.
   void beforeFrame(const Simulation& sim, behavior::HumanAwareness& aw, double t_s);
+  /// The active look's figures so far (looks started, time the PTZ head was off the path).
+  const behavior::ActiveLookState& activeLook() const { return look_state_; }
 
  private:
   class Real;
@@ -72,6 +78,9 @@ class CameraLooks {
   std::vector<Head> heads_;
   double next_look_s_ = 0.0;
   std::vector<PersonDisc> discs_;
+  behavior::ActiveLookParams look_;
+  behavior::RecallTable ptz_recall_;
+  behavior::ActiveLookState look_state_;
 };
 
 }  // namespace inspect::sim

@@ -69,7 +69,7 @@ struct Options {
 class CameraObserver final : public sim::RunObserver {
  public:
   CameraObserver(const sim::ScenarioSpec& s, const sim::ScenarioContext& ctx, const sim::ScenarioCamera& c, uint64_t seed)
-      : looks_(s.world, ctx.robot, c, seed) {}
+      : looks_(s.world, ctx.robot, ctx.awareness, c, seed) {}
   void beforeFrame(const sim::Simulation& sim, behavior::HumanAwareness& aw, double t_s) override {
     looks_.beforeFrame(sim, aw, t_s);
   }

@@ -226,6 +226,16 @@ AwarenessConfig loadAwarenessConfig(const config::ConfigNode& root, const std::s
   c.pattern.max_lateral_m = p.number("max_lateral_m", c.pattern.max_lateral_m, 0, 10);
   c.pattern.dwell_s = p.number("dwell_s", c.pattern.dwell_s, 0, 5);
   if (c.pattern.along_deg >= c.pattern.crossing_deg) p.fail("along_deg", "must be below crossing_deg (the gap is the hysteresis band)");
+  const auto al = root.optChild("active_look");
+  auto& l = c.active_look;
+  l.enabled = al.boolean("enabled", l.enabled);
+  l.min_off_axis_deg = al.number("min_off_axis_deg", l.min_off_axis_deg, 0, 180);
+  l.max_pan_deg = al.number("max_pan_deg", l.max_pan_deg, 0, 180);
+  l.dwell_s = al.number("dwell_s", l.dwell_s, 0.1, 10);
+  l.slew_deg_s = al.number("slew_deg_s", l.slew_deg_s, 1, 2000);
+  l.revisit_s = al.number("revisit_s", l.revisit_s, 0, 600);
+  l.ahead_m = al.number("ahead_m", l.ahead_m, 0, 20);
+  l.ahead_deg = al.number("ahead_deg", l.ahead_deg, 0, 90);
   validate(c.speed);
   return c;
 }

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "shared/behavior/active_look.hpp"
 #include "shared/behavior/human_tracker.hpp"
 #include "shared/behavior/pattern_classifier.hpp"
 #include "shared/behavior/social_force.hpp"
@@ -56,6 +57,7 @@ struct AwarenessConfig {
   SpeedStrategyParams speed;
   HumanTrackerParams tracker;
   PatternParams pattern;
+  ActiveLookParams active_look;  // where the PTZ head looks when nobody is ahead (active_look.hpp)
 };
 
 /// What the robot knows about people this tick.
@@ -98,6 +100,7 @@ class HumanAwareness {
   /// tracking and the classifier still run and are still reported. Experiments only.
   void overrideNextSpeedInput(const SpeedInput& in) { override_ = in; }
   const HumanTracker& tracker() const { return tracker_; }
+  const AwarenessConfig& config() const { return cfg_; }
   const PatternClassifier& classifier() const { return classifier_; }
 
  private:
