@@ -137,19 +137,29 @@ void VideoSender::start() {
   if (running_.exchange(true)) return;
   keyframe_requested_ = true;
   // Named, so that top -H and bench_loop's CPU per thread say which is which
-  // (the encoder's own threads inherit "video-encode").
-  capture_thread_ = std::thread([this] {
-    pthread_setname_np(pthread_self(), (s_.thread_prefix + "-capture").substr(0, 15).c_str());
+  // (the encoder's own threads inherit "<prefix>-encode"). The settings are
+  // read here, before the threads run: apply() may change s_ under mu_ later.
+  bool stream = true, retransmission = true;
+  std::string prefix;
+  {
+    std::lock_guard lk(mu_);
+    stream = s_.stream;
+    retransmission = s_.retransmission;
+    prefix = s_.thread_prefix;
+  }
+  const auto named = [](const std::string& name) { pthread_setname_np(pthread_self(), name.substr(0, 15).c_str()); };
+  capture_thread_ = std::thread([this, named, n = prefix + "-capture"] {
+    named(n);
     captureLoop();
   });
-  if (!s_.stream) return;
-  encode_thread_ = std::thread([this] {
-    pthread_setname_np(pthread_self(), (s_.thread_prefix + "-encode").substr(0, 15).c_str());
+  if (!stream) return;
+  encode_thread_ = std::thread([this, named, n = prefix + "-encode"] {
+    named(n);
     encodeLoop();
   });
-  if (s_.retransmission)
-    feedback_thread_ = std::thread([this] {
-      pthread_setname_np(pthread_self(), (s_.thread_prefix + "-rtcp").substr(0, 15).c_str());
+  if (retransmission)
+    feedback_thread_ = std::thread([this, named, n = prefix + "-rtcp"] {
+      named(n);
       feedbackLoop();
     });
 }

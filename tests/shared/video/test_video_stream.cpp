@@ -493,7 +493,9 @@ TEST(VideoStreamClean, DecodesNearlyEveryFrameWithTimecodeSizeAndLatency) {
               static_cast<unsigned long>(s.stream.decode_errors));
 
   expectSound(s, "clean");
-  ASSERT_GT(s.sender.encoded, 30u) << "the sender produced almost nothing in 2 s";
+  // About 60 in 2 s; "almost nothing" is under 10 (the sanitizer stage, four
+  // test programs on 2 cores, encoded 21 in one clean-clone run).
+  ASSERT_GT(s.sender.encoded, 10u) << "the sender produced almost nothing in 2 s";
   EXPECT_GE(static_cast<double>(s.stream.decoded), 0.9 * static_cast<double>(s.sender.encoded));
   EXPECT_EQ(s.stream.lost_packets, 0u);
   EXPECT_EQ(s.stream.frames_dropped, 0u);
