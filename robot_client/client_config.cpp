@@ -11,6 +11,13 @@ namespace inspect::client {
 
 bool validRobotId(const std::string& id) { return net::validRobotId(id); }
 
+bool showsPeople(const std::string& source) { return source != "synthetic"; }
+
+std::string wideSourceProblem(const std::string& source) {
+  return source.empty() || showsPeople(source) ? ""
+                                               : "the synthetic picture shows nobody: a camera, a file or sim:PATH";
+}
+
 namespace {
 // A head's detection settings (perception: the PTZ head; wide_head).
 void readDetection(const config::ConfigNode& n, DetectionParams& d) {
@@ -117,7 +124,7 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   const auto wh = root.optChild("wide_head");
   auto& wp = c.wide_head;
   wp.source = wh.string("source", wp.source);
-  if (wp.source == "synthetic") wh.fail("source", "the synthetic picture shows nobody: a camera, a file or sim:PATH, or \"\" for none");
+  if (const auto why = wideSourceProblem(wp.source); !why.empty()) wh.fail("source", why + ", or \"\" for none");
   readDetection(wh, wp);
   if (wp.width % 2 || wp.height % 2) wh.fail("width", "width and height must be even");
   wp.fps = wh.number("fps", wp.fps, 1, 120);

@@ -108,6 +108,12 @@ struct ClientConfig {
   std::string map_file;  // world file whose walls people tracking ignores ("" = no map); --map overrides
 };
 
+/// Whether a video source can show people: a camera, a file, the simulator's
+/// camera; not the synthetic test picture.
+bool showsPeople(const std::string& source);
+/// Why `source` cannot be the wide head's ("" = it can): the synthetic picture shows nobody.
+std::string wideSourceProblem(const std::string& source);
+
 /// True for ids made of [A-Za-z0-9_-], 1 to 64 characters.
 bool validRobotId(const std::string& id);
 

@@ -178,8 +178,8 @@ void applyArgs(const CliArgs& o, inspect::client::ClientConfig& cfg) {
   }
   if (!o.video_source.empty()) cfg.video.source = o.video_source;
   if (!o.wide_video_source.empty()) {
-    if (o.wide_video_source == "synthetic")
-      throw config::ConfigError("--wide-video-source: the synthetic picture shows nobody: a camera, a file or sim:PATH");
+    if (const auto why = client::wideSourceProblem(o.wide_video_source); !why.empty())
+      throw config::ConfigError("--wide-video-source: " + why);
     cfg.wide_head.source = o.wide_video_source;
   }
   if (o.no_video) cfg.video.enabled = false;

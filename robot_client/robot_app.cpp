@@ -42,9 +42,6 @@ video::SenderSettings senderSettings(const ClientConfig& cfg) {
   return s;
 }
 
-// A source that can show people: a camera, a file, the simulator's camera (not the synthetic test picture).
-bool showsPeople(const std::string& source) { return source != "synthetic"; }
-
 WatcherSettings watcherSettings(const DetectionParams& p, const config::CameraMount& mount) {
   WatcherSettings w;
   if (!perception::parseDetectorMethod(p.detector, w.detector.method))
