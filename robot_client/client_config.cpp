@@ -129,6 +129,8 @@ ClientConfig loadClientConfig(const config::ConfigNode& root) {
   if (wp.width % 2 || wp.height % 2) wh.fail("width", "width and height must be even");
   wp.fps = wh.number("fps", wp.fps, 1, 120);
   wp.pixel_format = readPixelFormat(wh, wp.pixel_format);
+  wp.stream = wh.boolean("stream", wp.stream);
+  wp.bitrate_kbps = static_cast<int>(wh.integer("bitrate_kbps", wp.bitrate_kbps, 50, 50000));
   return c;
 }
 

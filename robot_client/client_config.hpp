@@ -56,7 +56,8 @@ struct PerceptionParams : DetectionParams {
 
 /// The wide, fixed head (robot.yaml's wide_camera; docs/human-awareness.md
 /// "The wide head"): its own source, captured and detected on the robot,
-/// not streamed. The bench's choice: HOG at 480x360, one window agreeing.
+/// streamed beside the PTZ head's when `stream` is on (docs/video.md "The
+/// wide head's stream"). The bench's choice: HOG at 480x360, one window agreeing.
 struct WideHeadParams : DetectionParams {
   WideHeadParams() {
     width = 480;
@@ -66,6 +67,8 @@ struct WideHeadParams : DetectionParams {
   std::string source;                // "" = no wide head; "v4l2:/dev/videoN", "file:PATH", "sim:PATH"
   double fps = 15.0;                 // captured at most this often (detection takes rate_hz of them)
   std::string pixel_format;          // V4L2 FOURCC asked of a camera; "" = driver's
+  bool stream = false;               // also stream it (H.264/RTP to video.host:video.port, its own SSRC)
+  int bitrate_kbps = 800;            // ...at this bitrate (the rest of the encoder's settings: video:)
 };
 
 /// Mutual TLS on the link (docs/security.md); relative paths are from the working directory.

@@ -64,10 +64,12 @@ options:
                        v4l2:/dev/videoN, file:PATH or sim:PATH (the simulated
                        camera of mcu_sim --camera PATH)
   --video-port PORT    UDP port of the server's video receiver (overrides video.port)
-  --wide-video-source URI  the wide, fixed head's pictures, detected on the robot and not
-                       streamed (overrides wide_head.source; needs wide_camera in the robot
+  --wide-video-source URI  the wide, fixed head's pictures, detected on the robot
+                       (overrides wide_head.source; needs wide_camera in the robot
                        config): v4l2:/dev/videoN, file:PATH or sim:PATH (mcu_sim --wide-camera PATH)
-  --no-video           do not stream video (overrides video.enabled)
+  --wide-stream        stream the wide head's pictures too (wide_head.stream: true)
+  --no-video           do not stream video, neither head (overrides video.enabled and
+                       wide_head.stream; the heads' people detection goes on)
   --version            print the version and exit
   --help               print this help and exit
 
@@ -94,7 +96,7 @@ struct CliArgs {
   std::optional<int> video_port, realtime_priority;
   std::optional<std::string> journal;
   std::optional<inspect::robot::GasReaction> gas_reaction;
-  bool no_video = false, plaintext = false;
+  bool no_video = false, plaintext = false, wide_stream = false;
 };
 
 /// Reads the command line (--help and --version print and exit 0; a usage error exits 2).
@@ -131,6 +133,7 @@ CliArgs parseArgs(int argc, char** argv) {
       else if (a.is("--realtime-priority")) o.realtime_priority = static_cast<int>(a.integer(0, 99));
       else if (a.is("--plaintext")) o.plaintext = true;
       else if (a.is("--no-video")) o.no_video = true;
+      else if (a.is("--wide-stream")) o.wide_stream = true;
       else if (a.is("--gas-reaction")) o.gas_reaction = robot::gasReactionOf(a.choice({"continue", "stop", "retreat"}));
       else a.unknown();
     }
@@ -182,7 +185,8 @@ void applyArgs(const CliArgs& o, inspect::client::ClientConfig& cfg) {
       throw config::ConfigError("--wide-video-source: " + why);
     cfg.wide_head.source = o.wide_video_source;
   }
-  if (o.no_video) cfg.video.enabled = false;
+  if (o.wide_stream) cfg.wide_head.stream = true;
+  if (o.no_video) cfg.video.enabled = cfg.wide_head.stream = false;
   if (o.video_port) cfg.video.port = *o.video_port;
   if (o.realtime_priority) cfg.realtime_priority = *o.realtime_priority;
 }

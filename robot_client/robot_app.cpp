@@ -123,8 +123,12 @@ void RobotApp::openWideHead(const config::RobotConfig& robot) {
     return;
   }
   wide_mount_ = *robot.wide_camera;
-  video::SenderSettings s;
-  s.stream = false;
+  // Streamed: video:'s encoder and destination, its own source, bitrate and SSRC (docs/video.md).
+  video::SenderSettings s = senderSettings(cfg_);
+  s.enabled = true;
+  s.stream = w.stream;
+  s.encoder.bitrate_kbps = w.bitrate_kbps;
+  s.adapt.max_kbps = 0;
   s.thread_prefix = "wide";
   s.source.uri = w.source;
   s.source.width = w.width;
@@ -139,7 +143,8 @@ void RobotApp::openWideHead(const config::RobotConfig& robot) {
     wide_video_->setPictureTap([p = wide_watcher_.get()](const cv::Mat& bgr, uint64_t us) { p->offer(bgr, us); });
     log::info("perception", "wide head ", w.source, " (", wide_mount_.hfov_deg, " deg): people detector ",
               wide_watcher_->stats().detector, " at ", w.width, "x", w.height, ", at most ", w.rate_hz, " Hz and ",
-              w.max_core_share * 100, " % of a core");
+              w.max_core_share * 100, " % of a core",
+              w.stream ? "; streamed at " + std::to_string(w.bitrate_kbps) + " kbit/s" : std::string("; not streamed"));
   } catch (const std::exception& e) {
     log::error("perception", "wide head: ", e.what(), ": not used");
     wide_watcher_.reset();
@@ -252,7 +257,11 @@ void RobotApp::onServerMessage(const v1::Envelope& env) {
 
 v1::Ack RobotApp::onVideoCommand(const v1::Command& cmd) {
   const auto& v = cmd.video();
-  if (!video_) return ack(cmd.id(), v1::Ack::REJECTED, "video: this robot has no video stream (see its log)");
+  const bool wide = v.head() == v1::WIDE_HEAD;
+  video::VideoSender* const sender = wide ? wide_video_.get() : video_.get();
+  if (wide && (!sender || !cfg_.wide_head.stream))
+    return ack(cmd.id(), v1::Ack::REJECTED, "video: this robot does not stream a wide head (wide_head.stream)");
+  if (!sender) return ack(cmd.id(), v1::Ack::REJECTED, "video: this robot has no video stream (see its log)");
   video::SenderChange c;
   if (v.has_enabled()) c.enabled = v.enabled();
   if (v.width() || v.height()) {
@@ -261,8 +270,8 @@ v1::Ack RobotApp::onVideoCommand(const v1::Command& cmd) {
   }
   if (v.fps() != 0) c.fps = v.fps();
   if (v.bitrate_kbps()) c.bitrate_kbps = static_cast<int>(v.bitrate_kbps());
-  if (const auto why = video_->apply(c); !why.empty()) return ack(cmd.id(), v1::Ack::REJECTED, why);
-  if (v.keyframe()) video_->requestKeyframe();
+  if (const auto why = sender->apply(c); !why.empty()) return ack(cmd.id(), v1::Ack::REJECTED, why);
+  if (v.keyframe()) sender->requestKeyframe();
   return ack(cmd.id(), v1::Ack::ACCEPTED);
 }
 
@@ -414,12 +423,18 @@ void RobotApp::fillHead(const PeopleWatcher& w, v1::Perception& p) const {
 void RobotApp::fillVideoStatus(v1::Telemetry& t) const {
   t.set_ptz_pan_rad(ptz_pan_rad_);
   t.set_ptz_tilt_rad(ptz_tilt_rad_);
-  if (!video_) {
+  if (video_)
+    fillStream(video_->stats(), *t.mutable_video());
+  else
     t.clear_video();
-    return;
-  }
-  const auto s = video_->stats();
-  auto* v = t.mutable_video();
+  if (wide_video_ && cfg_.wide_head.stream)
+    fillStream(wide_video_->stats(), *t.mutable_wide_video());
+  else
+    t.clear_wide_video();
+}
+
+void RobotApp::fillStream(const video::SenderStats& s, v1::VideoStatus& status) {
+  auto* v = &status;
   v->set_enabled(s.enabled);
   v->set_ssrc(s.ssrc);
   v->set_width(static_cast<uint32_t>(s.width));

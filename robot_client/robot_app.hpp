@@ -52,6 +52,8 @@ class RobotApp {
   /// Sends a camera set-point to the MCU; "" or why not.
   std::string applyPtz(const v1::Ptz& p);
   void fillVideoStatus(v1::Telemetry& t) const;
+  /// One head's stream figures (Telemetry.video, .wide_video).
+  static void fillStream(const video::SenderStats& s, v1::VideoStatus& v);
   void fillPerception(v1::Telemetry& t) const;
   /// Turns the camera ahead while a tracked person is near and the robot
   /// moves, and gives the PTZ back look_ahead_hold_s after (perception.look_ahead).

@@ -316,7 +316,7 @@ int main(int argc, char** argv) {
     while (feeding) {
       f.keyframe = n % 30 == 0;
       f.annexb.assign(f.keyframe ? 40000 : 8000, 0x55);
-      bridge.onAccessUnit("robot1", f, monoNowUs());
+      bridge.onAccessUnit("robot1", v1::PTZ_HEAD, f, monoNowUs());
       ++n;
       next += std::chrono::microseconds(33333);
       std::this_thread::sleep_until(next);

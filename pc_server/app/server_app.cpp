@@ -36,6 +36,7 @@
 #include "pc_server/recording/fleet_presence.hpp"
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/video/video_hub.hpp"
+#include "pc_server/video/video_streams.hpp"
 #include "pc_server/video/video_stats_proto.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/file_util.hpp"
@@ -199,9 +200,10 @@ std::unique_ptr<VideoHub> startVideo(const ServerConfig& config, const CliOption
     });
   }
   // Every intact access unit goes to the run's recording and to the Foxglove clients, as received.
-  video->setAccessUnitHook([recorder, &bridge_ptr](const std::string& robot, const video::Frame& f, uint64_t capture_us) {
-    if (recorder) recorder->onAccessUnit(robot, f, capture_us);
-    if (auto* b = bridge_ptr.load()) b->onAccessUnit(robot, f, capture_us);
+  video->setAccessUnitHook([recorder, &bridge_ptr](const std::string& stream, const video::Frame& f, uint64_t capture_us) {
+    const StreamRef s = parseStreamName(stream);
+    if (recorder) recorder->onAccessUnit(s.robot, s.head, f, capture_us);
+    if (auto* b = bridge_ptr.load()) b->onAccessUnit(s.robot, s.head, f, capture_us);
   });
   video->start();
   std::cout << "pc_server: video on UDP port " << video->port() << ", SDP files in " << config.video.dir << "/"

@@ -12,6 +12,7 @@
 #include "pc_server/recording/recorder.hpp"
 #include "pc_server/scene/site_maps.hpp"
 #include "pc_server/video/video_hub.hpp"
+#include "pc_server/video/video_streams.hpp"
 #include "shared/config/config_node.hpp"
 #include "shared/util/clock.hpp"
 
@@ -143,8 +144,10 @@ bool MotionCommands::cmdVideo(const CommandArgs& a) {
     v.what = W::kBitrate;
     v.bitrate_kbps = static_cast<long long>(*a.number("kbit/s"));
   } else {
-    v.what = what == "on" ? W::kOn : what == "off" ? W::kOff : W::kKeyframe;
+    const std::string& w = a.has("wide") ? a.text("what") : what;
+    v.what = w == "on" ? W::kOn : w == "off" ? W::kOff : W::kKeyframe;
   }
+  if (a.has("wide")) v.head = v1::WIDE_HEAD;
   return c_.report(c_.service().video(c_.session(), c_.selected(), v, c_.clock().nowNs()));
 }
 
@@ -166,7 +169,8 @@ bool MotionCommands::cmdSnapshot(const CommandArgs& a) {
   if (!c_.video()) return c_.fail("snapshot", "the server runs without video (video.enabled: false or --no-video)");
   if (c_.selected().empty()) return c_.fail("snapshot", "no robot selected");
   try {
-    const std::string path = c_.video()->snapshot(c_.selected(), a.text("file.png"));
+    const std::string path = c_.video()->snapshot(
+        streamName(c_.selected(), a.has("wide") ? v1::WIDE_HEAD : v1::PTZ_HEAD), a.text("file.png"));
     c_.out() << c_.selected() << ": snapshot " << path << "\n";
     return true;
   } catch (const std::exception& e) {
@@ -242,8 +246,10 @@ std::vector<ConsoleCommand> MotionCommands::commands() {
      {{choice("what", {"on", "off", "keyframe", "stats"})},
       {keyword("res"), wanting(size("size"), kVideoSizeWant)},
       {keyword("fps"), wanting(number("n"), kVideoFpsWant)},
-      {keyword("bitrate"), wanting(integer("kbit/s"), kVideoBitrateWant)}},
-     "control the selected robot's camera stream; show its figures",
+      {keyword("bitrate"), wanting(integer("kbit/s"), kVideoBitrateWant)},
+      {keyword("wide"), choice("what", {"on", "off", "keyframe"})},
+      {keyword("wide"), keyword("bitrate"), wanting(integer("kbit/s"), kVideoBitrateWant)}},
+     "control the selected robot's camera streams; show their figures",
      "  on/off start and stop streaming; keyframe asks for an IDR now (the server also asks by\n"
      "  itself, at most every 0.3 s, when it lost part of a picture).\n"
      "  res: even width and height, 64 to 4096 (e.g. 1280x720); fps: 1 to 120; bitrate: 50 to\n"
@@ -252,15 +258,20 @@ std::vector<ConsoleCommand> MotionCommands::commands() {
      "  counters, the SDP file for players, and the robot's encoder figures.\n"
      "  Play the stream elsewhere: ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer\n"
      "    -flags low_delay video/robot1.sdp   (the server forwards the RTP to the SDP's port)\n"
-     "  example: video res 1280x720\n",
+     "  wide ...: the same for the wide head's stream, on a robot that streams it\n"
+     "  (wide_head.stream; video/robot1.wide.sdp); stats shows both.\n"
+     "  example: video res 1280x720\n"
+     "  example: video wide bitrate 500\n",
      handler(this, &MotionCommands::cmdVideo)},
     {"ptz", {{number("pan_deg"), number("tilt_deg")}, {keyword("home")}}, "point the camera mount (sent to the MCU)",
      "  pan counter-clockwise positive, [-180, 180] degrees; tilt up positive, [-90, 90].\n"
      "  example: ptz 30 -10\n",
      handler(this, &MotionCommands::cmdPtz)},
-    {"snapshot", {{opt(word("file.png"))}}, "save the selected robot's latest decoded picture as PNG",
+    {"snapshot", {{keyword("wide"), opt(word("file.png"))}, {opt(word("file.png"))}},
+     "save the selected robot's latest decoded picture as PNG",
      "  Default file: <video.dir>/<robot>_<n>.png. Without a display the server also keeps\n"
-     "  <video.dir>/<robot>_latest.png fresh (video.snapshot_period_s).\n",
+     "  <video.dir>/<robot>_latest.png fresh (video.snapshot_period_s).\n"
+     "  snapshot wide: the wide head's picture (<robot>.wide_<n>.png), when the robot streams it.\n",
      handler(this, &MotionCommands::cmdSnapshot)},
     {"foxglove", noArguments(), "the Foxglove bridge: clients, subscriptions, send queues, drops",
      "  One line per connected Foxglove/Lichtblick client (its operator session, how long it has\n"

@@ -7,6 +7,7 @@
 #include "pc_server/console/expect_check.hpp"
 #include "pc_server/console/text_util.hpp"
 #include "pc_server/video/video_hub.hpp"
+#include "pc_server/video/video_streams.hpp"
 
 namespace inspect::server {
 
@@ -70,6 +71,32 @@ std::string videoFigures(const RobotSnapshot& snap, const VideoHub* video) {
   return " | video " + fmtFixed(st->fps_received, 0) + "/" + fmtFixed(st->fps_decoded, 0) + " fps " +
          fmtFixed(st->kbps, 0) + " kbit/s loss " + fmtFixed(st->loss_pct, 1) + "% lat " +
          (st->latency_ms < 0 ? std::string("--") : fmtFixed(st->latency_ms, 0)) + " ms" + rateNote(tv);
+}
+}  // namespace
+
+namespace {
+/// The wide head's stream (docs/video.md "The wide head's stream"): the robot's and the server's figures.
+template <typename Line>
+void wideStreamLines(const Line& line, const std::string& robot_id, const v1::VideoStatus& v, const VideoHub& video) {
+  line("wide stream", std::string(v.enabled() ? "on" : "off") + ", " + v.source() + " " + std::to_string(v.width()) +
+                          "x" + std::to_string(v.height()) + " @ " + fmtShort(v.fps()) + " fps, " + v.encoder() + " " +
+                          std::to_string(v.rate_kbps() ? v.rate_kbps() : v.bitrate_kbps()) + " kbit/s, SSRC " +
+                          std::to_string(v.ssrc()) + "; captured " + std::to_string(v.frames_captured()) +
+                          ", encoded " + std::to_string(v.frames_encoded()) + ", dropped " +
+                          std::to_string(v.frames_dropped()) + (v.error().empty() ? "" : "; error: " + v.error()));
+  const std::string name = streamName(robot_id, v1::WIDE_HEAD);
+  if (const auto st = video.stats(name))
+    line("wide received", fmtFixed(st->fps_received, 1) + " fps, decoded " + fmtFixed(st->fps_decoded, 1) + " fps, " +
+                              fmtFixed(st->kbps, 0) + " kbit/s, loss " + fmtFixed(st->loss_pct, 2) + "%, " +
+                              std::to_string(st->width) + "x" + std::to_string(st->height) + ", latency p50 " +
+                              fmtFixed(st->latency_p50_ms, 1) + " ms, p99 " + fmtFixed(st->latency_p99_ms, 1) +
+                              " ms, frames " + std::to_string(st->frames) + ", lost packets " +
+                              std::to_string(st->lost_packets));
+  else
+    line("wide received", "no stream yet");
+  if (const auto sdp = video.sdpPath(name); !sdp.empty())
+    line("wide play", "ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay " + sdp +
+                          "   (RTP forwarded to 127.0.0.1:" + std::to_string(video.forwardPort(name)) + ")");
 }
 }  // namespace
 
@@ -149,6 +176,8 @@ std::string videoReport(const std::string& robot_id, const std::optional<RobotSn
   if (!sdp.empty())
     line("play", "ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay " + sdp +
                      "   (RTP forwarded to 127.0.0.1:" + std::to_string(video->forwardPort(robot_id)) + ")");
+  if (snap && snap->has_telemetry && snap->telemetry.has_wide_video())
+    wideStreamLines(line, robot_id, snap->telemetry.wide_video(), *video);
   return s;
 }
 

@@ -30,7 +30,8 @@ constexpr auto kRefusalDebounce = std::chrono::seconds(1);
 }  // namespace
 
 std::vector<uint32_t> FoxgloveBridge::RobotChannels::all() const {
-  std::vector<uint32_t> ids{telemetry, events, acks, alarms, camera, camera_people, tf, scene, log, video_stats};
+  std::vector<uint32_t> ids{telemetry, events, acks,  alarms,      camera,      camera_people,
+                            tf,        scene,  log,   video_stats, camera_wide, camera_wide_people};
   for (const auto& [name, id] : grids) ids.push_back(id);
   std::erase(ids, 0u);
   return ids;
@@ -120,6 +121,15 @@ void FoxgloveBridge::advertiseRobot(const std::string& robot, RobotState& r) {
   log::info(kTag, robot, ": channels advertised");
 }
 
+void FoxgloveBridge::advertiseWideHead(const std::string& robot, RobotState& r) {
+  r.ch.camera_wide = addChannel(scene::topicName(robot, scene::TopicKind::kCameraWide),
+                                scene::topicDef(scene::TopicKind::kCameraWide).type(), WsServer::Kind::kVideo);
+  r.ch.camera_wide_people =
+      addChannel(scene::topicName(robot, scene::TopicKind::kCameraWidePeople),
+                 scene::topicDef(scene::TopicKind::kCameraWidePeople).type(), WsServer::Kind::kData);
+  log::info(kTag, robot, ": the wide head's channels advertised");
+}
+
 void FoxgloveBridge::unadvertiseRobot(RobotState& r) {
   for (const uint32_t id : r.ch.all()) server_.removeChannel(id);
   r.ch = {};
@@ -147,6 +157,12 @@ void FoxgloveBridge::onEnvelope(const std::string& robot, const v1::Envelope& en
       const int64_t link_offset_us = static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us());
       if (const auto people = r.feed->cameraPeople(t, link_offset_us); people && server_.subscribed(r.ch.camera_people))
         publishMessage(r.ch.camera_people, people->first, people->second);
+      if (t.has_wide_video()) {
+        if (!r.ch.camera_wide) advertiseWideHead(robot, r);
+        if (const auto people = r.feed->cameraPeople(t, link_offset_us, v1::WIDE_HEAD);
+            people && server_.subscribed(r.ch.camera_wide_people))
+          publishMessage(r.ch.camera_wide_people, people->first, people->second);
+      }
       if (server_.subscribed(r.ch.tf)) publishMessage(r.ch.tf, ns, r.feed->scene().transforms(ns));
       break;
     }
@@ -162,18 +178,19 @@ void FoxgloveBridge::onEnvelope(const std::string& robot, const v1::Envelope& en
   }
 }
 
-void FoxgloveBridge::onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us) {
+void FoxgloveBridge::onAccessUnit(const std::string& robot, v1::CameraHead head, const video::Frame& frame,
+                                  uint64_t capture_us) {
   uint32_t channel = 0;
   const uint64_t ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
   {
     std::lock_guard lk(mu_);
     const auto it = robots_.find(robot);
     if (it == robots_.end() || !it->second.connected) return;
-    if (it->second.feed) it->second.feed->onAccessUnit(frame, capture_us, ns);
-    channel = it->second.ch.camera;
+    if (it->second.feed) it->second.feed->onAccessUnit(frame, capture_us, ns, head);
+    channel = head == v1::WIDE_HEAD ? it->second.ch.camera_wide : it->second.ch.camera;
   }
-  if (!server_.subscribed(channel)) return;
-  const auto v = scene::RobotScene::cameraFrame(robot, frame, ns);
+  if (channel == 0 || !server_.subscribed(channel)) return;
+  const auto v = scene::RobotScene::cameraFrame(robot, frame, ns, head);
   server_.publish(channel, ns, std::make_shared<const std::string>(v.SerializeAsString()), frame.keyframe);
 }
 
@@ -293,23 +310,26 @@ void FoxgloveBridge::onClientClose(uint64_t client) {
 }
 
 void FoxgloveBridge::onSubscribe(uint64_t client, uint32_t channel) {
-  // A new video subscriber needs a keyframe to start from: ask the robot (at most once a second).
+  // A new video subscriber needs a keyframe to start from: ask the robot (at most once a second per head).
   std::string robot;
+  VideoRequest keyframe;
+  keyframe.what = VideoRequest::What::kKeyframe;
   {
     std::lock_guard lk(mu_);
     for (auto& [id, r] : robots_) {
-      if (!r.connected || r.ch.camera != channel) continue;
+      if (!r.connected || channel == 0 || (r.ch.camera != channel && r.ch.camera_wide != channel)) continue;
+      const bool wide = r.ch.camera_wide == channel;
+      auto& asked = wide ? r.wide_keyframe_asked : r.keyframe_asked;
       const auto now = SteadyClock::now();
-      if (now - r.keyframe_asked < std::chrono::seconds(1)) return;
-      r.keyframe_asked = now;
+      if (now - asked < std::chrono::seconds(1)) return;
+      asked = now;
       robot = id;
+      keyframe.head = wide ? v1::WIDE_HEAD : v1::PTZ_HEAD;
     }
   }
   if (robot.empty()) return;
   // The camera's settings need no control; the Ack is not waited for.
   const auto op = operatorOf(client);
-  VideoRequest keyframe;
-  keyframe.what = VideoRequest::What::kKeyframe;
   (void)service_.video(op ? op->session() : 0, robot, keyframe, monoNowNs());
 }
 

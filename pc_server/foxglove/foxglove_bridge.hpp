@@ -59,8 +59,9 @@ class FoxgloveBridge : public WsServer::Handler {
 
   /// Every envelope to or from a robot (LinkServer's observer; any thread).
   void onEnvelope(const std::string& robot, const v1::Envelope& env, bool inbound, uint64_t time_us);
-  /// Every intact access unit of a robot's camera (VideoHub's hook).
-  void onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us);
+  /// Every intact access unit of a robot's camera head (VideoHub's hook):
+  /// /<robot>/camera, or /<robot>/camera_wide for the wide head.
+  void onAccessUnit(const std::string& robot, v1::CameraHead head, const video::Frame& frame, uint64_t capture_us);
 
   /// The `foxglove` console command's text: clients, subscriptions, queues, drops.
   std::string report() const;
@@ -79,6 +80,8 @@ class FoxgloveBridge : public WsServer::Handler {
   struct RobotChannels {
     uint32_t telemetry = 0, events = 0, acks = 0, alarms = 0, camera = 0, camera_people = 0, tf = 0, scene = 0, log = 0,
              video_stats = 0;
+    // The wide head's, advertised once the robot's telemetry shows its stream (Telemetry.wide_video).
+    uint32_t camera_wide = 0, camera_wide_people = 0;
     std::map<std::string, uint32_t> grids;  // gas channel -> channel id
     std::vector<uint32_t> all() const;
   };
@@ -88,7 +91,8 @@ class FoxgloveBridge : public WsServer::Handler {
     bool connected = false;
     std::chrono::steady_clock::time_point last_grid{};
     std::chrono::steady_clock::time_point last_video_stats{};
-    std::chrono::steady_clock::time_point keyframe_asked{};  // for a new video subscriber, at most once a second
+    // For a new video subscriber, at most once a second per head.
+    std::chrono::steady_clock::time_point keyframe_asked{}, wide_keyframe_asked{};
   };
   struct Client {
     std::shared_ptr<ClientOperator> op;
@@ -104,6 +108,7 @@ class FoxgloveBridge : public WsServer::Handler {
   void deadman();      // every 50 ms: teleop set-points that lapsed
   void advertiseRobot(const std::string& robot, RobotState& r);
   void unadvertiseRobot(RobotState& r);
+  void advertiseWideHead(const std::string& robot, RobotState& r);
   uint32_t addChannel(const std::string& topic, const google::protobuf::Descriptor* d, WsServer::Kind kind);
   void publishMessage(uint32_t channel, uint64_t ns, const google::protobuf::Message& m);
   void teleop(uint64_t client, const std::string& robot, std::string_view payload);

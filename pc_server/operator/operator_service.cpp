@@ -184,6 +184,7 @@ Issued OperatorService::video(uint64_t session, const std::string& robot, const 
   using W = VideoRequest::What;
   v1::Command c;
   auto* v = c.mutable_video();
+  v->set_head(r.head);
   std::string what;
   switch (r.what) {
     case W::kOn:
@@ -217,7 +218,7 @@ Issued OperatorService::video(uint64_t session, const std::string& robot, const 
       what = "bitrate";
       break;
   }
-  return send(session, robot, "video " + what, std::move(c), now_ns);
+  return send(session, robot, std::string(r.head == v1::WIDE_HEAD ? "video wide " : "video ") + what, std::move(c), now_ns);
 }
 
 Issued OperatorService::teleop(uint64_t session, const std::string& robot, double v_m_s, double w_rad_s,

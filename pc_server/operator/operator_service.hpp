@@ -95,6 +95,7 @@ struct VideoRequest {
   long long width = 0, height = 0;  // kRes
   double fps = 0.0;                 // kFps
   long long bitrate_kbps = 0;       // kBitrate
+  v1::CameraHead head = v1::PTZ_HEAD;  // which head's stream
 };
 
 class OperatorService {

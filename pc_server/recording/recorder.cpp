@@ -1,4 +1,5 @@
 #include "pc_server/recording/recorder.hpp"
+#include "pc_server/recording/recorder_run.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -55,28 +56,6 @@ std::string runGainsJson(const v1::Gains& g, uint32_t version) {
   j["a3"] = g.a3();
   return j.dump();
 }
-
-struct Recorder::Run {
-  catalog::RunInfo info;
-  record::McapWriter mcap;
-  uint16_t ch_telemetry = 0, ch_command = 0, ch_ack = 0, ch_event = 0, ch_server = 0, ch_camera = 0, ch_info = 0;
-  // The 3-D scene: the live bridge's SceneFeed, so that the run replays the same view.
-  std::unique_ptr<scene::SceneFeed> feed;
-  uint16_t ch_tf = 0, ch_scene = 0, ch_log = 0, ch_camera_people = 0;
-  std::map<std::string, uint16_t> ch_grid;
-  uint64_t last_tf_ns = 0, last_scene_ns = 0, last_grid_ns = 0;
-  std::unique_ptr<video::Mp4Writer> mp4;
-  std::string mp4_error;
-  RunStats stats;
-  uint64_t command_id = 0;   // the track/goto command that started it (ends it on COMPLETED/FAILED)
-  std::string address;       // robot's link address, to notice reconnects
-  uint64_t video_frames = 0;
-  uint64_t last_telemetry_ns = 0;  // log time of the latest telemetry, to mark gaps
-  bool gains_known = false;  // gains_json names the tracking controller
-  nlohmann::json gains = nlohmann::json::object();  // the run's gains_json
-
-  explicit Run(record::McapWriterOptions o) : mcap(std::move(o)) {}
-};
 
 Recorder::Recorder(const RecordingConfig& config, std::string software_version)
     : config_(config), software_version_(std::move(software_version)) {

@@ -17,6 +17,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "inspect_robot/v1/link.pb.h"
@@ -61,8 +62,10 @@ class Recorder {
   /// Every envelope to or from a robot (LinkServer's observer).
   void onEnvelope(const std::string& robot, const std::string& address, const v1::Envelope& env, bool inbound,
                   uint64_t time_us);
-  /// Every intact access unit of a robot's camera (VideoReceiver's hook).
-  void onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us);
+  /// Every intact access unit of a robot's camera head (VideoReceiver's
+  /// hook): the PTZ head's into run.mcap's /<robot>/camera and video.mp4,
+  /// the wide head's into /<robot>/camera_wide.
+  void onAccessUnit(const std::string& robot, v1::CameraHead head, const video::Frame& frame, uint64_t capture_us);
   /// Closes MCAP chunks of quiet recordings; call every 100-200 ms.
   void tick();
   /// Where a new run gets the robot's controller gains in force (JSON; "{}" when unknown).
@@ -153,6 +156,8 @@ class Recorder {
   std::function<std::string(const std::string&)> gains_source_;
   std::function<std::optional<v1::Hello>(const std::string&)> hello_source_;
   void writeScene(Run& r, const std::string& robot, uint64_t ns, bool telemetry);
+  /// The run's wide-head channels (camera, people), made at the first use.
+  static std::pair<uint16_t, uint16_t> wideChannels(Run& r);
   scene::SiteMaps* site_maps_ = nullptr;
   scene::Geometry geometry_;
   std::map<std::string, std::string> pending_map_;  // robot -> map for its next run

@@ -4,6 +4,7 @@
 // MP4 and MCAP, and each run's 3-D scene (docs/recording.md). recorder.cpp
 // has the runs' life: start, stop, the catalog and the shared copies.
 #include "pc_server/recording/recorder.hpp"
+#include "pc_server/recording/recorder_run.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -58,9 +59,12 @@ void Recorder::recordTelemetryLocked(Run& r, const std::string& robot, const v1:
   }
   r.mcap.write(r.ch_telemetry, log_ns, env.send_time_us() * 1000, t);
   r.feed->onEnvelope(env, true);
-  if (const auto people =
-          r.feed->cameraPeople(t, static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us())))
+  const int64_t link_offset_us = static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us());
+  if (const auto people = r.feed->cameraPeople(t, link_offset_us))
     r.mcap.write(r.ch_camera_people, log_ns, people->first, people->second);
+  if (t.has_wide_video())
+    if (const auto people = r.feed->cameraPeople(t, link_offset_us, v1::WIDE_HEAD))
+      r.mcap.write(wideChannels(r).second, log_ns, people->first, people->second);
   writeScene(r, robot, log_ns, true);
 }
 
@@ -165,15 +169,36 @@ std::string Recorder::runAt(const std::string& robot, catalog::Time t) {
   return "";
 }
 
-void Recorder::onAccessUnit(const std::string& robot, const video::Frame& frame, uint64_t capture_us) {
+std::pair<uint16_t, uint16_t> Recorder::wideChannels(Run& r) {
+  if (!r.ch_camera_wide) {
+    using scene::TopicKind;
+    const auto add = [&](TopicKind kind) {
+      return r.mcap.addProtobufChannel(scene::topicDef(kind).type(), scene::topicName(r.info.robot, kind));
+    };
+    r.ch_camera_wide = add(TopicKind::kCameraWide);
+    r.ch_camera_wide_people = add(TopicKind::kCameraWidePeople);
+  }
+  return {r.ch_camera_wide, r.ch_camera_wide_people};
+}
+
+void Recorder::onAccessUnit(const std::string& robot, v1::CameraHead head, const video::Frame& frame,
+                            uint64_t capture_us) {
   std::lock_guard lk(mu_);
   auto it = runs_.find(robot);
   if (it == runs_.end()) return;
   Run& r = *it->second;
-  ++r.video_frames;
   const uint64_t capture_wall_ns = capture_us ? monoUsToWallNs(capture_us) : wallNowNs();
-  r.feed->onAccessUnit(frame, capture_us, capture_wall_ns);
-  const auto v = scene::RobotScene::cameraFrame(robot, frame, capture_wall_ns);
+  r.feed->onAccessUnit(frame, capture_us, capture_wall_ns, head);
+  const auto v = scene::RobotScene::cameraFrame(robot, frame, capture_wall_ns, head);
+  if (head == v1::WIDE_HEAD) {  // in run.mcap only; video.mp4 is the PTZ head's
+    try {
+      r.mcap.write(wideChannels(r).first, wallNowNs(), capture_wall_ns, v);
+    } catch (const std::exception& e) {
+      log::error(log::tag::kRecord, robot, ": run ", r.info.id, " wide video: ", e.what());
+    }
+    return;
+  }
+  ++r.video_frames;
   try {
     r.mcap.write(r.ch_camera, wallNowNs(), capture_wall_ns, v);
     if (r.mp4) r.mp4->write(frame.annexb.data(), frame.annexb.size(), frame.keyframe, capture_us ? capture_us : monoNowUs());

@@ -68,10 +68,9 @@ void CameraPeopleClock::onAccessUnit(const video::Frame& f, uint64_t capture_ser
   next_ = (next_ + 1) % kPictures;
 }
 
-std::optional<uint64_t> CameraPeopleClock::fresh(const v1::Telemetry& t, int64_t link_offset_us,
+std::optional<uint64_t> CameraPeopleClock::fresh(const v1::Perception& p, int64_t link_offset_us,
                                                  uint64_t (*to_wall_ns)(uint64_t)) {
-  if (!t.has_perception()) return std::nullopt;
-  const uint64_t c = t.perception().capture_us();
+  const uint64_t c = p.capture_us();
   if (c == 0 || c == last_capture_us_) return std::nullopt;
   last_capture_us_ = c;
   for (const auto& [robot_us, ns] : pictures_)

@@ -34,10 +34,11 @@ class CameraPeopleClock {
   /// A frame published on the camera channel at `ns`; capture_server_us is the
   /// frame's capture time after the receiver's offset (0: none).
   void onAccessUnit(const video::Frame& f, uint64_t capture_server_us, uint64_t ns);
-  /// The camera channel's timestamp of the picture of t.perception() if it has
-  /// not been returned before; nullopt otherwise or without a perception.
-  /// `to_wall_ns` turns a server monotonic µs into the channel's time (monoUsToWallNs).
-  std::optional<uint64_t> fresh(const v1::Telemetry& t, int64_t link_offset_us, uint64_t (*to_wall_ns)(uint64_t));
+  /// The camera channel's timestamp of the picture of `p` (a head's
+  /// Telemetry.perception) if it has not been returned before; nullopt
+  /// otherwise. `to_wall_ns` turns a server monotonic µs into the channel's
+  /// time (monoUsToWallNs).
+  std::optional<uint64_t> fresh(const v1::Perception& p, int64_t link_offset_us, uint64_t (*to_wall_ns)(uint64_t));
 
  private:
   std::optional<int64_t> video_offset_us_;

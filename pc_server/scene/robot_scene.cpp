@@ -142,6 +142,8 @@ Geometry geometryOf(const config::RobotConfig& c) {
   if (c.wide_camera) {
     g.wide_camera_x_m = c.wide_camera->x_m;
     g.wide_camera_y_m = c.wide_camera->y_m;
+    g.wide_camera_z_m = c.wide_camera->z_m;
+    g.wide_camera_tilt_deg = c.wide_camera->tilt_deg;
   }
   return g;
 }
@@ -248,6 +250,8 @@ void RobotScene::onEvent(const v1::Event& e) {
   // (+z ahead, +x right, +y down) from the mount's (+x ahead, +y left, +z up).
   const Quat optical{0.5, -0.5, 0.5, -0.5};
   add(frame("camera_mount"), frame("camera"), 0, 0, 0, pitchQ(-last_.ptz_tilt_rad()) * optical);
+  add(frame("base_link"), frame("camera_wide"), g_.wide_camera_x_m, g_.wide_camera_y_m, g_.wide_camera_z_m,
+      pitchQ(-g_.wide_camera_tilt_deg * std::numbers::pi / 180) * optical);
   return out;
 }
 
@@ -510,10 +514,11 @@ std::optional<::foxglove::Grid> RobotScene::grid(const std::string& channel, uin
   return g;
 }
 
-::foxglove::CompressedVideo RobotScene::cameraFrame(const std::string& robot, const video::Frame& f, uint64_t ns) {
+::foxglove::CompressedVideo RobotScene::cameraFrame(const std::string& robot, const video::Frame& f, uint64_t ns,
+                                                   v1::CameraHead head) {
   ::foxglove::CompressedVideo v;
   setTime(v.mutable_timestamp(), ns);
-  v.set_frame_id(robot + "/camera");
+  v.set_frame_id(robot + (head == v1::WIDE_HEAD ? "/camera_wide" : "/camera"));
   v.set_data(f.annexb.data(), f.annexb.size());
   v.set_format("h264");
   return v;

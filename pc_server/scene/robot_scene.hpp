@@ -45,7 +45,8 @@ struct Geometry {
   double sonar_z_m = 0.25;
   double camera_x_m = config::CameraMount{}.x_m, camera_y_m = config::CameraMount{}.y_m,
          camera_z_m = config::CameraMount{}.z_m;
-  double wide_camera_x_m = 0.24, wide_camera_y_m = 0.0;  // the wide head's lens (robot.yaml wide_camera)
+  // The wide head's lens (robot.yaml wide_camera; its frame "<robot>/camera_wide").
+  double wide_camera_x_m = 0.24, wide_camera_y_m = 0.0, wide_camera_z_m = 0.55, wide_camera_tilt_deg = 0.0;
 };
 Geometry geometryOf(const config::RobotConfig& c);
 
@@ -88,8 +89,10 @@ class RobotScene {
   /// The live concentration grid of a channel (nullopt: no data yet).
   std::optional<::foxglove::Grid> grid(const std::string& channel, uint64_t ns) const;
   /// A camera access unit as Foxglove's video message (frame "<robot>/camera",
-  /// the Annex B bytes as received: nothing re-encoded).
-  static ::foxglove::CompressedVideo cameraFrame(const std::string& robot, const video::Frame& f, uint64_t ns);
+  /// or "<robot>/camera_wide" for the wide head; the Annex B bytes as
+  /// received: nothing re-encoded).
+  static ::foxglove::CompressedVideo cameraFrame(const std::string& robot, const video::Frame& f, uint64_t ns,
+                                                 v1::CameraHead head = v1::PTZ_HEAD);
   /// A robot event as a log line (level from its kind).
   static ::foxglove::Log log(const std::string& robot, const v1::Event& e, uint64_t ns);
 

@@ -18,11 +18,15 @@ void SceneFeed::onEnvelope(const v1::Envelope& env, bool inbound) {
 }
 
 std::optional<std::pair<uint64_t, ::foxglove::ImageAnnotations>> SceneFeed::cameraPeople(const v1::Telemetry& t,
-                                                                                        int64_t link_offset_us) {
-  const auto capture_ns = people_clock_.fresh(t, link_offset_us, monoUsToWallNs);
+                                                                                        int64_t link_offset_us,
+                                                                                        v1::CameraHead head) {
+  const bool wide = head == v1::WIDE_HEAD;
+  if (!(wide ? t.has_wide_perception() : t.has_perception())) return std::nullopt;
+  const v1::Perception& p = wide ? t.wide_perception() : t.perception();
+  const v1::VideoStatus& v = wide ? t.wide_video() : t.video();
+  const auto capture_ns = clock(head).fresh(p, link_offset_us, monoUsToWallNs);
   if (!capture_ns) return std::nullopt;
-  return std::make_pair(*capture_ns,
-                        scene::cameraPeople(t.perception(), t.video().width(), t.video().height(), *capture_ns));
+  return std::make_pair(*capture_ns, scene::cameraPeople(p, v.width(), v.height(), *capture_ns));
 }
 
 void SceneFeed::followMap(SiteMaps& maps, const std::string& robot) {

@@ -24,15 +24,18 @@ class SceneFeed {
   /// A message to (inbound false: the commands) or from the robot.
   void onEnvelope(const v1::Envelope& env, bool inbound);
   void onHello(const v1::Hello& hello) { scene_.onHello(hello); }
-  /// A camera picture published at `ns` (capture_server_us: its capture on the server's clock, 0 = none).
-  void onAccessUnit(const video::Frame& f, uint64_t capture_server_us, uint64_t ns) {
-    people_clock_.onAccessUnit(f, capture_server_us, ns);
+  /// A head's camera picture published at `ns` (capture_server_us: its capture on the server's clock, 0 = none).
+  void onAccessUnit(const video::Frame& f, uint64_t capture_server_us, uint64_t ns,
+                    v1::CameraHead head = v1::PTZ_HEAD) {
+    clock(head).onAccessUnit(f, capture_server_us, ns);
   }
-  /// The people in the picture this telemetry is the first to report, with
-  /// that picture's timestamp on the camera channel; nullopt otherwise.
+  /// The people in the head's picture this telemetry is the first to report
+  /// (Telemetry.perception, .wide_perception), with that picture's timestamp
+  /// on the head's camera channel; nullopt otherwise.
   /// link_offset_us: receive - send of the telemetry's envelope.
   std::optional<std::pair<uint64_t, ::foxglove::ImageAnnotations>> cameraPeople(const v1::Telemetry& t,
-                                                                                 int64_t link_offset_us);
+                                                                                 int64_t link_offset_us,
+                                                                                 v1::CameraHead head = v1::PTZ_HEAD);
   /// Takes the robot's site map from `maps` when it changed since the last call.
   void followMap(SiteMaps& maps, const std::string& robot);
 
@@ -40,7 +43,8 @@ class SceneFeed {
 
  private:
   RobotScene scene_;
-  CameraPeopleClock people_clock_;
+  CameraPeopleClock& clock(v1::CameraHead head) { return head == v1::WIDE_HEAD ? wide_clock_ : people_clock_; }
+  CameraPeopleClock people_clock_, wide_clock_;
   uint64_t map_version_ = 0;
 };
 

@@ -29,6 +29,8 @@ const std::vector<TopicDef>& topicTable() {
       {K::kRobotInfo, "robot_info", "/robot_info", false, true, false, typeOf<v1::Hello>},
       {K::kCamera, "camera", "/camera", true, true, true, typeOf<::foxglove::CompressedVideo>},
       {K::kCameraPeople, "camera_people", "/camera_people", true, true, false, typeOf<::foxglove::ImageAnnotations>},
+      {K::kCameraWide, "camera_wide", "", true, true, true, typeOf<::foxglove::CompressedVideo>},
+      {K::kCameraWidePeople, "camera_wide_people", "", true, true, false, typeOf<::foxglove::ImageAnnotations>},
       {K::kTf, "tf", "/tf", true, true, false, typeOf<::foxglove::FrameTransforms>},
       {K::kScene, "scene", "/scene", true, true, false, typeOf<::foxglove::SceneUpdate>},
       {K::kLog, "log", "/log", true, true, false, typeOf<::foxglove::Log>},

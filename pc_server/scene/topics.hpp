@@ -25,6 +25,8 @@ enum class TopicKind {
   kRobotInfo,     // recorded only: the robot's Hello
   kCamera,
   kCameraPeople,
+  kCameraWide,        // the wide head's stream (when the robot streams it)
+  kCameraWidePeople,
   kTf,
   kScene,
   kLog,

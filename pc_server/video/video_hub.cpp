@@ -14,6 +14,7 @@
 #include "shared/util/file_util.hpp"
 #include "shared/util/log.hpp"
 #include "shared/video/sdp.hpp"
+#include "pc_server/video/video_streams.hpp"
 
 namespace inspect::server {
 
@@ -57,10 +58,12 @@ VideoHub::VideoHub(const VideoServerConfig& config, const std::string& link_bind
     fwd_socket_.open(asio::ip::udp::v4(), ec);
     if (ec) throw util::StartupError("video: cannot open the forwarding socket: " + ec.message());
   }
-  receiver_->setKeyframeRequest([this](const std::string& robot) {
+  receiver_->setKeyframeRequest([this](const std::string& stream) {
+    const StreamRef ref = parseStreamName(stream);
     v1::Command c;
     c.mutable_video()->set_keyframe(true);
-    sink_.sendCommand(robot, c);
+    c.mutable_video()->set_head(ref.head);
+    sink_.sendCommand(ref.robot, c);
   });
   receiver_->setFrameHook([this](const std::string& robot, const cv::Mat& bgr, uint64_t capture_us) {
     onFrame(robot, bgr, capture_us);
@@ -91,117 +94,125 @@ void VideoHub::stop() {
 void VideoHub::onTelemetry(const std::string& robot_id, const std::string& address, const v1::Envelope& env,
                            uint64_t recv_us) {
   const auto& t = env.telemetry();
-  if (!t.has_video() || t.video().ssrc() == 0) return;
+  const bool ptz = t.has_video() && t.video().ssrc() != 0, wide = t.has_wide_video() && t.wide_video().ssrc() != 0;
+  if (!ptz && !wide) return;
   std::lock_guard lk(mu_);
-  Robot& r = robots_[robot_id];
   // Clock offset: the smallest (receive - send) of recent messages is the
   // offset plus the shortest one-way delay (tens of µs on loopback).
-  r.offsets.push_back(static_cast<int64_t>(recv_us) - static_cast<int64_t>(env.send_time_us()));
-  if (r.offsets.size() > kOffsetSamples) r.offsets.pop_front();
-  int64_t offset = r.offsets.front();
-  for (auto o : r.offsets) offset = std::min(offset, o);
+  auto& offsets = offsets_[robot_id];
+  offsets.push_back(static_cast<int64_t>(recv_us) - static_cast<int64_t>(env.send_time_us()));
+  if (offsets.size() > kOffsetSamples) offsets.pop_front();
+  int64_t offset = offsets.front();
+  for (auto o : offsets) offset = std::min(offset, o);
   const std::string ip = hostOf(address);
-  const bool changed = r.ssrc != t.video().ssrc() || r.source_ip != ip;
+  if (ptz) followStream(streamName(robot_id, v1::PTZ_HEAD), t.video().ssrc(), ip, offset);
+  if (wide) followStream(streamName(robot_id, v1::WIDE_HEAD), t.wide_video().ssrc(), ip, offset);
+}
+
+void VideoHub::followStream(const std::string& name, uint32_t ssrc, const std::string& ip, int64_t offset) {
+  Stream& r = streams_[name];
+  const bool changed = r.ssrc != ssrc || r.source_ip != ip;
   if (changed) {
-    r.ssrc = t.video().ssrc();
+    r.ssrc = ssrc;
     r.source_ip = ip;
     r.offset_us = offset;
     boost::system::error_code ec;
     const auto addr = asio::ip::make_address(ip, ec);
-    receiver_->setStream(robot_id, r.ssrc, ec ? asio::ip::address() : addr, offset);
+    receiver_->setStream(name, r.ssrc, ec ? asio::ip::address() : addr, offset);
     if (r.sdp_path.empty()) {
       if (config_.forward_base_port) r.forward_port = next_forward_port_++;
-      r.sdp_path = config_.dir + "/" + robot_id + ".sdp";
-      writeSdp(robot_id, r, false);
+      r.sdp_path = config_.dir + "/" + streamFileStem(name) + ".sdp";
+      writeSdp(name, r, false);
     }
-    log::info(log::tag::kVideo, robot_id, ": stream SSRC ", r.ssrc, " from ", ip,
+    log::info(log::tag::kVideo, name, ": stream SSRC ", r.ssrc, " from ", ip,
               r.forward_port ? ", forwarded to 127.0.0.1:" + std::to_string(r.forward_port) : std::string(),
               "; play with: ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay ", r.sdp_path);
   } else if (std::abs(offset - r.offset_us) > 200) {
     r.offset_us = offset;
-    receiver_->setClockOffset(robot_id, offset);
+    receiver_->setClockOffset(name, offset);
   }
 }
 
-void VideoHub::writeSdp(const std::string& robot_id, Robot& r, bool with_params) {
+void VideoHub::writeSdp(const std::string& name, Stream& r, bool with_params) {
+  const StreamRef ref = parseStreamName(name);
   video::SdpParams p;
-  p.session_name = robot_id + " camera";
+  p.session_name = ref.robot + (ref.head == v1::WIDE_HEAD ? " wide camera" : " camera");
   p.address = "127.0.0.1";
   p.port = r.forward_port;
-  if (with_params && receiver_->parameterSets(robot_id, p.sps, p.pps)) r.sdp_has_params = true;
+  if (with_params && receiver_->parameterSets(name, p.sps, p.pps)) r.sdp_has_params = true;
   if (const auto why = writeFileAtomically(r.sdp_path, video::makeSdp(p)); !why.empty())
-    log::warn(log::tag::kVideo, robot_id, ": SDP: ", why);
+    log::warn(log::tag::kVideo, name, ": SDP: ", why);
 }
 
-void VideoHub::forward(const std::string& robot_id, const std::vector<uint8_t>& datagram) {
+void VideoHub::forward(const std::string& stream, const std::vector<uint8_t>& datagram) {
   uint16_t port = 0;
   {
     std::lock_guard lk(mu_);
-    auto it = robots_.find(robot_id);
-    if (it != robots_.end()) port = it->second.forward_port;
+    auto it = streams_.find(stream);
+    if (it != streams_.end()) port = it->second.forward_port;
   }
   if (!port) return;
   boost::system::error_code ec;  // nobody listening is fine
   fwd_socket_.send_to(asio::buffer(datagram), asio::ip::udp::endpoint(asio::ip::address_v4::loopback(), port), 0, ec);
 }
 
-void VideoHub::onFrame(const std::string& robot_id, const cv::Mat& bgr, uint64_t) {
+void VideoHub::onFrame(const std::string& stream, const cv::Mat& bgr, uint64_t) {
   std::string latest;
   {
     std::lock_guard lk(mu_);
-    auto it = robots_.find(robot_id);
-    if (it == robots_.end()) return;
-    Robot& r = it->second;
-    if (!r.sdp_has_params) writeSdp(robot_id, r, true);
+    auto it = streams_.find(stream);
+    if (it == streams_.end()) return;
+    Stream& r = it->second;
+    if (!r.sdp_has_params) writeSdp(stream, r, true);
     const auto now = static_cast<int64_t>(monoNowUs());
     if (!window_running_ && config_.snapshot_period_s > 0 &&
         now - r.last_snapshot_us >= static_cast<int64_t>(config_.snapshot_period_s * 1e6)) {
       r.last_snapshot_us = now;
-      latest = config_.dir + "/" + robot_id + "_latest.png";
+      latest = config_.dir + "/" + streamFileStem(stream) + "_latest.png";
     }
   }
-  if (!latest.empty() && !writePng(latest, bgr)) log::warn(log::tag::kVideo, robot_id, ": cannot write ", latest);
+  if (!latest.empty() && !writePng(latest, bgr)) log::warn(log::tag::kVideo, stream, ": cannot write ", latest);
 }
 
-std::optional<video::StreamStats> VideoHub::stats(const std::string& robot_id) const {
-  return receiver_->stats(robot_id);
+std::optional<video::StreamStats> VideoHub::stats(const std::string& stream) const {
+  return receiver_->stats(stream);
 }
 
 video::ReceiverCounters VideoHub::counters() const { return receiver_->counters(); }
 
-std::string VideoHub::snapshot(const std::string& robot_id, const std::string& path) {
+std::string VideoHub::snapshot(const std::string& stream, const std::string& path) {
   cv::Mat bgr;
-  if (!receiver_->latestFrame(robot_id, bgr)) throw std::runtime_error("no picture decoded from " + robot_id + " yet");
+  if (!receiver_->latestFrame(stream, bgr)) throw std::runtime_error("no picture decoded from " + stream + " yet");
   std::string out = path;
   if (out.empty()) {
     std::lock_guard lk(mu_);
-    out = config_.dir + "/" + robot_id + "_" + std::to_string(++robots_[robot_id].snapshot_count) + ".png";
+    out = config_.dir + "/" + streamFileStem(stream) + "_" + std::to_string(++streams_[stream].snapshot_count) + ".png";
   }
   if (out.size() < 4 || out.substr(out.size() - 4) != ".png") out += ".png";
   if (!writePng(out, bgr)) throw std::runtime_error("cannot write '" + out + "'");
   return out;
 }
 
-std::string VideoHub::sdpPath(const std::string& robot_id) const {
+std::string VideoHub::sdpPath(const std::string& stream) const {
   std::lock_guard lk(mu_);
-  auto it = robots_.find(robot_id);
-  return it == robots_.end() ? std::string() : it->second.sdp_path;
+  auto it = streams_.find(stream);
+  return it == streams_.end() ? std::string() : it->second.sdp_path;
 }
 
-uint16_t VideoHub::forwardPort(const std::string& robot_id) const {
+uint16_t VideoHub::forwardPort(const std::string& stream) const {
   std::lock_guard lk(mu_);
-  auto it = robots_.find(robot_id);
-  return it == robots_.end() ? 0 : it->second.forward_port;
+  auto it = streams_.find(stream);
+  return it == streams_.end() ? 0 : it->second.forward_port;
 }
 
 void VideoHub::windowLoop() {
-  std::map<std::string, uint64_t> shown;  // robot -> capture time of the picture on screen
+  std::map<std::string, uint64_t> shown;  // stream -> capture time of the picture on screen
   try {
     while (!stopping_) {
       std::vector<std::string> ids;
       {
         std::lock_guard lk(mu_);
-        for (const auto& [id, r] : robots_) ids.push_back(id);
+        for (const auto& [id, r] : streams_) ids.push_back(id);
       }
       for (const auto& id : ids) {
         cv::Mat bgr;

@@ -116,5 +116,16 @@ TEST(ClientConfig, WideHead) {
   EXPECT_NE(clientConfigError("wide_head:\n  fps: 0\n").find("wide_head.fps: 0 is out of range"), std::string::npos);
   EXPECT_NE(clientConfigError("wide_head:\n  pixel_format: MJPEG\n").find("wide_head.pixel_format: a FOURCC"),
             std::string::npos);
-  EXPECT_NE(clientConfigError("wide_head:\n  stream: true\n").find("wide_head.stream: unknown key"), std::string::npos);
+  // Streamed only when asked (docs/video.md "The wide head's stream").
+  EXPECT_FALSE(c.wide_head.stream);
+  EXPECT_EQ(c.wide_head.bitrate_kbps, 800);
+  const auto f = client::loadClientConfig(
+      config::ConfigNode::loadString("wide_head:\n  stream: true\n  bitrate_kbps: 600\n", "client.yaml"));
+  EXPECT_TRUE(f.wide_head.stream);
+  EXPECT_EQ(f.wide_head.bitrate_kbps, 600);
+  EXPECT_NE(clientConfigError("wide_head:\n  stream: maybe\n").find("wide_head.stream"), std::string::npos);
+  EXPECT_NE(clientConfigError("wide_head:\n  bitrate_kbps: 10\n").find("wide_head.bitrate_kbps: 10 is out of range"),
+            std::string::npos);
+  EXPECT_NE(clientConfigError("wide_head:\n  streamed: true\n").find("wide_head.streamed: unknown key"),
+            std::string::npos);
 }

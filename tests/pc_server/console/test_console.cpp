@@ -160,7 +160,7 @@ TEST_F(ConsoleTest, CompletionComesFromTheCommandTable) {
   EXPECT_EQ(console_.completions("tr"), (V{"track", "try"}));
   EXPECT_EQ(console_.completions("try tr"), (V{"track"}));
   EXPECT_EQ(console_.completions("dr"), (V{"drive"}));
-  EXPECT_EQ(console_.completions("video "), (V{"bitrate", "fps", "keyframe", "off", "on", "res", "stats"}));
+  EXPECT_EQ(console_.completions("video "), (V{"bitrate", "fps", "keyframe", "off", "on", "res", "stats", "wide"}));
   EXPECT_EQ(console_.completions("gains push r"), (V{"robot1"}));
   EXPECT_EQ(console_.completions("help dri"), (V{"drive"}));
   EXPECT_EQ(console_.completions("control take f"), (V{"force"}));
@@ -628,10 +628,12 @@ INSTANTIATE_TEST_SUITE_P(
                       BadArgsCase{"video fps many", "video: fps 'many'"},
                       BadArgsCase{"video bitrate 10", "video: bitrate '10': want 50 to 50000 kbit/s"},
                       BadArgsCase{"video on now", "syntax: video"},
+                      BadArgsCase{"video wide stats", "video: unknown what 'stats' (on, off or keyframe)"},
+                      BadArgsCase{"video wide bitrate 5", "bitrate"},
                       BadArgsCase{"ptz 200 0", "ptz: pan must be within [-180, 180] and tilt within [-90, 90]"},
                       BadArgsCase{"ptz 10", "syntax: ptz <pan_deg> <tilt_deg> | ptz home"},
                       BadArgsCase{"ptz left up", "syntax: ptz"},
-                      BadArgsCase{"snapshot a.png b.png", "syntax: snapshot [file.png]"},
+                      BadArgsCase{"snapshot a.png b.png", "syntax: snapshot wide [file.png] | snapshot [file.png]"},
                       BadArgsCase{"snapshot", "snapshot: the server runs without video"}));
 
 TEST_F(ConsoleTest, VideoAndPtzCommandsReachTheRobot) {
@@ -659,7 +661,25 @@ TEST_F(ConsoleTest, VideoAndPtzCommandsReachTheRobot) {
   EXPECT_NEAR(sink_.sent.back().ptz().tilt_rad(), -std::numbers::pi / 4, 1e-12);
   std::tie(ok, out) = run("ptz home");
   EXPECT_TRUE(sink_.sent.back().ptz().home());
+  EXPECT_EQ(sink_.sent[0].video().head(), v1::PTZ_HEAD);
+  // The wide head's stream (docs/video.md "The wide head's stream").
+  std::tie(ok, out) = run("video wide bitrate 500");
+  EXPECT_TRUE(ok) << out;
+  EXPECT_HAS(out, "robot1: video wide bitrate accepted");
+  EXPECT_EQ(sink_.sent.back().video().head(), v1::WIDE_HEAD);
+  EXPECT_EQ(sink_.sent.back().video().bitrate_kbps(), 500u);
+  std::tie(ok, out) = run("video wide off");
+  EXPECT_EQ(sink_.sent.back().video().head(), v1::WIDE_HEAD);
+  ASSERT_TRUE(sink_.sent.back().video().has_enabled());
+  EXPECT_FALSE(sink_.sent.back().video().enabled());
+  std::tie(ok, out) = run("video wide keyframe");
+  EXPECT_TRUE(sink_.sent.back().video().keyframe());
+  EXPECT_EQ(sink_.sent.back().video().head(), v1::WIDE_HEAD);
   sink_.reply = v1::Ack::REJECTED;
+  sink_.reason = "video: this robot does not stream a wide head (wide_head.stream)";
+  std::tie(ok, out) = run("video wide on");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "robot1: video wide on rejected: video: this robot does not stream a wide head");
   sink_.reason = "video: this robot has no video stream (see its log)";
   std::tie(ok, out) = run("video on");
   EXPECT_FALSE(ok);

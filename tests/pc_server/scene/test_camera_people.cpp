@@ -78,11 +78,11 @@ uint64_t plusOneSecondNs(uint64_t us) { return us * 1000 + 1'000'000'000; }  // 
 TEST(CameraPeopleClock, AnnotatesEachPictureOnceWithItsFramesTimestamp) {
   CameraPeopleClock clock;
   v1::Telemetry t;
-  EXPECT_FALSE(clock.fresh(t, 0, plusOneSecondNs)) << "no perception";
+  EXPECT_FALSE(clock.fresh(t.perception(), 0, plusOneSecondNs)) << "no perception (capture time 0)";
   *t.mutable_perception() = twoPeople();  // the picture captured at robot time 5'000'000
   // Before any video: the link's offset (receive - send).
-  EXPECT_EQ(clock.fresh(t, 1000, plusOneSecondNs).value_or(0), plusOneSecondNs(5'001'000));
-  EXPECT_FALSE(clock.fresh(t, 1000, plusOneSecondNs)) << "the same picture again (telemetry repeats it while fresh)";
+  EXPECT_EQ(clock.fresh(t.perception(), 1000, plusOneSecondNs).value_or(0), plusOneSecondNs(5'001'000));
+  EXPECT_FALSE(clock.fresh(t.perception(), 1000, plusOneSecondNs)) << "the same picture again (telemetry repeats it while fresh)";
   // Frames arrive; the channel stamped them with its own times (the wall clock then).
   video::Frame f;
   for (uint64_t k = 0; k < 10; ++k) {
@@ -90,28 +90,28 @@ TEST(CameraPeopleClock, AnnotatesEachPictureOnceWithItsFramesTimestamp) {
     clock.onAccessUnit(f, *f.capture_us + 250, 7'000'000'000 + k);
   }
   t.mutable_perception()->set_capture_us(5'100'000 + 3 * 33'333);
-  EXPECT_EQ(clock.fresh(t, 1000, plusOneSecondNs).value_or(0), 7'000'000'003u) << "exactly the frame's timestamp";
+  EXPECT_EQ(clock.fresh(t.perception(), 1000, plusOneSecondNs).value_or(0), 7'000'000'003u) << "exactly the frame's timestamp";
   // A picture whose frame the channel did not carry (lost): the video's offset, not the link's.
   t.mutable_perception()->set_capture_us(5'090'000);
-  EXPECT_EQ(clock.fresh(t, 1000, plusOneSecondNs).value_or(0), plusOneSecondNs(5'090'250));
+  EXPECT_EQ(clock.fresh(t.perception(), 1000, plusOneSecondNs).value_or(0), plusOneSecondNs(5'090'250));
   // An access unit without a capture time teaches nothing.
   video::Frame no_time;
   clock.onAccessUnit(no_time, 0, 9);
   t.mutable_perception()->set_capture_us(5'095'000);
-  EXPECT_EQ(clock.fresh(t, 1000, plusOneSecondNs).value_or(0), plusOneSecondNs(5'095'250));
+  EXPECT_EQ(clock.fresh(t.perception(), 1000, plusOneSecondNs).value_or(0), plusOneSecondNs(5'095'250));
   // The ring forgets the oldest frames after kPictures.
   for (uint64_t k = 0; k < CameraPeopleClock::kPictures; ++k) {
     f.capture_us = 6'000'000 + k * 33'333;
     clock.onAccessUnit(f, *f.capture_us + 250, 8'000'000'000 + k);
   }
   t.mutable_perception()->set_capture_us(5'100'000);
-  EXPECT_EQ(clock.fresh(t, 1000, plusOneSecondNs).value_or(0), plusOneSecondNs(5'100'250));
+  EXPECT_EQ(clock.fresh(t.perception(), 1000, plusOneSecondNs).value_or(0), plusOneSecondNs(5'100'250));
   // A robot whose clock is ahead of the server's (negative offset) still maps.
   CameraPeopleClock behind;
   f.capture_us = 9'000'000;
   behind.onAccessUnit(f, 1'000'000, 5);
   t.mutable_perception()->set_capture_us(9'500'000);
-  EXPECT_EQ(behind.fresh(t, 0, plusOneSecondNs).value_or(0), plusOneSecondNs(1'500'000));
+  EXPECT_EQ(behind.fresh(t.perception(), 0, plusOneSecondNs).value_or(0), plusOneSecondNs(1'500'000));
 }
 
 TEST(RobotScene, DrawsTheCamerasBearingRaysAndMarksPeopleItSees) {

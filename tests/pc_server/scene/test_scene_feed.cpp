@@ -67,3 +67,41 @@ TEST(SceneFeed, TheMapFollowsSiteMapsAndTheCamerasPeopleComeOnce) {
   EXPECT_EQ(people->second.points_size() + people->second.texts_size() > 0, true);
   EXPECT_FALSE(feed.cameraPeople(env.telemetry(), 0)) << "the same picture once only";
 }
+
+TEST(SceneFeed, EachHeadsPeopleGoOnItsOwnPicturesAtItsOwnSize) {
+  // docs/video.md "The wide head's stream": the wide head's boxes are stamped
+  // with the wide stream's frames and scaled to its size, apart from the PTZ head's.
+  SceneFeed feed("robot1", Geometry{});
+  v1::Envelope env = telemetry(1'000'000);  // the PTZ head's picture of another time
+  auto* t = env.mutable_telemetry();
+  t->mutable_video()->set_width(640);
+  t->mutable_video()->set_height(480);
+  auto* w = t->mutable_wide_perception();
+  w->set_mode(v1::CAMERA_AND_SONAR);
+  w->set_capture_us(2'000'000);
+  w->set_width(480);
+  w->set_height(360);
+  auto* p = w->add_people();
+  p->set_box_x(240);
+  p->set_box_y(90);
+  p->set_box_w(48);
+  p->set_box_h(96);
+  p->set_bearing_rad(0.78);
+  p->set_range_m(2.6);
+  t->mutable_wide_video()->set_width(960);  // the stream at twice the detected size
+  t->mutable_wide_video()->set_height(720);
+  video::Frame f;
+  f.capture_us = 2'000'000;
+  feed.onAccessUnit(f, 2'000'500, 77, v1::WIDE_HEAD);  // the wide stream's frame of that picture
+  const auto wide = feed.cameraPeople(*t, 0, v1::WIDE_HEAD);
+  ASSERT_TRUE(wide);
+  EXPECT_EQ(wide->first, 77u) << "the wide frame's timestamp";
+  ASSERT_EQ(wide->second.points_size(), 1);
+  EXPECT_DOUBLE_EQ(wide->second.points(0).points(0).x(), 480.0) << "box scaled 480 -> 960 wide";
+  EXPECT_DOUBLE_EQ(wide->second.points(0).points(0).y(), 180.0);
+  EXPECT_FALSE(feed.cameraPeople(*t, 0, v1::WIDE_HEAD)) << "once only";
+  const auto ptz = feed.cameraPeople(*t, 0, v1::PTZ_HEAD);
+  ASSERT_TRUE(ptz) << "the PTZ head's people come apart, once too";
+  EXPECT_NE(ptz->first, 77u) << "its picture on the link's clock (no PTZ frame seen), not on the wide frame";
+  EXPECT_FALSE(feed.cameraPeople(*t, 0, v1::PTZ_HEAD));
+}

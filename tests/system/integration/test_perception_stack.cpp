@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <regex>
 #include <string>
 
@@ -21,13 +22,22 @@
 using namespace inspect::test;
 
 namespace {
+/// How runWithCamera runs the robot's heads.
+struct Heads {
+  bool wide = false;         // mcu_sim --wide-camera, robot_client --wide-video-source
+  bool wide_stream = false;  // ...and --wide-stream, with the Foxglove bridge on
+  /// Called once the robot's programs are started, while the script runs.
+  std::function<void(Stack&)> during;
+};
+
 /// Runs the server's `script` with one robot in `world` whose video source
 /// is mcu_sim's camera (its frame slot /dev/shm/inspect-NAME-PID); the
 /// server's output, or "" (a failure added) when it did not end. The robot's
 /// programs are stopped.
 std::string runWithCamera(Stack& s, const std::string& name, const std::string& world, const std::string& script,
-                          bool wide_head = false) {
+                          const Heads& heads = {}) {
   s.enableVideo();
+  if (heads.wide_stream) s.enableFoxglove();
   writeFile(s.dir() / "world.yaml", world);
   writeFile(s.dir() / "server.yaml", "video:\n  window: off\n  forward_base_port: 0\n");
   if (!s.startServer(script, {"--config", s.dir() / "server.yaml", "--runs-dir", s.dir() / "runs"})) {
@@ -37,11 +47,13 @@ std::string runWithCamera(Stack& s, const std::string& name, const std::string& 
   const std::string slot = "/dev/shm/inspect-" + name + "-" + std::to_string(::getpid());
   std::vector<std::string> sim_args{"--camera", slot}, client_args{"--video-source", "sim:" + slot};
   const std::string wide_slot = slot + "-wide";
-  if (wide_head) {
+  if (heads.wide) {
     sim_args.insert(sim_args.end(), {"--wide-camera", wide_slot});
     client_args.insert(client_args.end(), {"--wide-video-source", "sim:" + wide_slot});
   }
+  if (heads.wide_stream) client_args.push_back("--wide-stream");
   auto& robot = s.startRobot("robot1", s.dir() / "world.yaml", {}, sim_args, client_args);
+  if (heads.during) heads.during(s);
   const auto rc = s.server().wait(60.0);
   robot.client.terminate();
   robot.sim.terminate();
@@ -51,6 +63,14 @@ std::string runWithCamera(Stack& s, const std::string& name, const std::string& 
   EXPECT_EQ(access(slot.c_str(), F_OK), -1) << "mcu_sim removes its frame slot";
   EXPECT_EQ(access(wide_slot.c_str(), F_OK), -1) << "mcu_sim removes its frame slots";
   return rc ? out : "";
+}
+
+/// The run.mcap under the stack's runs directory ("" = none).
+std::string recordedMcap(Stack& s) {
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(s.dir() / "runs", ec))
+    if (e.is_directory() && std::filesystem::exists(e.path() / "run.mcap")) return (e.path() / "run.mcap").string();
+  return "";
 }
 
 /// The `robot people:` lines of `video stats` (`robot wide head:` with `head` "wide head").
@@ -105,10 +125,7 @@ TEST(PerceptionStack, TheRobotSeesAPersonAheadWithItsCameraAndSaysWhenItLooksAwa
   // Foxglove's Image panel pairs them (read by @mcap/core; docs/recording.md).
   const char* reader = std::getenv("INSPECT_MCAP_READER");
   ASSERT_NE(reader, nullptr) << "INSPECT_MCAP_READER: the @mcap/core reader (ctest fixture mcap_reader)";
-  std::string mcap;
-  std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(s.dir() / "runs", ec))
-    if (e.is_directory() && std::filesystem::exists(e.path() / "run.mcap")) mcap = (e.path() / "run.mcap").string();
+  const std::string mcap = recordedMcap(s);
   ASSERT_FALSE(mcap.empty()) << out;
   const std::string json = captureOutput(std::string("node ") + reader + " --decode --annotations /robot1/camera_people /robot1/camera " + mcap);
   ASSERT_TRUE(std::regex_search(json, m, std::regex(R"("messages":([0-9]+),"boxes":([0-9]+),"on_a_picture":([0-9]+))")))
@@ -160,17 +177,38 @@ TEST(PerceptionStack, TheWideHeadSeesAPersonBesideTheRobotWhomThePtzHeadCannot) 
   // PTZ head's +-30 degrees, and nearer than the PTZ head can see anyone
   // (2.7 m). The wide head (robot.yaml wide_camera, 120 degrees; mcu_sim
   // --wide-camera, robot_client --wide-video-source) finds them, the PTZ head
-  // does not, and the robot's tracker has them.
+  // does not, and the robot's tracker has them. The wide head is streamed
+  // too (--wide-stream; docs/video.md "The wide head's stream"): the operator
+  // sees its pictures and boxes in Foxglove, live and recorded.
+  const char* reader = std::getenv("INSPECT_MCAP_READER");
+  ASSERT_NE(reader, nullptr) << "INSPECT_MCAP_READER: the @mcap/core reader (ctest fixture mcap_reader)";
+  // The npm fixture's folder: @mcap/core's, and the Foxglove client library's.
+  const std::string modules = std::filesystem::path(reader).parent_path().string();
   Stack s("widehead");
+  Heads heads{.wide = true, .wide_stream = true, .during = [&](Stack& st) {
+                // A Foxglove client on the wide head's topics while the script runs.
+                const std::string url = "ws://127.0.0.1:" + std::to_string(st.foxglovePort()) + "/";
+                auto node = Process::spawn({"/usr/bin/env", "node", srcPath("tests/tools/foxglove_camera_check.js"),
+                                            "--modules", modules, "--url", url, "--token", st.foxgloveToken(),
+                                            "--video", "/robot1/camera_wide", "--annotations",
+                                            "/robot1/camera_wide_people", "--seconds", "8", "--json",
+                                            st.dir() / "live.json"},
+                                           st.dir() / "node.out", st.dir() / "node.err");
+                if (!node.wait(40.0)) ADD_FAILURE() << "the Foxglove client did not finish within 40 s";
+              }};
   const std::string out = runWithCamera(s, "widehead",
                                         "name: one_person_beside\nstart: {x_m: 0, y_m: 0, theta_rad: 0}\n"
                                         "walls:\n  - {points_m: [-3, -4,  10, -4,  10, 4,  -3, 4], closed: true}\n"
                                         "pedestrians:\n  - {id: p, route_m: [1.44, 1.2]}\n",
                                         "expect robots >= 1 within 15\n"
+                                        "record start wide head\n"
                                         "wait 5\n"
+                                        "video wide keyframe\n"
+                                        "snapshot wide\n"
                                         "video stats\n"
-                                        "status\n",
-                                        true);
+                                        "status\n"
+                                        "record stop\n",
+                                        heads);
   const auto ptz = peopleLines(out), wide = peopleLines(out, "wide head");
   ASSERT_EQ(ptz.size(), 1u) << out;
   ASSERT_EQ(wide.size(), 1u) << out << "\n" << s.logs();
@@ -196,4 +234,43 @@ TEST(PerceptionStack, TheWideHeadSeesAPersonBesideTheRobotWhomThePtzHeadCannot) 
   EXPECT_GT(std::stod(m[1]), 0.8 * std::hypot(1.44, 1.2)) << out;
   EXPECT_LT(std::stod(m[1]), 1.7 * std::hypot(1.44, 1.2)) << out;
   std::printf("%s\n%s\nstatus: %s\n", ptz[0].c_str(), wide[0].c_str(), m[0].str().c_str());
+
+  // The wide head's stream: the robot sends it, the server receives it beside the PTZ head's.
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(wide stream: on, sim:\S+ 480x360 @ 15 fps, \S+ 800 kbit/s)"))) << out;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(wide received: ([0-9.]+) fps, decoded ([0-9.]+) fps)"))) << out;
+  EXPECT_GE(std::stod(m[2]), 8.0) << "15 fps captured: " << m[0];
+  EXPECT_NE(out.find("robot1.wide.sdp"), std::string::npos) << "its own SDP for players: " << out;
+  EXPECT_NE(out.find("robot1: video wide keyframe accepted"), std::string::npos) << out;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(robot1: snapshot (\S+robot1\.wide_1\.png))"))) << out;
+  EXPECT_GT(std::filesystem::file_size(m[1].str()), 10000u) << "a 480x360 picture: " << m[1];
+
+  // Live: the Foxglove client got the pictures (decodable from the first
+  // keyframe) and the boxes, each on the picture it was found in.
+  const std::string live = readFile(s.dir() / "live.json");
+  std::printf("live: %s", live.c_str());
+  ASSERT_TRUE(std::regex_search(live, m, std::regex(R"re("frames":([0-9]+),"keyframes":([0-9]+),"frames_decoded":([0-9]+),"frame_id":"robot1/camera_wide","annotations":([0-9]+),"boxes":([0-9]+),"on_a_picture":([0-9]+))re")))
+      << live << readFile(s.dir() / "node.err");
+  const int frames = std::stoi(m[1]), decoded = std::stoi(m[3]), notes = std::stoi(m[4]), boxes = std::stoi(m[5]),
+            paired = std::stoi(m[6]);
+  EXPECT_GE(frames, 30) << "15 fps for at least 3 s: " << live;
+  EXPECT_GE(std::stoi(m[2]), 1) << live;
+  EXPECT_GE(decoded, frames / 2) << "from the first keyframe on: " << live;
+  EXPECT_GE(notes, 8) << "about 4 detected pictures a second: " << live;
+  EXPECT_GE(boxes, notes * 7 / 10) << live;
+  EXPECT_GE(paired, notes * 8 / 10) << "Foxglove pairs a box with the picture of the same time: " << live;
+  EXPECT_NE(live.find("\"person +4"), std::string::npos) << "the label of the person at +45 degrees: " << live;
+
+  // Recorded: run.mcap has the wide head's pictures and boxes (read by @mcap/core).
+  const std::string mcap = recordedMcap(s);
+  ASSERT_FALSE(mcap.empty()) << out;
+  const std::string json = captureOutput(std::string("node ") + reader +
+                                         " --decode --annotations /robot1/camera_wide_people /robot1/camera_wide " + mcap);
+  ASSERT_TRUE(std::regex_search(json, m, std::regex(R"("messages":([0-9]+),"boxes":([0-9]+),"on_a_picture":([0-9]+))")))
+      << json;
+  EXPECT_GE(std::stoi(m[1]), 8) << json;
+  EXPECT_GE(std::stoi(m[2]), std::stoi(m[1]) * 7 / 10) << json;
+  EXPECT_GE(std::stoi(m[3]), std::stoi(m[1]) - 1) << json;
+  ASSERT_TRUE(std::regex_search(json, m, std::regex(R"re("/robot1/camera_wide":([0-9]+))re"))) << json;
+  EXPECT_GE(std::stoi(m[1]), 50) << "15 fps for the 5 s recorded: " << json;
+  std::printf("recorded: %s\n", json.c_str());
 }
