@@ -28,6 +28,7 @@ void readDetection(const config::ConfigNode& n, DetectionParams& d) {
   d.max_core_share = n.number("max_core_share", d.max_core_share, 0.05, 1.0);
   d.hit_threshold = n.number("hit_threshold", d.hit_threshold, -1.0, 3.0);
   d.group_threshold = static_cast<int>(n.integer("group_threshold", d.group_threshold, 0, 20));
+  d.floor_band = n.boolean("floor_band", d.floor_band);
 }
 
 std::string readPixelFormat(const config::ConfigNode& n, const std::string& dflt) {

@@ -41,6 +41,7 @@ struct DetectionParams {
   double max_core_share = 0.5;       // ...and never more than this share of one core
   double hit_threshold = 0.0;        // HOG's SVM margin
   int group_threshold = 2;           // windows that must agree
+  bool floor_band = true;            // HOG: only windows whose person stands on the floor (people_detector.hpp)
 };
 
 /// People detection on the camera's pictures (docs/human-awareness.md,

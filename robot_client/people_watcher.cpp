@@ -82,21 +82,21 @@ void PeopleWatcher::loop() {
     view.tilt_rad = pending_tilt_;
     lk.unlock();
 
-    const uint64_t t0 = monoNowUs();
-    std::vector<perception::PersonBox> boxes;
-    std::string error;
-    try {
-      boxes = detector_.detect(picture);
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    const uint64_t t1 = monoNowUs();
-    perception::CameraPose cam;
+    perception::CameraPose cam;  // where the picture was taken (the detector's floor band goes by it)
     cam.width = picture.cols;
     cam.height = picture.rows;
     cam.mount = s_.mount;
     cam.pan_rad = view.pan_rad;
     cam.tilt_rad = view.tilt_rad;
+    const uint64_t t0 = monoNowUs();
+    std::vector<perception::PersonBox> boxes;
+    std::string error;
+    try {
+      boxes = detector_.detect(picture, &cam);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    const uint64_t t1 = monoNowUs();
     view.width = picture.cols;
     view.height = picture.rows;
     for (const auto& b : boxes) view.people.push_back({perception::sightingOf(b.box, cam), b});

@@ -48,6 +48,7 @@ WatcherSettings watcherSettings(const DetectionParams& p, const config::CameraMo
     throw std::invalid_argument("perception.detector: '" + p.detector + "' is not known");
   w.detector.hit_threshold = p.hit_threshold;
   w.detector.group_threshold = p.group_threshold;
+  w.detector.floor_band = p.floor_band;
   w.width = p.width;
   w.height = p.height;
   w.rate_hz = p.rate_hz;

@@ -33,7 +33,7 @@ class CameraLooks::Real {
     look.half_fov_rad = cam_.mount.hfov_deg * M_PI / 360.0;
     look.wide = wide_;
     cam_.pan_rad = pan_rad;
-    for (const auto& b : detector_.detect(frame_)) {
+    for (const auto& b : detector_.detect(frame_, &cam_)) {
       const auto s = perception::sightingOf(b.box, cam_);
       look.add({s.bearing_rad, s.range_m.value_or(-1.0)});
     }

@@ -29,7 +29,11 @@ struct ScenarioCamera {
   bool real = false;
   int width = 640, height = 480;
   double noise_sigma = 3.0, exposure_ms = 8.0;  // bench_people's defaults
-  perception::PeopleDetectorOptions detector;   // robot_client's default (config/client.yaml)
+  perception::PeopleDetectorOptions detector = [] {  // robot_client's default (config/client.yaml)
+    perception::PeopleDetectorOptions o;
+    o.floor_band = true;
+    return o;
+  }();
   // The wide, fixed head (the robot config's wide_camera), when the robot has
   // one: its own model, picture size and detector (docs/human-awareness.md
   // "The wide head"), at the same rate.
@@ -39,6 +43,7 @@ struct ScenarioCamera {
   perception::PeopleDetectorOptions wide_detector = [] {
     perception::PeopleDetectorOptions o;
     o.group_threshold = 1;
+    o.floor_band = true;
     return o;
   }();
 };

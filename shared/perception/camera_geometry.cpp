@@ -27,6 +27,18 @@ double CameraPose::focalPx() const {
   return (width / 2.0) / std::tan(mount.hfov_deg * kPi / 360.0);
 }
 
+double standingHeightM(double foot_row, double head_row, const CameraPose& cam) {
+  const double u = cam.width / 2.0;
+  const Ray foot = rayThrough(u, foot_row, cam);
+  if (!(foot.z < -1e-9)) return std::nan("");
+  const double t = cam.mount.z_m / -foot.z;
+  const double d = t * std::hypot(foot.x, foot.y);  // along the floor to the feet
+  const Ray head = rayThrough(u, head_row, cam);
+  const double hd = std::hypot(head.x, head.y);
+  if (!(hd > 1e-9)) return std::nan("");
+  return cam.mount.z_m + d * head.z / hd;
+}
+
 Sighting sightingOf(const cv::Rect& box, const CameraPose& cam, int edge_px, double max_range_m) {
   Sighting s;
   const double u = box.x + box.width / 2.0;

@@ -38,4 +38,10 @@ struct Sighting {
 /// meets the floor within `max_range_m`.
 Sighting sightingOf(const cv::Rect& box, const CameraPose& cam, int edge_px = 2, double max_range_m = 30.0);
 
+/// How tall someone standing on the floor is whose feet are at picture row
+/// `foot_row` and the top of whose head is at `head_row` (on the picture's
+/// centre column); NaN when the foot row is at or above the horizon (no
+/// floor there). The detector's floor band (people_detector.hpp) uses it.
+double standingHeightM(double foot_row, double head_row, const CameraPose& cam);
+
 }  // namespace inspect::perception

@@ -31,6 +31,54 @@ cv::Rect trimWindow(const cv::Rect2d& r) {
                   static_cast<int>(std::lround(0.8 * r.width)), static_cast<int>(std::lround(0.8 * r.height)));
 }
 
+// The person inside a window of height h at row y: head and feet rows, as trimWindow.
+constexpr double kHeadInWindow = 0.07, kFeetInWindow = 0.87;
+
+/// HOG's image pyramid as HOGDescriptor::detectMultiScale builds it (its
+/// scales, level sizes and window rounding, OpenCV 4.6), each level searched
+/// only in the window rows whose person would stand on the floor and be
+/// [min_m, max_m] tall (`cam`: the picture's, `up` its upscale); the same
+/// grouping after. Levels are cut with rowRange: HOG's gradients read the
+/// rows beyond the cut (locateROI), so a window's score is the full level's.
+void floorBandHog(const cv::HOGDescriptor& hog, const cv::Mat& img, double up, const CameraPose& cam,
+                  const PeopleDetectorOptions& o, std::vector<cv::Rect>& found, std::vector<double>& weights,
+                  cv::Mat& level) {
+  const cv::Size win = hog.winSize, stride(o.stride_px, o.stride_px);
+  std::vector<cv::Point> locations;
+  std::vector<double> hits;
+  double scale = 1.0;
+  for (int l = 0; l < hog.nlevels; ++l, scale *= o.scale_step) {
+    const cv::Size sz(cvRound(img.cols / scale), cvRound(img.rows / scale));
+    if (sz.width < win.width || sz.height < win.height) break;
+    const double to_picture = scale / up;  // level pixels -> the picture's
+    int k_lo = -1, k_hi = -1;
+    for (int k = 0; k * stride.height + win.height <= sz.height; ++k) {
+      const double top = k * stride.height * to_picture, h = win.height * to_picture;
+      const double height_m = standingHeightM(top + kFeetInWindow * h, top + kHeadInWindow * h, cam);
+      if (!(height_m >= o.floor_min_m && height_m <= o.floor_max_m)) continue;
+      if (k_lo < 0) k_lo = k;
+      k_hi = k;
+    }
+    if (k_lo < 0) continue;
+    if (sz == img.size())
+      level = img;
+    else
+      cv::resize(img, level, sz, 0, 0, cv::INTER_LINEAR_EXACT);
+    // One window row of margin each side, on the stride's grid.
+    const int r0 = std::max(0, (k_lo - 1) * stride.height);
+    const int r1 = std::min(sz.height, (k_hi + 1) * stride.height + win.height);
+    hog.detect(level.rowRange(r0, r1), locations, hits, o.hit_threshold, stride, cv::Size(0, 0));
+    const cv::Size scaled_win(cvRound(win.width * scale), cvRound(win.height * scale));
+    for (std::size_t j = 0; j < locations.size(); ++j) {
+      if (hits[j] < o.hit_threshold) continue;
+      found.emplace_back(cvRound(locations[j].x * scale), cvRound((locations[j].y + r0) * scale), scaled_win.width,
+                         scaled_win.height);
+      weights.push_back(hits[j]);
+    }
+  }
+  hog.groupRectangles(found, weights, o.group_threshold, 0.2);
+}
+
 }  // namespace
 
 bool parseDetectorMethod(std::string_view text, DetectorMethod& out) {
@@ -51,8 +99,9 @@ std::string_view methodName(DetectorMethod m) {
 std::string describe(const PeopleDetectorOptions& o) {
   char buf[160];
   if (isHog(o.method))
-    std::snprintf(buf, sizeof buf, "%s x%.3g step %.3g stride %d thr %.2f group %d", std::string(methodName(o.method)).c_str(),
-                  o.upscale, o.scale_step, o.stride_px, o.hit_threshold, o.group_threshold);
+    std::snprintf(buf, sizeof buf, "%s x%.3g step %.3g stride %d thr %.2f group %d%s", std::string(methodName(o.method)).c_str(),
+                  o.upscale, o.scale_step, o.stride_px, o.hit_threshold, o.group_threshold,
+                  o.floor_band ? " floor" : "");
   else
     std::snprintf(buf, sizeof buf, "%s x%.3g step %.3g neighbours %d", std::string(methodName(o.method)).c_str(), o.upscale,
                   o.scale_step, o.group_threshold);
@@ -62,7 +111,7 @@ std::string describe(const PeopleDetectorOptions& o) {
 struct PeopleDetector::Impl {
   cv::HOGDescriptor hog;
   cv::CascadeClassifier cascade;
-  cv::Mat grey, scaled;
+  cv::Mat grey, scaled, level;
 };
 
 PeopleDetector::PeopleDetector(PeopleDetectorOptions o) : options_(std::move(o)), impl_(std::make_unique<Impl>()) {
@@ -75,6 +124,9 @@ PeopleDetector::PeopleDetector(PeopleDetectorOptions o) : options_(std::move(o))
   if (!(options_.hit_threshold >= -1.0 && options_.hit_threshold <= 3.0))
     throw std::invalid_argument("people detector: hit_threshold " + std::to_string(options_.hit_threshold) +
                                 " outside [-1, 3]");
+  if (!(options_.floor_min_m > 0 && options_.floor_min_m < options_.floor_max_m && options_.floor_max_m <= 5))
+    throw std::invalid_argument("people detector: the floor band's heights " + std::to_string(options_.floor_min_m) +
+                                " - " + std::to_string(options_.floor_max_m) + " m are not 0 < min < max <= 5");
   if (options_.group_threshold < 0 || options_.group_threshold > 20)
     throw std::invalid_argument("people detector: group_threshold " + std::to_string(options_.group_threshold) +
                                 " outside [0, 20]");
@@ -103,7 +155,7 @@ PeopleDetector::~PeopleDetector() = default;
 PeopleDetector::PeopleDetector(PeopleDetector&&) noexcept = default;
 PeopleDetector& PeopleDetector::operator=(PeopleDetector&&) noexcept = default;
 
-std::vector<PersonBox> PeopleDetector::detect(const cv::Mat& picture) {
+std::vector<PersonBox> PeopleDetector::detect(const cv::Mat& picture, const CameraPose* cam) {
   if (picture.empty()) return {};
   if (picture.type() == CV_8UC3)
     cv::cvtColor(picture, impl_->grey, cv::COLOR_BGR2GRAY);
@@ -124,8 +176,15 @@ std::vector<PersonBox> PeopleDetector::detect(const cv::Mat& picture) {
     std::vector<cv::Rect> found;
     std::vector<double> weights;
     const cv::Size stride(options_.stride_px, options_.stride_px);
-    impl_->hog.detectMultiScale(*in, found, weights, options_.hit_threshold, stride, cv::Size(0, 0), options_.scale_step,
-                                static_cast<double>(options_.group_threshold));
+    if (options_.floor_band && cam) {
+      CameraPose pose = *cam;  // the picture's own size (the focal length follows from it)
+      pose.width = picture.cols;
+      pose.height = picture.rows;
+      floorBandHog(impl_->hog, *in, up, pose, options_, found, weights, impl_->level);
+    } else {
+      impl_->hog.detectMultiScale(*in, found, weights, options_.hit_threshold, stride, cv::Size(0, 0),
+                                  options_.scale_step, static_cast<double>(options_.group_threshold));
+    }
     for (std::size_t i = 0; i < found.size(); ++i) {
       const cv::Rect2d r(found[i].x / up, found[i].y / up, found[i].width / up, found[i].height / up);
       const cv::Rect box = trimWindow(r) & frame;

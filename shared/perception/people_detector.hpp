@@ -12,6 +12,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "shared/perception/camera_geometry.hpp"
+
 namespace inspect::perception {
 
 enum class DetectorMethod { Hog, HogDaimler, HaarFullBody, HaarUpperBody };
@@ -28,6 +30,11 @@ struct PeopleDetectorOptions {
   int stride_px = 8;            // HOG: window stride in the (upscaled) picture (4, 8 or 16)
   double hit_threshold = 0.0;   // HOG: the SVM's margin for a window to count
   int group_threshold = 2;      // windows that must agree (0: every window is a box)
+  /// HOG, given the picture's CameraPose: search only the windows whose
+  /// person would stand on the floor and be floor_min_m - floor_max_m tall
+  /// (the ground-plane constraint); each pyramid level is cut to those rows.
+  bool floor_band = false;
+  double floor_min_m = 0.8, floor_max_m = 2.8;
   std::string cascade_dir = "/usr/share/opencv4";  // opencv-data's haarcascades/ live here
 };
 
@@ -52,7 +59,9 @@ class PeopleDetector {
 
   /// The people in a BGR (CV_8UC3) or grey (CV_8UC1) picture, boxes in its
   /// pixels and cut to it. Throws std::invalid_argument for another type.
-  std::vector<PersonBox> detect(const cv::Mat& picture);
+  /// `cam`: where the picture was taken (floor_band needs it; without it the
+  /// whole picture is searched).
+  std::vector<PersonBox> detect(const cv::Mat& picture, const CameraPose* cam = nullptr);
 
   const PeopleDetectorOptions& options() const { return options_; }
 

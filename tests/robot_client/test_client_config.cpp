@@ -116,6 +116,10 @@ TEST(ClientConfig, WideHead) {
   EXPECT_NE(clientConfigError("wide_head:\n  fps: 0\n").find("wide_head.fps: 0 is out of range"), std::string::npos);
   EXPECT_NE(clientConfigError("wide_head:\n  pixel_format: MJPEG\n").find("wide_head.pixel_format: a FOURCC"),
             std::string::npos);
+  EXPECT_TRUE(c.wide_head.floor_band) << "the floor band on both heads (bench_people)";
+  EXPECT_TRUE(c.perception.floor_band);
+  EXPECT_FALSE(client::loadClientConfig(config::ConfigNode::loadString("perception:\n  floor_band: false\n", "client.yaml"))
+                   .perception.floor_band);
   // Streamed only when asked (docs/video.md "The wide head's stream").
   EXPECT_FALSE(c.wide_head.stream);
   EXPECT_EQ(c.wide_head.bitrate_kbps, 800);

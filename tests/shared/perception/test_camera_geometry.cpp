@@ -72,3 +72,21 @@ TEST(CameraGeometry, ThePinholeUnderTiltAndNoRangeWithoutTheFeet) {
   EXPECT_NEAR(sightingOf(cv::Rect(0, 0, 2, 20), CameraPose{}).bearing_rad, 29.9 * kRad, 0.2 * kRad)
       << "the picture's left edge: half the field of view to the left";
 }
+
+TEST(CameraGeometry, StandingHeightFromTheFootAndHeadRowsUnderTilt) {
+  // A person H tall at d along the axis: the pinhole's rows of feet and head
+  // (tilted by tau) give H back; a foot row at or above the horizon gives NaN.
+  for (const double tilt_deg : {0.0, 10.0, -8.0}) {
+    CameraPose cam;
+    cam.tilt_rad = tilt_deg * kRad;
+    const double f = cam.focalPx(), z = cam.mount.z_m, cy = cam.height / 2.0;
+    for (const double d : {2.0, 5.0, 9.0})
+      for (const double h : {1.2, 1.75}) {
+        const double foot = cy + f * std::tan(std::atan(z / d) + cam.tilt_rad);
+        const double head = cy - f * std::tan(std::atan((h - z) / d) - cam.tilt_rad);
+        EXPECT_NEAR(perception::standingHeightM(foot, head, cam), h, 1e-9) << d << " m, tilt " << tilt_deg;
+      }
+    const double horizon = cy + f * std::tan(cam.tilt_rad);
+    EXPECT_TRUE(std::isnan(perception::standingHeightM(horizon - 1, horizon - 100, cam))) << "tilt " << tilt_deg;
+  }
+}

@@ -66,6 +66,50 @@ TEST(PeopleDetector, FindsAPersonInTheOpenWhereTheCameraDrewThem) {
   EXPECT_EQ(again[0].box, found[0].box);
 }
 
+TEST(PeopleDetector, TheFloorBandFindsTheSameAsTheWholePyramidWithLessSearch) {
+  // The ground-plane constraint (PeopleDetectorOptions::floor_band): with a
+  // height range nobody leaves, it searches the windows detectMultiScale
+  // does and gives the very same boxes; with people's heights it still finds
+  // people standing on the floor at 3-8 m.
+  const sim::World w = corridor();
+  perception::CameraPose cam;  // the simulated camera: config::CameraMount{}, tilt 0
+  PeopleDetector whole({});
+  PeopleDetectorOptions any;
+  any.floor_band = true;
+  any.floor_min_m = 1e-6;
+  any.floor_max_m = 5.0;
+  PeopleDetector everything(any);
+  PeopleDetectorOptions band;
+  band.floor_band = true;
+  PeopleDetector floor(band);
+  EXPECT_EQ(perception::describe(band), "hog x1 step 1.05 stride 8 thr 0.00 group 2 floor");
+  int found = 0;
+  for (const double x : {3.2, 4.2, 5.2, 6.5, 8.0}) {
+    sim::CameraScene s;
+    s.people.push_back({{x, 0.4}, 0.25, 2, kPi, 1.0, 0.3});
+    std::vector<sim::PersonTruth> truth;
+    const cv::Mat pic = picture(w, s, &truth);
+    const auto a = whole.detect(pic), b = floor.detect(pic, &cam);
+    // The pyramid rebuilt level by level, every floor row searched: the same boxes to the pixel.
+    const auto c = everything.detect(pic, &cam);
+    ASSERT_EQ(a.size(), c.size()) << "x " << x;
+    for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].box, c[i].box) << "x " << x;
+    ASSERT_EQ(b.size(), a.size()) << "x " << x;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      // The group's mean moves a pixel or two where a level's edge windows were left out.
+      EXPECT_GT(iou(b[i].box, a[i].box), 0.9) << "x " << x;
+      EXPECT_GT(iou(b[i].box, truth[0].box), 0.5) << "x " << x;
+    }
+    found += static_cast<int>(b.size());
+  }
+  EXPECT_GE(found, 4) << "people at 3-8 m in the open";
+  // Without the picture's pose there is no floor to go by: the whole picture.
+  sim::CameraScene s;
+  s.people.push_back({{5.2, 0.4}, 0.25, 2, kPi, 1.0, 0.3});
+  const cv::Mat pic = picture(w, s);
+  EXPECT_EQ(floor.detect(pic).size(), whole.detect(pic).size());
+}
+
 TEST(PeopleDetector, AnEmptyCorridorGivesNoBox) {
   const sim::World w = corridor();
   for (const double pan : {-0.3, 0.0, 0.3}) {
