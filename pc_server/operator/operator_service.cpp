@@ -185,6 +185,13 @@ Issued OperatorService::video(uint64_t session, const std::string& robot, const 
   v1::Command c;
   auto* v = c.mutable_video();
   v->set_head(r.head);
+  if (r.head == v1::WIDE_HEAD) {
+    // A robot from before the wide head's stream would take the command for the PTZ head's.
+    const auto snap = registry_.snapshot(robot, now_ns);
+    if (snap && snap->connected && snap->has_telemetry && !snap->telemetry.has_wide_video())
+      return invalid("video", robot,
+                     robot + " does not stream a wide head (its config's wide_head.stream, robot_client --wide-stream)");
+  }
   std::string what;
   switch (r.what) {
     case W::kOn:

@@ -662,7 +662,19 @@ TEST_F(ConsoleTest, VideoAndPtzCommandsReachTheRobot) {
   std::tie(ok, out) = run("ptz home");
   EXPECT_TRUE(sink_.sent.back().ptz().home());
   EXPECT_EQ(sink_.sent[0].video().head(), v1::PTZ_HEAD);
-  // The wide head's stream (docs/video.md "The wide head's stream").
+  // The wide head's stream (docs/video.md "The wide head's stream"): refused
+  // here while the robot's telemetry shows none (an older robot would take it
+  // for the PTZ head's).
+  v1::Telemetry t;
+  t.mutable_video()->set_ssrc(42);
+  registry_.onTelemetry("robot1", kSerial, t, now());
+  const auto sent = sink_.sent.size();
+  std::tie(ok, out) = run("video wide bitrate 500");
+  EXPECT_FALSE(ok);
+  EXPECT_HAS(out, "robot1 does not stream a wide head");
+  EXPECT_EQ(sink_.sent.size(), sent) << "nothing sent";
+  t.mutable_wide_video()->set_ssrc(43);
+  registry_.onTelemetry("robot1", kSerial, t, now());
   std::tie(ok, out) = run("video wide bitrate 500");
   EXPECT_TRUE(ok) << out;
   EXPECT_HAS(out, "robot1: video wide bitrate accepted");
