@@ -91,14 +91,14 @@ behavior::CameraLook detectPeople(const world::World& w, const control::Pose2& r
 DetectorModelParams wideHeadModel() {
   DetectorModelParams p;
   p.upto_m = {1.0, 1.5, 2.0, 3.0, 4.0, 6.0};
-  p.recall_clear = {0.07, 0.52, 0.81, 0.61, 0.08, 0.04};
-  p.recall_part = {0.05, 0.10, 0.0, 0.33, 0.0, 0.0};
-  p.bearing_sigma_deg = 0.55;  // a normal's sigma from p50 0.35 / 0.674 and p90 0.93 / 1.645
-  // A two-piece normal about the median: (10.1 + 14.8) / 1.2816 short, (38.8 - 10.1) / 1.2816 long.
-  p.range_median = 0.101;
-  p.range_sigma_short = 0.194;
-  p.range_sigma_long = 0.224;
-  p.false_per_picture = 0.005;
+  p.recall_clear = {0.08, 0.50, 0.80, 0.61, 0.11, 0.03};
+  p.recall_part = {0.03, 0.05, 0.0, 0.32, 0.0, 0.0};
+  p.bearing_sigma_deg = 0.55;  // a normal's sigma from p50 0.33 / 0.674 and p90 0.96 / 1.645
+  // A two-piece normal about the median: (9.9 + 12.6) / 1.2816 short, (30.9 - 9.9) / 1.2816 long.
+  p.range_median = 0.099;
+  p.range_sigma_short = 0.175;
+  p.range_sigma_long = 0.164;
+  p.false_per_picture = 0.0;  // none in 300 pictures
   p.false_min_m = 1.0;
   p.false_max_m = 3.0;
   return p;

@@ -93,11 +93,12 @@ TEST(DetectorModel, RangeAndBearingErrorsAreTheBenchs) {
   const world::World open;
   const Seen s = watch(open, {{6.2, 0.5, 0.25}}, 0);
   ASSERT_GT(s.range_err.size(), 1000u);
-  EXPECT_NEAR(median(s.range_err), 0.107, 0.02) << "the foot row reads long";
+  // bench_people, 640x480 hog with the floor band (2026-12-07).
+  EXPECT_NEAR(median(s.range_err), 0.106, 0.02) << "the foot row reads long";
   std::vector<double> r = s.range_err;
   std::sort(r.begin(), r.end());
   EXPECT_NEAR(r[r.size() / 10], -0.068, 0.03) << "p10";
-  EXPECT_NEAR(r[r.size() * 9 / 10], 0.409, 0.04) << "p90";
+  EXPECT_NEAR(r[r.size() * 9 / 10], 0.355, 0.04) << "p90";
   EXPECT_NEAR(median(s.bearing_err_deg), 0.13, 0.03);
-  EXPECT_NEAR(s.falses, 0.027, 0.01) << "false boxes per picture";
+  EXPECT_NEAR(s.falses, 0.0033, 0.003) << "false boxes per picture";
 }
