@@ -99,14 +99,16 @@ void FoxgloveBridge::publishMessage(uint32_t channel, uint64_t ns, const google:
   server_.publish(channel, ns, std::make_shared<const std::string>(m.SerializeAsString()));
 }
 
-void FoxgloveBridge::advertiseRobot(const std::string& robot, RobotState& r) {
+uint32_t FoxgloveBridge::addTopic(const std::string& robot, scene::TopicKind kind) {
   // The topic table's live topics (pc_server/scene/topics: the names the recorder writes too).
+  const auto& d = scene::topicDef(kind);
+  return addChannel(scene::topicName(robot, kind), d.type(), d.video ? WsServer::Kind::kVideo : WsServer::Kind::kData);
+}
+
+void FoxgloveBridge::advertiseRobot(const std::string& robot, RobotState& r) {
   using scene::TopicKind;
   auto& c = r.ch;
-  const auto add = [&](TopicKind kind) {
-    const auto& d = scene::topicDef(kind);
-    return addChannel(scene::topicName(robot, kind), d.type(), d.video ? WsServer::Kind::kVideo : WsServer::Kind::kData);
-  };
+  const auto add = [&](TopicKind kind) { return addTopic(robot, kind); };
   c.telemetry = add(TopicKind::kTelemetry);
   c.events = add(TopicKind::kEvents);
   c.acks = add(TopicKind::kAcks);
@@ -122,11 +124,8 @@ void FoxgloveBridge::advertiseRobot(const std::string& robot, RobotState& r) {
 }
 
 void FoxgloveBridge::advertiseWideHead(const std::string& robot, RobotState& r) {
-  r.ch.camera_wide = addChannel(scene::topicName(robot, scene::TopicKind::kCameraWide),
-                                scene::topicDef(scene::TopicKind::kCameraWide).type(), WsServer::Kind::kVideo);
-  r.ch.camera_wide_people =
-      addChannel(scene::topicName(robot, scene::TopicKind::kCameraWidePeople),
-                 scene::topicDef(scene::TopicKind::kCameraWidePeople).type(), WsServer::Kind::kData);
+  r.ch.camera_wide = addTopic(robot, scene::TopicKind::kCameraWide);
+  r.ch.camera_wide_people = addTopic(robot, scene::TopicKind::kCameraWidePeople);
   log::info(kTag, robot, ": the wide head's channels advertised");
 }
 

@@ -25,6 +25,7 @@
 #include "pc_server/scene/robot_scene.hpp"
 #include "pc_server/scene/scene_feed.hpp"
 #include "pc_server/scene/site_maps.hpp"
+#include "pc_server/scene/topics.hpp"
 #include "shared/video/rtp_h264.hpp"
 
 namespace inspect::server::foxglove {
@@ -109,6 +110,7 @@ class FoxgloveBridge : public WsServer::Handler {
   void advertiseRobot(const std::string& robot, RobotState& r);
   void unadvertiseRobot(RobotState& r);
   void advertiseWideHead(const std::string& robot, RobotState& r);
+  uint32_t addTopic(const std::string& robot, scene::TopicKind kind);
   uint32_t addChannel(const std::string& topic, const google::protobuf::Descriptor* d, WsServer::Kind kind);
   void publishMessage(uint32_t channel, uint64_t ns, const google::protobuf::Message& m);
   void teleop(uint64_t client, const std::string& robot, std::string_view payload);
