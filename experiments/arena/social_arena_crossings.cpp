@@ -68,7 +68,7 @@ int crossings(const Options& o, const std::vector<sim::ScenarioContext>& context
               "and truly crossing, and what the strategy reported on them (%%). Target: crossing on >= 80 %%.\n\n",
               !o.camera.enabled ? "none" : o.camera.real ? "real" : "model", o.camera.wide_head ? "both" : "ptz");
   std::printf("| case | ticks | crossing | leading | confronting | encountering | none | unseen | dominant | "
-              "personal s (oracle) | lost s (oracle) | contacts |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "personal s (oracle) | lost s (oracle) | robot-fault (oracle) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   nlohmann::json cj = nlohmann::json::array();
   uint64_t all_ticks = 0, all_right = 0;
   for (const auto& r : runs) {
@@ -78,12 +78,12 @@ int crossings(const Options& o, const std::vector<sim::ScenarioContext>& context
     all_ticks += n;
     all_right += row[kCrossing];
     const auto at = [&](behavior::Pattern p) { return pct(row[static_cast<int>(p)], n); };
-    std::printf("| %s | %llu | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %s | %.2f (%.2f) | %.2f (%.2f) | %u |\n",
+    std::printf("| %s | %llu | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %s | %.2f (%.2f) | %.2f (%.2f) | %u (%u) |\n",
                 r.c.name().c_str(), static_cast<unsigned long long>(n), at(behavior::Pattern::kCrossing),
                 at(behavior::Pattern::kLeading), at(behavior::Pattern::kConfronting),
                 at(behavior::Pattern::kEncountering), at(behavior::Pattern::kNone), pct(row[arena::kUnseen], n),
                 m.reported_dominant < 0 ? "-" : patternName(m.reported_dominant).c_str(), m.personal_s,
-                r.oracle.personal_s, m.time_lost_s, r.oracle.time_lost_s, m.robot_fault + m.person_fault);
+                r.oracle.personal_s, m.time_lost_s, r.oracle.time_lost_s, m.robot_fault, r.oracle.robot_fault);
     nlohmann::json j;
     j["case"] = r.c.name();
     j["angle_deg"] = r.c.angle_deg;
@@ -101,6 +101,7 @@ int crossings(const Options& o, const std::vector<sim::ScenarioContext>& context
     j["oracle_time_lost_s"] = r.oracle.time_lost_s;
     j["robot_fault"] = m.robot_fault;
     j["person_fault"] = m.person_fault;
+    j["oracle_robot_fault"] = r.oracle.robot_fault;
     j["success"] = m.success;
     cj.push_back(j);
   }
