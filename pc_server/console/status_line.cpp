@@ -72,9 +72,14 @@ std::string videoFigures(const RobotSnapshot& snap, const VideoHub* video) {
          fmtFixed(st->kbps, 0) + " kbit/s loss " + fmtFixed(st->loss_pct, 1) + "% lat " +
          (st->latency_ms < 0 ? std::string("--") : fmtFixed(st->latency_ms, 0)) + " ms" + rateNote(tv);
 }
-}  // namespace
 
-namespace {
+/// "ffplay ... robot1.sdp   (RTP forwarded to 127.0.0.1:5700)" for a stream seen.
+std::string playLine(const VideoHub& video, const std::string& stream) {
+  const auto sdp = video.sdpPath(stream);
+  if (sdp.empty()) return {};
+  return ffplayCommand(sdp) + "   (RTP forwarded to 127.0.0.1:" + std::to_string(video.forwardPort(stream)) + ")";
+}
+
 /// The wide head's stream (docs/video.md "The wide head's stream"): the robot's and the server's figures.
 template <typename Line>
 void wideStreamLines(const Line& line, const std::string& robot_id, const v1::VideoStatus& v, const VideoHub& video) {
@@ -94,9 +99,7 @@ void wideStreamLines(const Line& line, const std::string& robot_id, const v1::Vi
                               std::to_string(st->lost_packets));
   else
     line("wide received", "no stream yet");
-  if (const auto sdp = video.sdpPath(name); !sdp.empty())
-    line("wide play", "ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay " + sdp +
-                          "   (RTP forwarded to 127.0.0.1:" + std::to_string(video.forwardPort(name)) + ")");
+  if (const auto play = playLine(video, name); !play.empty()) line("wide play", play);
 }
 }  // namespace
 
@@ -172,10 +175,7 @@ std::string videoReport(const std::string& robot_id, const std::optional<RobotSn
                                  ", wrong source " + std::to_string(c.wrong_source) + ", wrong payload type " +
                                  std::to_string(c.wrong_payload_type) +
                                  (c.last_reject.empty() ? std::string() : " (last: " + c.last_reject + ")"));
-  const auto sdp = video->sdpPath(robot_id);
-  if (!sdp.empty())
-    line("play", "ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay " + sdp +
-                     "   (RTP forwarded to 127.0.0.1:" + std::to_string(video->forwardPort(robot_id)) + ")");
+  if (const auto play = playLine(*video, robot_id); !play.empty()) line("play", play);
   if (snap && snap->has_telemetry && snap->telemetry.has_wide_video())
     wideStreamLines(line, robot_id, snap->telemetry.wide_video(), *video);
   return s;

@@ -140,6 +140,7 @@ Geometry geometryOf(const config::RobotConfig& c) {
   g.camera_y_m = c.camera.y_m;
   g.camera_z_m = c.camera.z_m;
   if (c.wide_camera) {
+    g.wide_camera = true;
     g.wide_camera_x_m = c.wide_camera->x_m;
     g.wide_camera_y_m = c.wide_camera->y_m;
     g.wide_camera_z_m = c.wide_camera->z_m;
@@ -250,8 +251,9 @@ void RobotScene::onEvent(const v1::Event& e) {
   // (+z ahead, +x right, +y down) from the mount's (+x ahead, +y left, +z up).
   const Quat optical{0.5, -0.5, 0.5, -0.5};
   add(frame("camera_mount"), frame("camera"), 0, 0, 0, pitchQ(-last_.ptz_tilt_rad()) * optical);
-  add(frame("base_link"), frame("camera_wide"), g_.wide_camera_x_m, g_.wide_camera_y_m, g_.wide_camera_z_m,
-      pitchQ(-g_.wide_camera_tilt_deg * std::numbers::pi / 180) * optical);
+  if (g_.wide_camera)
+    add(frame("base_link"), frame("camera_wide"), g_.wide_camera_x_m, g_.wide_camera_y_m, g_.wide_camera_z_m,
+        pitchQ(-g_.wide_camera_tilt_deg * std::numbers::pi / 180) * optical);
   return out;
 }
 

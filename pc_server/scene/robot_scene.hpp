@@ -46,6 +46,7 @@ struct Geometry {
   double camera_x_m = config::CameraMount{}.x_m, camera_y_m = config::CameraMount{}.y_m,
          camera_z_m = config::CameraMount{}.z_m;
   // The wide head's lens (robot.yaml wide_camera; its frame "<robot>/camera_wide").
+  bool wide_camera = false;  // the robot config has one (its frame is published only then)
   double wide_camera_x_m = 0.24, wide_camera_y_m = 0.0, wide_camera_z_m = 0.55, wide_camera_tilt_deg = 0.0;
 };
 Geometry geometryOf(const config::RobotConfig& c);

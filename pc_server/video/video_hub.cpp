@@ -126,7 +126,7 @@ void VideoHub::followStream(const std::string& name, uint32_t ssrc, const std::s
     }
     log::info(log::tag::kVideo, name, ": stream SSRC ", r.ssrc, " from ", ip,
               r.forward_port ? ", forwarded to 127.0.0.1:" + std::to_string(r.forward_port) : std::string(),
-              "; play with: ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay ", r.sdp_path);
+              "; play with: ", ffplayCommand(r.sdp_path));
   } else if (std::abs(offset - r.offset_us) > 200) {
     r.offset_us = offset;
     receiver_->setClockOffset(name, offset);

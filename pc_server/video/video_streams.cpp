@@ -24,4 +24,8 @@ std::string streamFileStem(const std::string& name) {
   return stem;
 }
 
+std::string ffplayCommand(const std::string& sdp_path) {
+  return "ffplay -protocol_whitelist file,udp,rtp -fflags nobuffer -flags low_delay " + sdp_path;
+}
+
 }  // namespace inspect::server

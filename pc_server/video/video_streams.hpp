@@ -23,4 +23,7 @@ StreamRef parseStreamName(const std::string& name);
 /// A file name's stem for the stream: "robot1", "robot1.wide".
 std::string streamFileStem(const std::string& name);
 
+/// The command line that plays a stream's SDP file with ffplay (docs/video.md).
+std::string ffplayCommand(const std::string& sdp_path);
+
 }  // namespace inspect::server

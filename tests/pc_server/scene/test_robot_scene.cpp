@@ -83,6 +83,16 @@ TEST(RobotScene, TransformsChainMapOdomBaseSensorsCamera) {
   EXPECT_NEAR(mount->rotation().z(), std::sin(0.25), 1e-12);  // pan 0.5 rad
   const auto* cam = find(f, "robot1/camera");
   ASSERT_NE(cam, nullptr);
+  EXPECT_EQ(find(f, "robot1/camera_wide"), nullptr) << "no wide head in this robot's config: no frame for one";
+  Geometry wide;
+  wide.wide_camera = true;
+  RobotScene w("robot1", wide);
+  w.onTelemetry(sceneTelemetry(1.0, 0.5, 0));
+  const auto wf = w.transforms(1'500'000'000);
+  const auto* wide_cam = find(wf, "robot1/camera_wide");
+  ASSERT_NE(wide_cam, nullptr);
+  EXPECT_EQ(wide_cam->parent_frame_id(), "robot1/base_link");
+  EXPECT_DOUBLE_EQ(wide_cam->translation().z(), 0.55);
   // Every rotation is a unit quaternion (proto3's unset quaternion, w = 0, is not).
   for (const auto& t : f.transforms()) {
     const auto& q = t.rotation();
