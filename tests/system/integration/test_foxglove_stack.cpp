@@ -30,6 +30,10 @@ TEST(FoxgloveStack, ClientLibraryDecodesDrivesCallsAndIsRefused) {
                             {"--config", s.dir() / "server.yaml", "--site-map", srcPath("config/worlds/square_room.yaml")}))
       << s.logs();
   auto& r = s.startRobot("robot1");
+  // The client looks for the robot's channels for 5 s once connected: start it when the robot is
+  // (on a loaded host robot_client once took 20 s to come up, and the client found no channel).
+  EXPECT_TRUE(waitUntil([&] { return s.serverOutput().find("expect ok (line 1)") != std::string::npos; }, 30.0))
+      << "the robot did not connect within 30 s\n" << s.logs();
   const std::string url = "ws://127.0.0.1:" + std::to_string(s.foxglovePort()) + "/";
   auto node = Process::spawn({"/usr/bin/env", "node", srcPath("tests/tools/foxglove_client.js"), "--modules", reader, "--url", url,
                               "--token", s.foxgloveToken(), "--truth", r.truth, "--robot", "robot1", "--seconds", "6",
