@@ -2,6 +2,7 @@
 
 #include "shared/net/gains_proto.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <cmath>
@@ -64,6 +65,16 @@ v1::Ack ack(uint64_t id, v1::Ack::Status status, const std::string& reason = {})
   a.set_reason(reason);
   return a;
 }
+
+// What a look aside at track `id` found, as its track now says.
+const char* lookOutcome(const std::vector<behavior::HumanTrack>& tracks, int id) {
+  const auto it = std::find_if(tracks.begin(), tracks.end(), [&](const auto& t) { return t.id == id; });
+  if (it == tracks.end()) return "the track is gone";
+  if (it->camera_hits > 0) return "a person found there";
+  if (it->camera_denied || it->camera_doubted) return "nobody seen there: not a person";
+  return "the dwell is over or someone is ahead";
+}
+
 }  // namespace
 
 RobotApp::RobotApp(asio::io_context& io, const ClientConfig& cfg, const config::RobotConfig& robot,
@@ -277,6 +288,7 @@ v1::Ack RobotApp::onVideoCommand(const v1::Command& cmd) {
 }
 
 v1::Ack RobotApp::onPtzCommand(const v1::Command& cmd) {
+  abandonLookAside("the operator moved the camera");
   if (const std::string why = sendPtz(cmd.ptz()); !why.empty()) return ack(cmd.id(), v1::Ack::REJECTED, why);
   // The operator points the camera: the look-ahead yields until nobody is near.
   if (looking_ahead_) {
@@ -293,6 +305,7 @@ std::string RobotApp::applyPtz(const v1::Ptz& p) {
     ptz_before_look_ = p;
     return "";
   }
+  abandonLookAside("a route's camera preset");
   return sendPtz(p);
 }
 
@@ -327,9 +340,12 @@ void RobotApp::lookAhead(double now_s) {
   if (!held) look_ahead_yielded_ = false;
   const bool ahead = std::abs(ptz_pan_rad_) <= cfg_.perception.ahead_deg * M_PI / 180 && std::abs(ptz_tilt_rad_) < 0.1;
   if (want && !looking_ahead_ && !look_ahead_yielded_ && !ahead) {
-    ptz_before_look_.Clear();
-    ptz_before_look_.set_pan_rad(ptz_pan_rad_);
-    ptz_before_look_.set_tilt_rad(ptz_tilt_rad_);
+    ptz_before_look_.Clear();  // a look aside is not given back: level ahead is
+    if (!looking_aside_) {
+      ptz_before_look_.set_pan_rad(ptz_pan_rad_);
+      ptz_before_look_.set_tilt_rad(ptz_tilt_rad_);
+    }
+    abandonLookAside("a person near while moving");
     v1::Ptz level;  // straight ahead, level
     if (sendPtz(level).empty()) {
       looking_ahead_ = true;
@@ -343,6 +359,43 @@ void RobotApp::lookAhead(double now_s) {
       log::info("perception", "nobody near: the camera goes back to pan ", ptz_before_look_.pan_rad(), " tilt ",
                 ptz_before_look_.tilt_rad(), " rad");
   }
+}
+
+void RobotApp::lookAside(double now_s) {
+  const behavior::HumanAwareness* aw = core_.awareness();
+  if (!watcher_ || !aw || !aw->config().active_look.enabled || looking_ahead_) return;
+  const bool level = std::abs(ptz_pan_rad_) < 1e-3 && std::abs(ptz_tilt_rad_) < 1e-3;
+  if (!looking_aside_ && !level) return;  // someone else's set-point
+  const int before = aside_.target_id;
+  const double settled_before = aside_.settled_s;
+  const double pan = behavior::activeLookPan(aside_, aw->config().active_look, aw->tracker().tracks(), core_.pose(),
+                                             camera_mount_.x_m, camera_mount_.y_m, camera_mount_.hfov_deg * M_PI / 360.0,
+                                             aw->config().tracker.camera.recall, now_s);
+  if (aside_.settled_s != settled_before)  // a turn began: its pictures are blurred
+    aside_settled_us_ = monoNowUs() + static_cast<uint64_t>(std::max(0.0, aside_.settled_s - now_s) * 1e6);
+  if (std::abs(pan - ptz_pan_rad_) > 1e-3) {
+    v1::Ptz p;
+    p.set_pan_rad(pan);
+    if (const auto why = sendPtz(p); !why.empty()) {
+      log::warn("perception", "active looking: ", why);
+      return;
+    }
+  }
+  looking_aside_ = aside_.target_id >= 0 || std::abs(ptz_pan_rad_) > 1e-3;
+  if (aside_.target_id >= 0 && aside_.target_id != before)
+    log::info("perception", "nobody ahead: the camera looks aside at sonar track ", aside_.target_id, ", pan ", pan,
+              " rad");
+  else if (aside_.target_id < 0 && before >= 0)
+    log::info("perception", "the look aside at track ", before, " is over (", lookOutcome(aw->tracker().tracks(), before),
+              "): the camera goes back ahead");
+}
+
+void RobotApp::abandonLookAside(const char* why) {
+  if (!looking_aside_) return;
+  log::info("perception", why, ": the look aside at track ", aside_.target_id, " ends");
+  aside_.target_id = -1;
+  aside_.pan_rad = 0.0;
+  looking_aside_ = false;
 }
 
 void RobotApp::feedCamera() {
@@ -359,6 +412,7 @@ void RobotApp::feedHead(const PeopleWatcher& w, const config::CameraMount& mount
   // the people around now.
   if (monoNowUs() > view->capture_us + static_cast<uint64_t>(cfg_.perception.stale_s * 1e6)) return;
   if (std::abs(view->tilt_rad) > M_PI / 6) return;
+  if (!wide && view->capture_us < aside_settled_us_) return;  // taken while the head turned
   behavior::CameraLook look;
   look.lens_x_m = mount.x_m;
   look.lens_y_m = mount.y_m;
@@ -376,6 +430,9 @@ void RobotApp::fillPerception(v1::Telemetry& t) const {
     auto* p = t.mutable_perception();
     fillHead(*watcher_, *p);
     p->set_looking_ahead(looking_ahead_);
+    p->set_looking_aside(looking_aside_);
+    p->set_aside_looks(static_cast<uint32_t>(aside_.looks));
+    p->set_aside_off_path_s(aside_.off_path_s);
     const bool ahead =
         std::abs(ptz_pan_rad_) <= cfg_.perception.ahead_deg * M_PI / 180 && std::abs(ptz_tilt_rad_) <= M_PI / 6;
     if (p->mode() == v1::CAMERA_AND_SONAR && !ahead) p->set_mode(v1::CAMERA_ELSEWHERE);
@@ -540,6 +597,7 @@ void RobotApp::tick10ms() {
 }
 
 void RobotApp::sendTelemetry() {
+  lookAside(now());
   lookAhead(now());
   core_.setSerialCounters(serial_.rxCounters(), serial_.bytesTx(), serial_.framesTx());
   if (link_.isUp()) {

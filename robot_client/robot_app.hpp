@@ -58,6 +58,13 @@ class RobotApp {
   /// Turns the camera ahead while a tracked person is near and the robot
   /// moves, and gives the PTZ back look_ahead_hold_s after (perception.look_ahead).
   void lookAhead(double now_s);
+  /// Active looking (config/behavior.yaml active_look): turns the PTZ head to
+  /// a sonar track beside that no head has settled while nobody is ahead, and
+  /// back ahead; only while the camera is left ahead and level (an operator's
+  /// or a route's set-point is never taken over; either ends a look).
+  void lookAside(double now_s);
+  /// Ends a look aside without turning back (the operator or a route points the camera).
+  void abandonLookAside(const char* why);
   /// Sends a set-point to the MCU and tells the people watcher; "" or why not.
   std::string sendPtz(const v1::Ptz& p);
   /// Gives the people tracker each head's newest detection (once each).
@@ -88,6 +95,9 @@ class RobotApp {
   bool look_ahead_yielded_ = false;  // the operator moved the camera: not again until nobody is near
   double look_last_s_ = -1e9;        // last time people were near while moving
   v1::Ptz ptz_before_look_;          // the set-point to give back
+  behavior::ActiveLookState aside_;  // active looking's planner state
+  bool looking_aside_ = false;       // the PTZ head is turned (or turning) aside by it
+  uint64_t aside_settled_us_ = 0;    // the PTZ head's pictures before this (monotonic us) were taken while it turned
   config::CameraMount camera_mount_;
   uint64_t camera_fed_seq_ = 0;      // the last detection given to the people tracker
   // The wide, fixed head (wide_head.source): captured without streaming, detected.

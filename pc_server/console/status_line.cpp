@@ -58,7 +58,12 @@ std::string headFigures(const v1::Perception& p) {
   return std::string(perceptionName(p.mode())) + ", " + seenPeople(p) + "; " + p.detector() + " on " +
          std::to_string(p.width()) + "x" + std::to_string(p.height()) + ", " + fmtFixed(p.rate_hz(), 1) + " Hz, " +
          fmtFixed(p.detect_ms(), 1) + " ms, " + std::to_string(p.detections()) + " pictures" +
-         (p.looking_ahead() ? ", looking ahead for people" : "") + (p.error().empty() ? "" : ", error: " + p.error());
+         (p.looking_ahead() ? ", looking ahead for people" : "") +
+         (p.looking_aside() ? ", looking aside at a sonar track" : "") +
+         (p.aside_looks() ? ", " + std::to_string(p.aside_looks()) + " looks aside (" +
+                                fmtFixed(p.aside_off_path_s(), 1) + " s off the path)"
+                          : "") +
+         (p.error().empty() ? "" : ", error: " + p.error());
 }
 
 std::string videoFigures(const RobotSnapshot& snap, const VideoHub* video) {

@@ -55,6 +55,8 @@ class RobotCore {
 
   /// Turns on human awareness (people tracking and the Eq 9 speed factor).
   void setAwareness(std::unique_ptr<behavior::HumanAwareness> a) { awareness_ = std::move(a); }
+  /// Human awareness (its tracks, its config); null when off.
+  const behavior::HumanAwareness* awareness() const { return awareness_.get(); }
 
   /// A camera picture's people (the robot at its present pose: the
   /// picture's ~0.1 s age is in the fusion's bearing noise).
