@@ -18,6 +18,7 @@ PACKAGES=(
   openssl protobuf-compiler python3-protobuf
   libsqlite3-dev sqlite3
   libpq-dev postgresql
+  libmosquitto-dev mosquitto python3-paho-mqtt
   libnlopt-cxx-dev
   libzstd-dev zlib1g-dev
   fuzzylite libfuzzylite-dev

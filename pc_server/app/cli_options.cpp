@@ -41,6 +41,15 @@ CliOptions parseCli(const std::vector<std::string>& args) {
     else if (a.is("--foxglove-port-file")) o.foxglove_port_file = a.path();
     else if (a.is("--foxglove-token-file")) o.foxglove_token_file = a.path();
     else if (a.is("--site-map")) o.site_map = a.path();
+    else if (a.is("--sparkplug-broker")) {
+      o.sparkplug_broker = a.path();
+      const auto colon = o.sparkplug_broker->rfind(':');
+      if (colon == std::string::npos || colon == 0 || colon + 1 == o.sparkplug_broker->size() ||
+          o.sparkplug_broker->find_first_not_of("0123456789", colon + 1) != std::string::npos ||
+          o.sparkplug_broker->size() - colon - 1 > 5 || std::stoi(o.sparkplug_broker->substr(colon + 1)) < 1 ||
+          std::stoi(o.sparkplug_broker->substr(colon + 1)) > 65535)
+        a.fail("'" + *o.sparkplug_broker + "' is not HOST:PORT (e.g. 127.0.0.1:1883)");
+    }
     else if (a.is("--operator-socket")) o.operator_socket = a.path();
     else if (a.is("--attach")) o.attach = a.path();
     else if (a.is("--plaintext")) o.plaintext = true;
@@ -88,6 +97,9 @@ std::string usageText() {
          "  --foxglove-port-file FILE  write the bridge's port to FILE once listening\n"
          "  --foxglove-token-file FILE  the bridge's token (read, or created with a new random token; mode 0600)\n"
          "  --site-map FILE   world file drawn in every robot's 3-D scene (overrides site_map; a route's map wins)\n"
+         "  --sparkplug-broker HOST:PORT  publish to SCADA as a Sparkplug B edge node on this MQTT broker\n"
+         "                    (turns sparkplug.enabled on; credentials only from sparkplug.credentials_file;\n"
+         "                    docs/sparkplug.md)\n"
          "  --operator-socket PATH  more operator consoles: `pc_server --attach PATH` connects one (Unix socket,\n"
          "                    mode 0660; overrides operator_socket; each is a session, see 'help control')\n"
          "  --attach PATH     be an operator console of the server listening on PATH, then exit\n"

@@ -35,6 +35,7 @@ struct CliOptions {
   std::optional<std::string> foxglove_port_file;
   std::optional<std::string> foxglove_token_file;
   std::optional<std::string> site_map;
+  std::optional<std::string> sparkplug_broker;  // --sparkplug-broker HOST:PORT: the edge node on
   std::optional<std::string> operator_socket;  // more operator consoles on this Unix socket
   std::optional<std::string> attach;           // --attach PATH: be a console of a running server
   bool interactive = false;

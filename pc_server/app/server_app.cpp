@@ -25,6 +25,8 @@
 #include "pc_server/foxglove/foxglove_bridge.hpp"
 #include "pc_server/foxglove/token_file.hpp"
 #include "pc_server/scene/site_maps.hpp"
+#include "pc_server/sparkplug/sparkplug_credentials.hpp"
+#include "pc_server/sparkplug/sparkplug_service.hpp"
 #include "shared/config/robot_config.hpp"
 #include "pc_server/app/console_runner.hpp"
 #include "pc_server/link/link_server.hpp"
@@ -117,6 +119,12 @@ ServerConfig resolveConfig(const CliOptions& options) {
     c.foxglove.auth = "token";
   }
   if (options.site_map) c.site_map = *options.site_map;
+  if (options.sparkplug_broker) {
+    const auto colon = options.sparkplug_broker->rfind(':');
+    c.sparkplug.enabled = true;
+    c.sparkplug.host = options.sparkplug_broker->substr(0, colon);
+    c.sparkplug.port = static_cast<uint16_t>(std::stoi(options.sparkplug_broker->substr(colon + 1)));  // checked by parseCli
+  }
   c.recording.server_id = catalogServerId(c);
   return c;
 }
@@ -391,6 +399,11 @@ int runServer(const CliOptions& options) {
                                          bool inbound, uint64_t time_us) {
     if (auto* b = bridge_ptr.load()) b->onEnvelope(id, env, inbound, time_us);
   });
+  std::atomic<sparkplug::SparkplugService*> scada_ptr{nullptr};
+  link.addEnvelopeObserver([&scada_ptr](const std::string& id, const std::string&, const v1::Envelope& env,
+                                        bool inbound, uint64_t time_us) {
+    if (auto* s = scada_ptr.load()) s->onEnvelope(id, env, inbound, time_us);
+  });
   const auto endpoint = link.listen();
   if (config.tls.plaintext) {
     log::warn(log::tag::kServer, net::kPlaintextWarning);
@@ -431,6 +444,23 @@ int runServer(const CliOptions& options) {
     foxglove_port = ep.port();
   }
   auto presence = startPresence(ioc, config, recorder.get(), registry, endpoint.port(), foxglove_port);
+  // The plant's SCADA (docs/sparkplug.md): alarm transitions from the link, the rest from the registry.
+  std::unique_ptr<sparkplug::SparkplugService> scada;
+  if (config.sparkplug.enabled) {
+    const auto& sc = config.sparkplug;
+    scada = std::make_unique<sparkplug::SparkplugService>(
+        sc, sc.edge_node_id.empty() ? config.server_id : sc.edge_node_id, registry,
+        [rec = recorder.get()](const std::string& robot) { return rec ? rec->activeRun(robot).value_or("") : ""; });
+    if (!sc.credentials_file.empty()) {
+      const auto cred = sparkplug::loadCredentials(sc.credentials_file);
+      scada->setCredentials(cred.username, cred.password);
+    }
+    scada_ptr = scada.get();
+    scada->start();
+    std::cout << "pc_server: Sparkplug B edge node " << sc.group_id << "/"
+              << (sc.edge_node_id.empty() ? config.server_id : sc.edge_node_id) << " on mqtt" << (sc.ca.empty() ? "" : "s")
+              << "://" << sc.host << ":" << sc.port << std::endl;
+  }
 
   StopFlag stop;
   asio::signal_set signals(ioc, SIGINT, SIGTERM);
@@ -445,6 +475,7 @@ int runServer(const CliOptions& options) {
   const int status = runConsoles(mode, script, options, config, registry, link, control, copt, configure, stop);
   std::cout.flush();
   if (bridge) bridge->stop();
+  if (scada) scada->stop();  // the robots' DDEATH and the node's NDEATH while the links still stand
 
   log::info(log::tag::kServer, "stopping: closing robot sessions");
   link.stop();

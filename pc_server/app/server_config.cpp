@@ -2,6 +2,8 @@
 
 #include <boost/asio/ip/address.hpp>
 
+#include "pc_server/sparkplug/sparkplug_metric.hpp"
+
 namespace inspect::server {
 
 bool validBindAddress(const std::string& address) {
@@ -82,6 +84,36 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   fc.grid_hz = f.number("grid_hz", fc.grid_hz, 0.1, 10);
   fc.teleop_timeout_s = f.number("teleop_timeout_s", fc.teleop_timeout_s, 0.1, 2);
   fc.max_clients = static_cast<int>(f.integer("max_clients", fc.max_clients, 1, 256));
+  const auto sp = root.optChild("sparkplug");
+  auto& sc = c.sparkplug;
+  sc.enabled = sp.boolean("enabled", sc.enabled);
+  sc.host = sp.string("host", sc.host);
+  if (sc.host.empty()) sp.fail("host", "must not be empty (the MQTT broker's name or address)");
+  sc.port = static_cast<uint16_t>(sp.integer("port", sc.port, 1, 65535));
+  sc.group_id = sp.string("group_id", sc.group_id);
+  if (!sparkplug::validId(sc.group_id)) sp.fail("group_id", "'" + sc.group_id + "' must be non-empty without '/', '+' or '#'");
+  sc.edge_node_id = sp.string("edge_node_id", sc.edge_node_id);
+  if (!sc.edge_node_id.empty() && !sparkplug::validId(sc.edge_node_id))
+    sp.fail("edge_node_id", "'" + sc.edge_node_id + "' must be without '/', '+' or '#' (\"\" = the server_id)");
+  sc.credentials_file = sp.string("credentials_file", sc.credentials_file);
+  sc.ca = sp.string("ca", sc.ca);
+  sc.cert = sp.string("cert", sc.cert);
+  sc.key = sp.string("key", sc.key);
+  if (sc.cert.empty() != sc.key.empty()) sp.fail(sc.cert.empty() ? "cert" : "key", "cert and key go together");
+  if (!sc.cert.empty() && sc.ca.empty()) sp.fail("ca", "must be set with a client certificate (TLS)");
+  sc.qos = static_cast<int>(sp.integer("qos", sc.qos, 0, 1));
+  sc.keepalive_s = sp.number("keepalive_s", sc.keepalive_s, 1, 600);
+  sc.min_period_s = sp.number("min_period_s", sc.min_period_s, 0.05, 60);
+  sc.commands = sp.boolean("commands", sc.commands);
+  sc.queue_max = static_cast<std::size_t>(sp.integer("queue_max", static_cast<long>(sc.queue_max), 1, 10'000'000));
+  const auto db = sp.optChild("deadbands");
+  auto& d = sc.deadbands;
+  d.position_m = db.number("position_m", d.position_m, 0, 100);
+  d.heading_rad = db.number("heading_rad", d.heading_rad, 0, 3.15);
+  d.speed_m_s = db.number("speed_m_s", d.speed_m_s, 0, 10);
+  d.battery_v = db.number("battery_v", d.battery_v, 0, 100);
+  d.person_m = db.number("person_m", d.person_m, 0, 100);
+  d.gas_fraction = db.number("gas_fraction", d.gas_fraction, 0, 1);
   const auto t = root.optChild("tls");
   for (const char* key : {"ca", "cert", "key"}) {
     std::string& field = key[0] == 'c' ? (key[1] == 'a' ? c.tls.ca : c.tls.cert) : c.tls.key;

@@ -8,6 +8,7 @@
 #include "pc_server/foxglove/foxglove_config.hpp"
 #include "pc_server/link/link_config.hpp"
 #include "pc_server/recording/recording_config.hpp"
+#include "pc_server/sparkplug/sparkplug_config.hpp"
 #include "pc_server/video/video_config.hpp"
 #include "shared/config/config_node.hpp"
 
@@ -22,6 +23,7 @@ struct ServerConfig : LinkConfig {
   std::string operator_socket;           // Unix socket for more operator consoles; "" = none
   FoxgloveServerConfig foxglove;
   std::string site_map;                  // world file drawn in every robot's 3-D scene ("" = none; routes' maps win)
+  sparkplug::SparkplugConfig sparkplug;  // the MQTT Sparkplug B edge node (docs/sparkplug.md); off by default
 };
 
 /// True for a numeric IPv4/IPv6 address.

@@ -1,0 +1,109 @@
+#include "pc_server/sparkplug/mqtt_session.hpp"
+
+#include <mosquitto.h>
+
+#include <mutex>
+
+namespace inspect::server::sparkplug {
+
+namespace {
+void libInit() {
+  static std::once_flag once;
+  std::call_once(once, [] { mosquitto_lib_init(); });
+}
+}  // namespace
+
+std::string MqttSession::errorText(int rc) { return mosquitto_strerror(rc); }
+
+MqttSession::MqttSession(const MqttOptions& o, Callbacks cb) : cb_(std::move(cb)), opts_(o) {
+  libInit();
+  mosq_ = mosquitto_new(o.client_id.c_str(), /*clean_session=*/true, this);
+  if (!mosq_) {
+    lost_ = true;
+    error_ = "mosquitto_new failed";
+    return;
+  }
+  mosquitto_connect_callback_set(mosq_, [](struct mosquitto*, void* self, int rc) {
+    auto* s = static_cast<MqttSession*>(self);
+    if (rc != 0) {
+      s->lost_ = true;
+      s->error_ = std::string("the broker refused the connection: ") + mosquitto_connack_string(rc);
+    }
+    if (s->cb_.connected) s->cb_.connected(rc);
+  });
+  mosquitto_disconnect_callback_set(mosq_, [](struct mosquitto*, void* self, int rc) {
+    auto* s = static_cast<MqttSession*>(self);
+    s->lost_ = true;
+    if (s->error_.empty()) s->error_ = rc == 0 ? "disconnected" : "connection lost: " + errorText(rc);
+  });
+  mosquitto_publish_callback_set(mosq_, [](struct mosquitto*, void* self, int mid) {
+    auto* s = static_cast<MqttSession*>(self);
+    if (s->cb_.delivered) s->cb_.delivered(mid);
+  });
+  mosquitto_message_callback_set(mosq_, [](struct mosquitto*, void* self, const struct mosquitto_message* m) {
+    auto* s = static_cast<MqttSession*>(self);
+    if (s->cb_.message && m && m->topic)
+      s->cb_.message(m->topic, std::string(static_cast<const char*>(m->payload), static_cast<std::size_t>(m->payloadlen)));
+  });
+}
+
+MqttSession::~MqttSession() {
+  if (mosq_) mosquitto_destroy(mosq_);
+}
+
+std::string MqttSession::connect(const std::string& will_topic, const std::string& will_payload) {
+  if (!mosq_) return error_;
+  int rc = MOSQ_ERR_SUCCESS;
+  if (!opts_.username.empty())
+    rc = mosquitto_username_pw_set(mosq_, opts_.username.c_str(), opts_.password.empty() ? nullptr : opts_.password.c_str());
+  if (rc == MOSQ_ERR_SUCCESS && !opts_.ca.empty())
+    rc = mosquitto_tls_set(mosq_, opts_.ca.c_str(), nullptr, opts_.cert.empty() ? nullptr : opts_.cert.c_str(),
+                           opts_.key.empty() ? nullptr : opts_.key.c_str(), nullptr);
+  if (rc == MOSQ_ERR_SUCCESS)
+    rc = mosquitto_will_set(mosq_, will_topic.c_str(), static_cast<int>(will_payload.size()), will_payload.data(), 1, false);
+  if (rc == MOSQ_ERR_SUCCESS) mosquitto_int_option(mosq_, MOSQ_OPT_TCP_NODELAY, 1);
+  if (rc == MOSQ_ERR_SUCCESS) rc = mosquitto_connect(mosq_, opts_.host.c_str(), opts_.port, opts_.keepalive_s);
+  if (rc != MOSQ_ERR_SUCCESS) {
+    lost_ = true;
+    error_ = rc == MOSQ_ERR_ERRNO ? std::string("cannot connect to ") + opts_.host + ":" + std::to_string(opts_.port)
+                                  : errorText(rc);
+    return error_;
+  }
+  return "";
+}
+
+bool MqttSession::step(int timeout_ms) {
+  if (!mosq_ || lost_) return false;
+  const int rc = mosquitto_loop(mosq_, timeout_ms, 1);
+  if (rc != MOSQ_ERR_SUCCESS && !lost_) {
+    lost_ = true;
+    error_ = "connection lost: " + errorText(rc);
+  }
+  return !lost_;
+}
+
+int MqttSession::publish(const std::string& topic, const std::string& payload, int qos) {
+  if (!mosq_ || lost_) return -1;
+  int mid = 0;
+  const int rc = mosquitto_publish(mosq_, &mid, topic.c_str(), static_cast<int>(payload.size()), payload.data(), qos, false);
+  if (rc != MOSQ_ERR_SUCCESS) {
+    lost_ = true;
+    error_ = "publish: " + errorText(rc);
+    return -1;
+  }
+  return mid;
+}
+
+bool MqttSession::subscribe(const std::string& pattern, int qos) {
+  return mosq_ && !lost_ && mosquitto_subscribe(mosq_, nullptr, pattern.c_str(), qos) == MOSQ_ERR_SUCCESS;
+}
+
+void MqttSession::disconnect() {
+  if (mosq_ && !lost_) {
+    mosquitto_disconnect(mosq_);
+    mosquitto_loop(mosq_, 50, 1);
+  }
+  lost_ = true;
+}
+
+}  // namespace inspect::server::sparkplug

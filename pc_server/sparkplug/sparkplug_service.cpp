@@ -1,0 +1,245 @@
+#include "pc_server/sparkplug/sparkplug_service.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "pc_server/sparkplug/device_metrics.hpp"
+#include "shared/util/clock.hpp"
+#include "shared/util/log.hpp"
+
+namespace inspect::server::sparkplug {
+
+namespace {
+uint64_t nowMs() {
+  return static_cast<uint64_t>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+}
+constexpr int kStepMs = 20;  // the session's poll: an alarm transition waits at most this before it goes out
+}  // namespace
+
+SparkplugService::SparkplugService(const SparkplugConfig& cfg, std::string edge_node_id, const RobotRegistry& registry,
+                                   std::function<std::string(const std::string&)> run_of)
+    : cfg_(cfg), registry_(registry), run_of_(std::move(run_of)), node_(cfg.group_id, std::move(edge_node_id)) {
+  mqtt_.client_id = "inspect-" + cfg_.group_id + "-" + node_.node();
+  mqtt_.host = cfg_.host;
+  mqtt_.port = cfg_.port;
+  mqtt_.keepalive_s = std::max(1, static_cast<int>(cfg_.keepalive_s));
+  mqtt_.ca = cfg_.ca;
+  mqtt_.cert = cfg_.cert;
+  mqtt_.key = cfg_.key;
+  stats_.broker = cfg_.host + ":" + std::to_string(cfg_.port);
+}
+
+void SparkplugService::setCredentials(std::string username, std::string password) {
+  mqtt_.username = std::move(username);
+  mqtt_.password = std::move(password);
+}
+
+SparkplugService::~SparkplugService() { stop(); }
+
+void SparkplugService::start() {
+  if (thread_.joinable()) return;
+  thread_ = std::thread([this] { run(); });
+}
+
+void SparkplugService::stop() {
+  stop_ = true;
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+ServiceStats SparkplugService::stats() const {
+  std::lock_guard lk(mu_);
+  ServiceStats s = stats_;
+  s.queued = events_.size();
+  return s;
+}
+
+uint64_t SparkplugService::wallMs(const std::string& robot, uint64_t robot_us) const {
+  const auto it = offsets_us_.find(robot);
+  if (it == offsets_us_.end()) return nowMs();
+  return monoUsToWallNs(static_cast<uint64_t>(static_cast<int64_t>(robot_us) + it->second)) / 1'000'000;
+}
+
+void SparkplugService::onEnvelope(const std::string& robot, const v1::Envelope& env, bool inbound, uint64_t time_us) {
+  if (!inbound) return;
+  std::lock_guard lk(mu_);
+  // The robot's clock to the server's: the smallest (receive - send) seen is
+  // the offset plus the shortest one-way delay.
+  if (env.send_time_us()) {
+    const int64_t o = static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us());
+    auto [it, fresh] = offsets_us_.try_emplace(robot, o);
+    if (!fresh) it->second = std::min(it->second, o);
+  }
+  if (!env.has_event() || !env.event().has_gas_alarm()) return;
+  const auto kind = env.event().kind();
+  if (kind != v1::Event::ALARM_RAISED && kind != v1::Event::ALARM_CLEARED) return;
+  if (events_.size() >= cfg_.queue_max) {
+    ++stats_.dropped;
+    log::warn("sparkplug", "event queue full (", cfg_.queue_max, "): alarm ", env.event().gas_alarm().id(), " of ",
+              robot, " not sent");
+    return;
+  }
+  const auto& a = env.event().gas_alarm();
+  events_.push_back({robot, a, wallMs(robot, a.robot_time_us() ? a.robot_time_us() : env.event().robot_time_us()),
+                     env.event().has_stored() && env.event().stored().replayed(), -1});
+  wake_.notify_all();
+}
+
+void SparkplugService::run() {
+  double backoff_s = 0.5;
+  while (!stop_) {
+    const uint32_t before = stats().sessions;
+    session();
+    if (stop_) break;
+    if (stats().sessions != before) backoff_s = 0.5;  // it had been accepted: try again soon
+    std::unique_lock lk(mu_);
+    wake_.wait_for(lk, std::chrono::duration<double>(backoff_s), [this] { return stop_.load(); });
+    backoff_s = std::min(backoff_s * 2, 5.0);
+  }
+}
+
+void SparkplugService::session() {
+  MqttSession* self = nullptr;
+  MqttSession s(mqtt_, {[&](int rc) { onConnected(*self, rc); },
+                        [&](int mid) {
+                          std::lock_guard lk(mu_);
+                          const auto it = std::find_if(events_.begin(), events_.end(), [&](const QueuedEvent& e) { return e.mid == mid; });
+                          if (it == events_.end()) return;  // a birth or data
+                          events_.erase(it);
+                          ++stats_.events_sent;
+                        },
+                        [&](const std::string& topic_name, const std::string& payload) {
+                          if (topic_name != topic(node_.group(), "NCMD", node_.node()) || !node_.born()) return;
+                          if (EdgeNode::rebirthAsked(payload).value_or(false)) {
+                            log::info("sparkplug", "NCMD Node Control/Rebirth: the births again");
+                            publishDevices(*self, true);
+                          }
+                        }});
+  self = &s;
+  const Message will = node_.will(nowMs());
+  if (const auto why = s.connect(will.topic, will.payload); !why.empty()) {
+    std::lock_guard lk(mu_);
+    if (stats_.error != why) log::warn("sparkplug", "broker ", stats_.broker, ": ", why);
+    stats_.error = why;
+    return;
+  }
+  auto next_data = std::chrono::steady_clock::now();
+  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(std::max(0.02, cfg_.min_period_s)));
+  while (!stop_ && s.step(kStepMs)) {
+    if (!node_.born()) continue;
+    publishEvents(s);
+    if (std::chrono::steady_clock::now() >= next_data) {
+      publishDevices(s, false);
+      next_data = std::chrono::steady_clock::now() + period;
+    }
+  }
+  if (stop_ && node_.born() && !s.lost()) {
+    // A clean end: the robots' deaths and the node's (the broker drops the Will).
+    for (const auto& snap : registry_.snapshots(monoNowNs()))
+      if (const auto m = node_.deviceOffline(snap.id, nowMs())) publish(s, *m);
+    publish(s, node_.death(nowMs()));
+    s.disconnect();
+  }
+  const bool was_born = node_.born();
+  node_.sessionEnded();
+  std::lock_guard lk(mu_);
+  for (auto& e : events_) {
+    if (e.mid >= 0) e.late = true;  // the broker may not have it: again after the rebirth
+    e.mid = -1;
+  }
+  stats_.connected = false;
+  stats_.bd_seq = node_.bdSeq();
+  if (was_born && !stop_) {
+    stats_.error = s.error();
+    log::warn("sparkplug", "broker ", stats_.broker, ": ", s.error(), "; ", events_.size(),
+              " alarm transitions kept for the next session");
+  }
+}
+
+void SparkplugService::onConnected(MqttSession& s, int rc) {
+  if (rc != 0) {
+    std::lock_guard lk(mu_);
+    if (stats_.error != s.error()) log::warn("sparkplug", "broker ", stats_.broker, ": ", s.error());
+    stats_.error = s.error();
+    return;
+  }
+  s.subscribe(topic(node_.group(), "NCMD", node_.node()), 1);
+  publishDevices(s, true);
+  std::lock_guard lk(mu_);
+  ++stats_.sessions;
+  stats_.connected = true;
+  stats_.error.clear();
+  stats_.bd_seq = node_.bdSeq();
+  log::info("sparkplug", "edge node ", node_.group(), "/", node_.node(), " born on ", stats_.broker, " (bdSeq ",
+            static_cast<int>(node_.bdSeq()), ", ", events_.size(), " alarm transitions to send)");
+}
+
+void SparkplugService::publishDevices(MqttSession& s, bool birth) {
+  const uint64_t now = nowMs();
+  uint32_t online = 0;
+  std::vector<Message> out;
+  for (const auto& snap : registry_.snapshots(monoNowNs())) {
+    if (snap.connected && snap.has_telemetry) {
+      ++online;
+      const auto m = node_.update(snap.id, deviceMetrics(snap.hello, snap.telemetry, run_of_ ? run_of_(snap.id) : "",
+                                                         cfg_.deadbands), now);
+      if (m && !birth) out.push_back(*m);
+    } else if (const auto m = node_.deviceOffline(snap.id, now)) {
+      out.push_back(*m);
+    }
+  }
+  if (birth) {
+    const auto births = node_.birth(now);
+    out.insert(out.begin(), births.begin(), births.end());
+  }
+  for (const auto& m : out)
+    if (!publish(s, m)) return;
+  std::lock_guard lk(mu_);
+  stats_.devices = online;
+}
+
+void SparkplugService::publishEvents(MqttSession& s) {
+  for (;;) {
+    QueuedEvent e;
+    {
+      std::lock_guard lk(mu_);
+      const auto it = std::find_if(events_.begin(), events_.end(), [](const QueuedEvent& q) { return q.mid < 0; });
+      if (it == events_.end()) return;
+      e = *it;
+    }
+    const uint64_t now = nowMs();
+    if (!node_.online(e.device)) {
+      // The robot is offline (it went during an outage): born from its last
+      // telemetry for its transitions, its death at the next data round.
+      const auto snap = registry_.snapshot(e.device, monoNowNs());
+      if (!snap || !snap->has_telemetry) return;  // no telemetry yet: wait for it
+      if (const auto b = node_.update(e.device, deviceMetrics(snap->hello, snap->telemetry, "", cfg_.deadbands), now))
+        if (!publish(s, *b)) return;
+    }
+    const auto m = node_.events(e.device, alarmEventMetrics(e.alarm, e.time_ms, e.late), now);
+    if (!m) return;
+    const int mid = s.publish(m->topic, m->payload, cfg_.qos);
+    if (mid < 0) return;
+    std::lock_guard lk(mu_);
+    ++stats_.published;
+    // The first not in flight is still `e` (only this thread sends; the link only appends).
+    const auto it = std::find_if(events_.begin(), events_.end(), [](const QueuedEvent& q) { return q.mid < 0; });
+    if (cfg_.qos == 0) {  // nothing will confirm it: sent is all there is
+      events_.erase(it);
+      ++stats_.events_sent;
+    } else {
+      it->mid = mid;
+    }
+  }
+}
+
+bool SparkplugService::publish(MqttSession& s, const Message& m) {
+  if (s.publish(m.topic, m.payload, cfg_.qos) < 0) return false;
+  std::lock_guard lk(mu_);
+  ++stats_.published;
+  return true;
+}
+
+}  // namespace inspect::server::sparkplug
