@@ -60,10 +60,11 @@ target_compile_definitions(inspect_test_paths PRIVATE INSPECT_BIN_DIR="${CMAKE_R
                                                       INSPECT_FIRMWARE_IMAGE="${CMAKE_BINARY_DIR}/tests/firmware/mcu/inspect-mcu-qemu.elf")
 
 # Child processes, temp dirs, the three programs wired together, the ground
-# truth reader, the UDP relay, test certificates (tests/support).
+# truth reader, the UDP relay, test certificates, an MQTT broker (tests/support).
 add_library(inspect_test_support STATIC
   ${PROJECT_SOURCE_DIR}/tests/support/process.cpp
   ${PROJECT_SOURCE_DIR}/tests/support/stack.cpp
+  ${PROJECT_SOURCE_DIR}/tests/support/mosquitto_broker.cpp
   ${PROJECT_SOURCE_DIR}/tests/support/udp_relay.cpp)
 target_link_libraries(inspect_test_support PUBLIC inspect_test_paths Threads::Threads)
 target_compile_options(inspect_test_support PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})

@@ -95,6 +95,9 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   sc.edge_node_id = sp.string("edge_node_id", sc.edge_node_id);
   if (!sc.edge_node_id.empty() && !sparkplug::validId(sc.edge_node_id))
     sp.fail("edge_node_id", "'" + sc.edge_node_id + "' must be without '/', '+' or '#' (\"\" = the server_id)");
+  sc.primary_host_id = sp.string("primary_host_id", sc.primary_host_id);
+  if (!sc.primary_host_id.empty() && !sparkplug::validId(sc.primary_host_id))
+    sp.fail("primary_host_id", "'" + sc.primary_host_id + "' must be without '/', '+' or '#' (\"\" = none)");
   sc.credentials_file = sp.string("credentials_file", sc.credentials_file);
   sc.ca = sp.string("ca", sc.ca);
   sc.cert = sp.string("cert", sc.cert);

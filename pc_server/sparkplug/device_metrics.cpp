@@ -33,9 +33,13 @@ std::vector<Metric> deviceMetrics(const v1::Hello& hello, const v1::Telemetry& t
       bool active = false;
       for (const auto& a : t.active_alarms())
         active = active || (a.channel() == static_cast<uint32_t>(i) && a.level() == level);
-      Metric a = Metric::ofBool(alarmMetricName(c.name(), level), active);
-      a.event_driven = true;
-      m.push_back(std::move(a));
+      // The level, and the id and reading of its latest transition (events() sets them).
+      const std::string name = alarmMetricName(c.name(), level);
+      for (Metric a : {Metric::ofBool(name, active), Metric::ofUInt64(name + "/Alarm Id", 0),
+                       Metric::ofDouble(name + "/Reading", NAN)}) {
+        a.event_driven = true;
+        m.push_back(std::move(a));
+      }
     }
   }
   return m;

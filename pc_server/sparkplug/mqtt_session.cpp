@@ -99,10 +99,10 @@ bool MqttSession::subscribe(const std::string& pattern, int qos) {
 }
 
 void MqttSession::disconnect() {
-  if (mosq_ && !lost_) {
-    mosquitto_disconnect(mosq_);
-    mosquitto_loop(mosq_, 50, 1);
-  }
+  // Until the DISCONNECT is out (the disconnect callback): a socket closed
+  // before it makes the broker publish the Will as well (at most 1 s).
+  if (mosq_ && !lost_ && mosquitto_disconnect(mosq_) == MOSQ_ERR_SUCCESS)
+    for (int i = 0; i < 20 && !lost_; ++i) mosquitto_loop(mosq_, 50, 1);
   lost_ = true;
 }
 

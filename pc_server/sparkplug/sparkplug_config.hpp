@@ -22,6 +22,7 @@ struct SparkplugConfig {
   uint16_t port = 1883;                  // 8883 is the usual with TLS
   std::string group_id = "inspection";
   std::string edge_node_id;              // "" = the server's id (server_id)
+  std::string primary_host_id;           // "" = none; else births wait for its STATE online (section 7.4)
   std::string credentials_file;          // "username: ..." / "password: ..." (never on the command line); "" = none
   std::string ca;                        // TLS when set: the broker's CA
   std::string cert, key;                 // TLS client certificate (optional)

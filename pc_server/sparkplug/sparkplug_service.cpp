@@ -64,10 +64,11 @@ uint64_t SparkplugService::wallMs(const std::string& robot, uint64_t robot_us) c
 void SparkplugService::onEnvelope(const std::string& robot, const v1::Envelope& env, bool inbound, uint64_t time_us) {
   if (!inbound) return;
   std::lock_guard lk(mu_);
-  // The robot's clock to the server's: the smallest (receive - send) seen is
+  // The robot's clock (its telemetry's and its events' robot_time_us, from
+  // its start) to the server's: the smallest (receive - robot time) seen is
   // the offset plus the shortest one-way delay.
-  if (env.send_time_us()) {
-    const int64_t o = static_cast<int64_t>(time_us) - static_cast<int64_t>(env.send_time_us());
+  if (env.has_telemetry() && env.telemetry().robot_time_us()) {
+    const int64_t o = static_cast<int64_t>(time_us) - static_cast<int64_t>(env.telemetry().robot_time_us());
     auto [it, fresh] = offsets_us_.try_emplace(robot, o);
     if (!fresh) it->second = std::min(it->second, o);
   }
@@ -81,8 +82,10 @@ void SparkplugService::onEnvelope(const std::string& robot, const v1::Envelope& 
     return;
   }
   const auto& a = env.event().gas_alarm();
+  // Late: stored by the robot, or it waits for the next session (it is not
+  // the tags' current value when it arrives): historical data.
   events_.push_back({robot, a, wallMs(robot, a.robot_time_us() ? a.robot_time_us() : env.event().robot_time_us()),
-                     env.event().has_stored() && env.event().stored().replayed(), -1});
+                     !live_ || (env.event().has_stored() && env.event().stored().replayed()), -1});
   wake_.notify_all();
 }
 
@@ -110,6 +113,10 @@ void SparkplugService::session() {
                           ++stats_.events_sent;
                         },
                         [&](const std::string& topic_name, const std::string& payload) {
+                          if (!cfg_.primary_host_id.empty() && topic_name == "spBv1.0/STATE/" + cfg_.primary_host_id) {
+                            onHostState(*self, payload);
+                            return;
+                          }
                           if (topic_name != topic(node_.group(), "NCMD", node_.node()) || !node_.born()) return;
                           if (EdgeNode::rebirthAsked(payload).value_or(false)) {
                             log::info("sparkplug", "NCMD Node Control/Rebirth: the births again");
@@ -145,6 +152,7 @@ void SparkplugService::session() {
   const bool was_born = node_.born();
   node_.sessionEnded();
   std::lock_guard lk(mu_);
+  live_ = false;
   for (auto& e : events_) {
     if (e.mid >= 0) e.late = true;  // the broker may not have it: again after the rebirth
     e.mid = -1;
@@ -166,14 +174,45 @@ void SparkplugService::onConnected(MqttSession& s, int rc) {
     return;
   }
   s.subscribe(topic(node_.group(), "NCMD", node_.node()), 1);
+  {
+    std::lock_guard lk(mu_);
+    ++stats_.sessions;
+    stats_.connected = true;
+    stats_.error.clear();
+    stats_.bd_seq = node_.bdSeq();
+  }
+  if (!cfg_.primary_host_id.empty()) {
+    // Births wait for the primary host's STATE online (retained; section 7.4).
+    s.subscribe("spBv1.0/STATE/" + cfg_.primary_host_id, 1);
+    log::info("sparkplug", "connected to ", cfg_.host, ":", cfg_.port, ": waiting for the primary host ",
+              cfg_.primary_host_id);
+    return;
+  }
+  birth(s);
+}
+
+void SparkplugService::birth(MqttSession& s) {
   publishDevices(s, true);
   std::lock_guard lk(mu_);
-  ++stats_.sessions;
-  stats_.connected = true;
-  stats_.error.clear();
-  stats_.bd_seq = node_.bdSeq();
+  live_ = true;
   log::info("sparkplug", "edge node ", node_.group(), "/", node_.node(), " born on ", stats_.broker, " (bdSeq ",
             static_cast<int>(node_.bdSeq()), ", ", events_.size(), " alarm transitions to send)");
+}
+
+void SparkplugService::onHostState(MqttSession& s, const std::string& payload) {
+  // {"online": true|false, "timestamp": ms} (section 7.4.1); spaces allowed.
+  std::string compact;
+  for (const char c : payload)
+    if (c != ' ' && c != '\t' && c != '\n' && c != '\r') compact += c;
+  const bool online = compact.find("\"online\":true") != std::string::npos;
+  if (online && !node_.born()) {
+    birth(s);
+  } else if (!online && node_.born()) {
+    // The primary host went away: end this session (NDEATH) and start again, to be born when it is back.
+    log::info("sparkplug", "the primary host ", cfg_.primary_host_id, " is offline: the edge node leaves the broker");
+    publish(s, node_.death(nowMs()));
+    s.disconnect();
+  }
 }
 
 void SparkplugService::publishDevices(MqttSession& s, bool birth) {

@@ -72,6 +72,10 @@ class SparkplugService {
   void run();
   void session();
   void onConnected(MqttSession& s, int rc);
+  /// NBIRTH and the robots' DBIRTH.
+  void birth(MqttSession& s);
+  /// The primary host's STATE message: born when online, the session ended when offline.
+  void onHostState(MqttSession& s, const std::string& payload);
   /// Every robot's data beyond the deadbands, and DDEATH of those gone;
   /// `birth`: the node's and the robots' births instead (a new session, a rebirth).
   void publishDevices(MqttSession& s, bool birth);
@@ -91,6 +95,7 @@ class SparkplugService {
   mutable std::mutex mu_;  // what follows
   std::condition_variable wake_;
   std::deque<QueuedEvent> events_;
+  bool live_ = false;  // born on the broker now: a transition goes out at once
   std::map<std::string, int64_t> offsets_us_;  // per robot: server monotonic - robot clock (smallest seen)
   ServiceStats stats_;
 };

@@ -37,6 +37,7 @@ def main():
     ap.add_argument("--until-ndeath", action="store_true", help="end at the first NDEATH")
     ap.add_argument("--rebirth-after", type=float, default=-1, help="send NCMD Node Control/Rebirth after this many s")
     ap.add_argument("--ready-file", help="written once subscribed")
+    ap.add_argument("--host-id", default="", help="be the primary host: STATE online (retained), its Will offline")
     ap.add_argument("--json", required=True)
     a = ap.parse_args()
     sys.path.insert(0, a.pb_dir)
@@ -145,6 +146,10 @@ def main():
             done.set()
             return
         client.subscribe(f"spBv1.0/{a.group}/#", qos=1)
+        if a.host_id:  # section 7.4: after subscribing, online, retained
+            client.publish(f"spBv1.0/STATE/{a.host_id}",
+                           json.dumps({"online": True, "timestamp": int(time.time() * 1000)}), qos=1, retain=True)
+        state["host_connects"] = state.get("host_connects", 0) + 1
 
     def on_subscribe(client, userdata, mid, granted):
         if a.ready_file:
@@ -160,6 +165,10 @@ def main():
                     k, v = line.split(":", 1)
                     creds[k.strip()] = v.strip().strip('"')
         client.username_pw_set(creds.get("username"), creds.get("password"))
+    if a.host_id:
+        client.will_set(f"spBv1.0/STATE/{a.host_id}", json.dumps({"online": False, "timestamp": int(time.time() * 1000)}),
+                        qos=1, retain=True)
+    client.reconnect_delay_set(min_delay=0.2, max_delay=1)
     client.on_connect = on_connect
     client.on_message = on_message
     client.on_subscribe = on_subscribe

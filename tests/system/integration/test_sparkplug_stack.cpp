@@ -1,0 +1,116 @@
+// The plant's SCADA sees the robot's gas alarms (docs/sparkplug.md): the real
+// pc_server as a Sparkplug B edge node on a real mosquitto (its own port,
+// password file), a robot driving through the gas lab's CH4 plume, and a
+// Sparkplug host written from the specification in Python
+// (tests/tools/sparkplug_host.py, python3-paho-mqtt and protoc's module of
+// the project's sparkplug_b.proto) as the primary host. The broker is killed
+// for 10 s mid-run: every alarm transition the console lists reaches the
+// host once, in order, with the robot's time; births, seq and bdSeq keep the
+// specification's rules throughout.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <map>
+#include <cstdlib>
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/support/mosquitto_broker.hpp"
+#include "tests/support/paths.hpp"
+#include "tests/support/stack.hpp"
+
+using namespace inspect::test;
+
+namespace {
+std::string pythonProtoDir() {
+  const char* d = std::getenv("INSPECT_PYTHON_PROTO");
+  return d ? d : binDir() + "/../python_proto";
+}
+
+int count(const std::string& s, const std::string& what) {
+  int n = 0;
+  for (auto p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+  return n;
+}
+}  // namespace
+
+TEST(SparkplugStack, AlarmsReachTheScadaHostOnceInOrderThroughABrokerOutage) {
+  Stack s("sparkplug");
+  MosquittoBroker broker(s.dir().path());
+  const std::string host_json = s.dir() / "host.json", ready = s.dir() / "host.ready";
+  auto host = Process::spawn({"/usr/bin/python3", srcPath("tests/tools/sparkplug_host.py"), "--port",
+                              std::to_string(broker.port()), "--credentials", broker.credentialsFile(), "--pb-dir",
+                              pythonProtoDir(), "--host-id", "scada1", "--seconds", "90", "--until-ndeath", "--json",
+                              host_json, "--ready-file", ready},
+                             s.dir() / "host.out", s.dir() / "host.out");
+  ASSERT_TRUE(waitUntil([&] { return std::filesystem::exists(ready); }, 15.0)) << readFile(s.dir() / "host.out");
+  writeFile(s.dir() / "server.yaml",
+            "video:\n  enabled: false\nsparkplug:\n  enabled: true\n  port: " + std::to_string(broker.port()) +
+                "\n  credentials_file: " + broker.credentialsFile() +
+                "\n  primary_host_id: scada1\n  min_period_s: 0.2\n  edge_node_id: ops1\n");
+  ASSERT_TRUE(s.startServer("expect robots >= 1 within 20\n"
+                            "drive 0.35 0\n"
+                            "wait 24\n"
+                            "stop\n"
+                            "wait 3\n"
+                            "alarms all\n",
+                            {"--config", s.dir() / "server.yaml", "--no-record"}))
+      << s.logs();
+  s.startRobot("robot1", "gas_lab.yaml");
+  // The broker crashes 8 s into the drive and is back 10 s later (the plume is met meanwhile).
+  ASSERT_TRUE(waitUntil([&] { return s.serverOutput().find("drive 0.35") != std::string::npos; }, 30.0)) << s.logs();
+  std::this_thread::sleep_for(std::chrono::seconds(8));
+  broker.kill();
+  std::this_thread::sleep_for(std::chrono::seconds(10));
+  broker.start();
+  const auto rc = s.server().wait(60.0);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  const auto host_rc = host.wait(20.0);
+  ASSERT_EQ(host_rc, std::optional<int>(0)) << readFile(s.dir() / "host.out");
+  const std::string out = s.serverOutput(), json = readFile(host_json);
+  std::printf("%s\n%s\n", readFile(s.dir() / "host.out").c_str(), json.c_str());
+  const auto host_out = nlohmann::json::parse(json);
+  EXPECT_TRUE(host_out["violations"].empty()) << json;
+  EXPECT_GE(host_out["node_births"].get<int>(), 2) << "born again after the outage: " << json;
+  EXPECT_EQ(host_out["ndeaths"].get<int>(), 1) << "the clean NDEATH at the end";
+
+  // The console's alarm book: "#1 robot1 CH4 LOW ... raised 14.5 s ago, cleared after 12.0 s".
+  const std::regex book(R"(#([0-9]+) robot1 ([A-Z0-9]+) (LOW|HIGH) [^\n]*raised [0-9.]+ s ago, cleared after ([0-9.]+) s)");
+  struct Alarm {
+    std::string metric;
+    double lasted_s;
+  };
+  std::map<int, Alarm> alarms;
+  for (std::sregex_iterator it(out.begin(), out.end(), book), end; it != end; ++it)
+    alarms[std::stoi((*it)[1])] = {"Gas/" + (*it)[2].str() + ((*it)[3] == "LOW" ? "/A1" : "/A2"), std::stod((*it)[4])};
+  ASSERT_GE(alarms.size(), 1u) << "the plume raised and cleared no alarm: " << out;
+  // Each transition reached the host exactly once, under its level's metric, in the robot's order.
+  std::map<std::pair<int, bool>, int> seen;
+  std::map<std::pair<int, bool>, double> at_ms;
+  double last_ms = 0;
+  int historical = 0;
+  for (const auto& a : host_out["alarms"]) {
+    const int id = a["id"].get<int>();
+    const bool active = a["active"].get<bool>();
+    ++seen[{id, active}];
+    at_ms[{id, active}] = a["timestamp_ms"].get<double>();
+    EXPECT_GE(a["timestamp_ms"].get<double>(), last_ms) << "in the robot's order: " << json;
+    last_ms = a["timestamp_ms"].get<double>();
+    historical += a["historical"].get<bool>() ? 1 : 0;
+    ASSERT_TRUE(alarms.count(id)) << "an alarm the console does not list: " << json;
+    EXPECT_EQ(a["metric"].get<std::string>(), alarms[id].metric) << json;
+  }
+  for (const auto& [id, a] : alarms) {
+    EXPECT_EQ((seen[{id, true}]), 1) << "raise of #" << id << ": " << json;
+    EXPECT_EQ((seen[{id, false}]), 1) << "clear of #" << id << ": " << json;
+    // The robot's times: the clear after the raise by what the console says (0.1 s rounding, 20 ms ticks).
+    EXPECT_NEAR((at_ms[{id, false}] - at_ms[{id, true}]) / 1000.0, a.lasted_s, 0.15) << "#" << id;
+  }
+  EXPECT_EQ(host_out["alarms"].size(), 2 * alarms.size()) << json;
+  std::printf("%zu alarms, %zu transitions at the host, %d of them historical (held through the outage)\n",
+              alarms.size(), host_out["alarms"].size(), historical);
+}
