@@ -428,6 +428,7 @@ int runServer(const CliOptions& options) {
     c.setRecorder(recorder.get());
     c.setSiteMaps(&site_maps);
     if (auto* b = bridge_ptr.load()) c.setFoxgloveReport([b] { return b->report(); });
+    if (auto* sp = scada_ptr.load()) c.setSparkplugReport([sp] { return sp->report(); });
     c.setTuningPaths(beside("robot.yaml").string(), beside("control.yaml").string(),
                      (recorder ? recorder->config().dir : config.recording.dir) + "/tuning");
   };
@@ -445,6 +446,7 @@ int runServer(const CliOptions& options) {
   }
   auto presence = startPresence(ioc, config, recorder.get(), registry, endpoint.port(), foxglove_port);
   // The plant's SCADA (docs/sparkplug.md): alarm transitions from the link, the rest from the registry.
+  std::optional<OperatorService> scada_ops;  // SCADA's operator session: stop and e-stop only (DCMD); outlives scada
   std::unique_ptr<sparkplug::SparkplugService> scada;
   if (config.sparkplug.enabled) {
     const auto& sc = config.sparkplug;
@@ -454,6 +456,10 @@ int runServer(const CliOptions& options) {
     if (!sc.credentials_file.empty()) {
       const auto cred = sparkplug::loadCredentials(sc.credentials_file);
       scada->setCredentials(cred.username, cred.password);
+    }
+    if (sc.commands) {
+      scada_ops.emplace(registry, link, &control, OperatorService::Options{copt.ack_timeout_s, copt.max_v_m_s, copt.max_w_rad_s});
+      scada->setCommands(&*scada_ops, control.openSession("scada@" + sc.host));
     }
     scada_ptr = scada.get();
     scada->start();

@@ -119,6 +119,8 @@ class Console {
   VideoHub* video() const { return video_; }
   /// Enables `foxglove` (the bridge's report; empty function: no bridge).
   void setFoxgloveReport(std::function<std::string()> report) { foxglove_report_ = std::move(report); }
+  /// Enables `sparkplug` (the SCADA edge node's report; empty function: none).
+  void setSparkplugReport(std::function<std::string()> report) { sparkplug_report_ = std::move(report); }
   /// Where `inspect` and `route` note the site map of the route they send (null: nowhere).
   void setSiteMaps(scene::SiteMaps* maps) {
     site_maps_ = maps;
@@ -180,6 +182,7 @@ class Console {
   ControlArbiter* arbiter() { return control_; }
   const TeleopHandler& teleopHandler() const { return teleop_handler_; }
   const std::function<std::string()>& foxgloveReport() const { return foxglove_report_; }
+  const std::function<std::string()>& sparkplugReport() const { return sparkplug_report_; }
   scene::SiteMaps* siteMaps() const { return site_maps_; }
   /// The robot this session's last accepted `drive` went to (operatorPresent renews its lease).
   void setDriveRobot(const std::string& robot) { drive_robot_ = robot; }
@@ -205,6 +208,7 @@ class Console {
   Recorder* recorder_ = nullptr;
   uint64_t catalog_notices_ = 0;  // the recorder's catalog notices printed so far
   std::function<std::string()> foxglove_report_;
+  std::function<std::string()> sparkplug_report_;
   scene::SiteMaps* site_maps_ = nullptr;
   bool alarm_style_ = false;
   std::string selected_;

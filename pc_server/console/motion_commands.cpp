@@ -165,6 +165,13 @@ bool MotionCommands::cmdFoxglove(const CommandArgs&) {
   return true;
 }
 
+bool MotionCommands::cmdSparkplug(const CommandArgs&) {
+  if (!c_.sparkplugReport())
+    return c_.fail("sparkplug", "the server is no Sparkplug edge node (sparkplug.enabled: false; --sparkplug-broker)");
+  c_.out() << c_.sparkplugReport()();
+  return true;
+}
+
 bool MotionCommands::cmdSnapshot(const CommandArgs& a) {
   if (!c_.video()) return c_.fail("snapshot", "the server runs without video (video.enabled: false or --no-video)");
   if (c_.selected().empty()) return c_.fail("snapshot", "no robot selected");
@@ -279,6 +286,12 @@ std::vector<ConsoleCommand> MotionCommands::commands() {
      "  messages dropped for a slow reader, its messages refused), then the topics it subscribed\n"
      "  to and publishes on. docs/foxglove.md.\n",
      handler(this, &MotionCommands::cmdFoxglove)},
+    {"sparkplug", noArguments(), "the SCADA edge node: broker, births, alarm transitions queued and sent",
+     "  The MQTT Sparkplug B edge node (sparkplug: in server.yaml): the broker and whether the node\n"
+     "  is born there (bdSeq, sessions), robots online, messages published, alarm transitions the\n"
+     "  broker confirmed, still queued (a broker outage) and dropped, DCMD received and refused,\n"
+     "  and why the last session ended. docs/sparkplug.md.\n",
+     handler(this, &MotionCommands::cmdSparkplug)},
   };
 }
 

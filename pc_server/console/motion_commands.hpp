@@ -1,6 +1,6 @@
 #pragma once
 // The console's commands that move the robot and its camera: drive, teleop,
-// track, goto, route, stop, estop, resume; video, ptz, snapshot, foxglove.
+// track, goto, route, stop, estop, resume; video, ptz, snapshot, foxglove, sparkplug.
 #include "pc_server/console/command_family.hpp"
 
 namespace inspect::server {
@@ -25,6 +25,7 @@ class MotionCommands : public CommandFamily {
   bool cmdPtz(const CommandArgs& a);
   bool cmdSnapshot(const CommandArgs& a);
   bool cmdFoxglove(const CommandArgs& a);
+  bool cmdSparkplug(const CommandArgs&);
   Console& c_;
 };
 

@@ -24,6 +24,12 @@ std::vector<Metric> deviceMetrics(const v1::Hello& hello, const v1::Telemetry& t
   const double nearest = t.has_nearest_person_m() && t.nearest_person_m() >= 0 ? t.nearest_person_m() : NAN;
   m.push_back(Metric::ofDouble("People/Nearest_m", nearest, db.person_m));
   m.push_back(Metric::ofString("Run/Recording", run));
+  // DCMD's writable metrics (Boolean true = do it) and the last command's answer, set by events only.
+  for (Metric c : {Metric::ofBool(kCommandStop, false), Metric::ofBool(kCommandEStop, false),
+                   Metric::ofString(kCommandResult, "")}) {
+    c.event_driven = true;
+    m.push_back(std::move(c));
+  }
   for (int i = 0; i < hello.gas_channels_size(); ++i) {
     const auto& c = hello.gas_channels(i);
     const double scale = c.alarm_low() != 0 ? std::abs(c.alarm_low()) : std::abs(c.range_max() - c.range_min());

@@ -18,6 +18,11 @@ namespace inspect::server::sparkplug {
 std::vector<Metric> deviceMetrics(const v1::Hello& hello, const v1::Telemetry& t, const std::string& run,
                                   const Deadbands& deadbands);
 
+/// The writable metrics of DCMD (docs/sparkplug.md "Commands"), and the answer's.
+inline constexpr const char* kCommandStop = "Commands/Stop";
+inline constexpr const char* kCommandEStop = "Commands/E-Stop";
+inline constexpr const char* kCommandResult = "Commands/Last Result";
+
 /// The metric name of a channel's alarm level: "Gas/CH4/A1", ".../A2", ".../Sensor Fault".
 std::string alarmMetricName(const std::string& channel, v1::GasAlarm::Level level);
 

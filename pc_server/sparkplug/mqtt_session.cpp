@@ -101,8 +101,10 @@ bool MqttSession::subscribe(const std::string& pattern, int qos) {
 void MqttSession::disconnect() {
   // Until the DISCONNECT is out (the disconnect callback): a socket closed
   // before it makes the broker publish the Will as well (at most 1 s).
-  if (mosq_ && !lost_ && mosquitto_disconnect(mosq_) == MOSQ_ERR_SUCCESS)
-    for (int i = 0; i < 20 && !lost_; ++i) mosquitto_loop(mosq_, 50, 1);
+  if (mosq_ && !lost_ && mosquitto_disconnect(mosq_) == MOSQ_ERR_SUCCESS) {
+    for (int i = 0; i < 40 && !lost_; ++i) mosquitto_loop(mosq_, 50, 1);
+    if (!lost_) error_ = "the DISCONNECT was not out within 2 s: the broker may publish the Will too";
+  }
   lost_ = true;
 }
 

@@ -55,6 +55,23 @@ ServiceStats SparkplugService::stats() const {
   return s;
 }
 
+std::string SparkplugService::report() const {
+  const ServiceStats st = stats();
+  std::string r = "sparkplug: edge node " + node_.group() + "/" + node_.node() + " on mqtt" + (cfg_.ca.empty() ? "" : "s") +
+                  "://" + st.broker + ": " + (st.connected ? "connected" : "not connected") + ", bdSeq " +
+                  std::to_string(st.bd_seq) + ", " + std::to_string(st.sessions) + " sessions" +
+                  (cfg_.primary_host_id.empty() ? "" : ", primary host " + cfg_.primary_host_id) + "\n";
+  r += "  " + std::to_string(st.devices) + " robots online; " + std::to_string(st.published) +
+       " messages published (QoS " + std::to_string(cfg_.qos) + ")\n";
+  r += "  alarm transitions: " + std::to_string(st.events_sent) + " confirmed by the broker, " +
+       std::to_string(st.queued) + " queued, " + std::to_string(st.dropped) + " dropped (queue_max " +
+       std::to_string(cfg_.queue_max) + ")\n";
+  r += "  DCMD: " + std::to_string(st.commands) + " received, " + std::to_string(st.commands_refused) + " refused; " +
+       (cfg_.commands && ops_ ? "stop and e-stop allowed" : "commands off") + "\n";
+  if (!st.error.empty()) r += "  last: " + st.error + "\n";
+  return r;
+}
+
 uint64_t SparkplugService::wallMs(const std::string& robot, uint64_t robot_us) const {
   const auto it = offsets_us_.find(robot);
   if (it == offsets_us_.end()) return nowMs();
@@ -106,6 +123,7 @@ void SparkplugService::session() {
   MqttSession* self = nullptr;
   MqttSession s(mqtt_, {[&](int rc) { onConnected(*self, rc); },
                         [&](int mid) {
+                          last_delivered_mid_ = mid;
                           std::lock_guard lk(mu_);
                           const auto it = std::find_if(events_.begin(), events_.end(), [&](const QueuedEvent& e) { return e.mid == mid; });
                           if (it == events_.end()) return;  // a birth or data
@@ -115,6 +133,11 @@ void SparkplugService::session() {
                         [&](const std::string& topic_name, const std::string& payload) {
                           if (!cfg_.primary_host_id.empty() && topic_name == "spBv1.0/STATE/" + cfg_.primary_host_id) {
                             onHostState(*self, payload);
+                            return;
+                          }
+                          const std::string dcmd = topic(node_.group(), "DCMD", node_.node()) + "/";
+                          if (topic_name.starts_with(dcmd) && node_.born()) {
+                            onDeviceCommand(*self, topic_name.substr(dcmd.size()), payload);
                             return;
                           }
                           if (topic_name != topic(node_.group(), "NCMD", node_.node()) || !node_.born()) return;
@@ -137,6 +160,7 @@ void SparkplugService::session() {
   while (!stop_ && s.step(kStepMs)) {
     if (!node_.born()) continue;
     publishEvents(s);
+    settleCommands(s);
     if (std::chrono::steady_clock::now() >= next_data) {
       publishDevices(s, false);
       next_data = std::chrono::steady_clock::now() + period;
@@ -146,8 +170,15 @@ void SparkplugService::session() {
     // A clean end: the robots' deaths and the node's (the broker drops the Will).
     for (const auto& snap : registry_.snapshots(monoNowNs()))
       if (const auto m = node_.deviceOffline(snap.id, nowMs())) publish(s, *m);
-    publish(s, node_.death(nowMs()));
+    // NDEATH, then its PUBACK read (and so every earlier one) before the
+    // DISCONNECT: a socket closed with a PUBACK unread is reset, and a broker
+    // that sees the reset before the DISCONNECT publishes the Will as well.
+    const Message death = node_.death(nowMs());
+    const int mid = s.publish(death.topic, death.payload, 1);
+    for (int i = 0; mid >= 0 && i < 100 && last_delivered_mid_ != mid && s.step(kStepMs); ++i) {
+    }
     s.disconnect();
+    if (!s.error().empty()) log::warn("sparkplug", "stopping: ", s.error());
   }
   const bool was_born = node_.born();
   node_.sessionEnded();
@@ -174,6 +205,7 @@ void SparkplugService::onConnected(MqttSession& s, int rc) {
     return;
   }
   s.subscribe(topic(node_.group(), "NCMD", node_.node()), 1);
+  s.subscribe(topic(node_.group(), "DCMD", node_.node()) + "/+", 1);  // answered (refused) even when commands are off
   {
     std::lock_guard lk(mu_);
     ++stats_.sessions;
@@ -279,6 +311,68 @@ bool SparkplugService::publish(MqttSession& s, const Message& m) {
   std::lock_guard lk(mu_);
   ++stats_.published;
   return true;
+}
+
+}  // namespace inspect::server::sparkplug
+
+namespace inspect::server::sparkplug {
+
+void SparkplugService::answer(MqttSession& s, const std::string& device, const std::string& text) {
+  const uint64_t now = nowMs();
+  std::vector<Metric> m{Metric::ofString(kCommandResult, text)};
+  m[0].timestamp_ms = now;
+  if (const auto msg = node_.events(device, m, now)) publish(s, *msg);
+}
+
+void SparkplugService::onDeviceCommand(MqttSession& s, const std::string& device, const std::string& payload) {
+  {
+    std::lock_guard lk(mu_);
+    ++stats_.commands;
+  }
+  const auto refuse = [&](const std::string& why) {
+    {
+      std::lock_guard lk(mu_);
+      ++stats_.commands_refused;
+    }
+    log::warn("sparkplug", "DCMD for ", device, " refused: ", why);
+    answer(s, device, "refused: " + why);
+  };
+  spb::Payload p;
+  if (!p.ParseFromString(payload)) return refuse("not a Sparkplug B payload");
+  for (const auto& m : p.metrics()) {
+    const bool stop = m.name() == kCommandStop, estop = m.name() == kCommandEStop;
+    if (!stop && !estop) {
+      refuse("'" + m.name() + "' is not a command SCADA may give (" + kCommandStop + ", " + kCommandEStop + ")");
+      continue;
+    }
+    if (!m.has_boolean_value() || !m.boolean_value()) {
+      refuse(m.name() + " must be the Boolean true");
+      continue;
+    }
+    if (!cfg_.commands || !ops_) {
+      refuse("commands from SCADA are off on this server (sparkplug.commands)");
+      continue;
+    }
+    log::info("sparkplug", "DCMD from SCADA: ", device, " ", estop ? "e-stop" : "stop");
+    const Issued r = estop ? ops_->estop(ops_session_, device, monoNowNs()) : ops_->stop(ops_session_, device, monoNowNs());
+    if (const auto* done = std::get_if<CallResult>(&r))
+      answer(s, device, done->text());
+    else
+      pending_.push_back(std::get<PendingCall>(r));
+  }
+}
+
+void SparkplugService::settleCommands(MqttSession& s) {
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    const auto r = ops_ ? ops_->settle(*it, monoNowNs()) : std::nullopt;
+    if (!r) {
+      ++it;
+      continue;
+    }
+    log::info("sparkplug", "DCMD answered: ", r->text());
+    answer(s, it->robot, r->text());
+    it = pending_.erase(it);
+  }
 }
 
 }  // namespace inspect::server::sparkplug

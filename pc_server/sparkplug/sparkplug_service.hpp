@@ -21,6 +21,7 @@
 
 #include "inspect_robot/v1/link.pb.h"
 #include "pc_server/link/robot_registry.hpp"
+#include "pc_server/operator/operator_service.hpp"
 #include "pc_server/sparkplug/edge_node.hpp"
 #include "pc_server/sparkplug/mqtt_session.hpp"
 #include "pc_server/sparkplug/sparkplug_config.hpp"
@@ -38,6 +39,8 @@ struct ServiceStats {
   uint64_t events_sent = 0;  // alarm transitions the broker confirmed
   std::size_t queued = 0;    // alarm transitions waiting for the broker
   uint64_t dropped = 0;      // transitions lost to a full queue (queue_max)
+  uint64_t commands = 0;     // DCMD messages received
+  uint64_t commands_refused = 0;
   uint32_t devices = 0;      // robots online
 };
 
@@ -50,6 +53,14 @@ class SparkplugService {
   SparkplugService(const SparkplugService&) = delete;
   SparkplugService& operator=(const SparkplugService&) = delete;
 
+  /// DCMD from SCADA (sparkplug.commands): stop and e-stop only, through
+  /// `ops` as `session` (an operator session of its own: any session may stop
+  /// a robot, none may move one from here). Not set, or commands off: every
+  /// DCMD is refused, and the refusal answered. Set before start().
+  void setCommands(OperatorService* ops, uint64_t session) {
+    ops_ = ops;
+    ops_session_ = session;
+  }
   /// The broker's user name and password (from credentials_file; never the command line).
   void setCredentials(std::string username, std::string password);
   void start();
@@ -60,6 +71,8 @@ class SparkplugService {
   void onEnvelope(const std::string& robot, const v1::Envelope& env, bool inbound, uint64_t time_us);
 
   ServiceStats stats() const;
+  /// The console's `sparkplug` lines.
+  std::string report() const;
 
  private:
   struct QueuedEvent {
@@ -83,12 +96,21 @@ class SparkplugService {
   void publishEvents(MqttSession& s);
   bool publish(MqttSession& s, const Message& m);
   uint64_t wallMs(const std::string& robot, uint64_t robot_us) const;
+  /// A DCMD for `device`: stop / e-stop issued, anything else refused; answered in DDATA.
+  void onDeviceCommand(MqttSession& s, const std::string& device, const std::string& payload);
+  /// Answers the calls whose Ack came in or whose time ran out.
+  void settleCommands(MqttSession& s);
+  void answer(MqttSession& s, const std::string& device, const std::string& text);
 
   SparkplugConfig cfg_;
   MqttOptions mqtt_;
   const RobotRegistry& registry_;
   std::function<std::string(const std::string&)> run_of_;
   EdgeNode node_;  // the thread's alone
+  OperatorService* ops_ = nullptr;
+  uint64_t ops_session_ = 0;
+  std::vector<PendingCall> pending_;  // DCMD calls waiting for the robot's Ack (the thread's alone)
+  int last_delivered_mid_ = -1;       // the session's latest PUBACK (the thread's alone)
   std::thread thread_;
   std::atomic<bool> stop_{false};
 

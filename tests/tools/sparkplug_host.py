@@ -37,6 +37,8 @@ def main():
     ap.add_argument("--until-ndeath", action="store_true", help="end at the first NDEATH")
     ap.add_argument("--rebirth-after", type=float, default=-1, help="send NCMD Node Control/Rebirth after this many s")
     ap.add_argument("--ready-file", help="written once subscribed")
+    ap.add_argument("--dcmd", action="append", default=[],
+                    help="DELAY_S:DEVICE:METRIC - send DCMD METRIC = true to DEVICE DELAY_S after the device's birth")
     ap.add_argument("--host-id", default="", help="be the primary host: STATE online (retained), its Will offline")
     ap.add_argument("--json", required=True)
     a = ap.parse_args()
@@ -45,7 +47,8 @@ def main():
 
     state = {"nodes": {}, "messages": 0, "by_type": {}, "violations": [], "alarms": [], "births": [],
              "node_births": 0, "ndeaths": 0, "ddeaths": 0, "ddata": 0, "last_seq": {}, "devices": {},
-             "first_message_s": None, "rebirth_sent": False, "metrics_of": {}}
+             "first_message_s": None, "rebirth_sent": False, "metrics_of": {}, "answers": [], "dcmd_sent": [],
+             "dbirth_s": {}}
     done = threading.Event()
     t0 = time.monotonic()
     lock = threading.Lock()
@@ -70,10 +73,14 @@ def main():
             state["by_type"][kind] = state["by_type"].get(kind, 0) + 1
             if state["first_message_s"] is None:
                 state["first_message_s"] = time.monotonic() - t0
+            if kind in ("NCMD", "DCMD"):
+                return  # a host's command (ours too): not the edge node's sequence
             n = state["nodes"].setdefault(node, {"born": False, "bdseq": None, "seq": None, "devices": {}})
             if kind == "NDEATH":
                 state["ndeaths"] += 1
                 bd = [m.long_value for m in p.metrics if m.name == "bdSeq"]
+                state["births"].append({"type": "NDEATH", "bdseq": bd[0] if bd else None, "t_s": time.monotonic() - t0,
+                                        "node_was_born": n["born"]})
                 if not bd:
                     violation("NDEATH without bdSeq")
                 elif n["bdseq"] is not None and bd[0] != n["bdseq"]:
@@ -119,6 +126,8 @@ def main():
                 state["births"].append({"type": "DBIRTH", "device": device, "metrics": len(p.metrics),
                                         "t_s": time.monotonic() - t0})
                 state["metrics_of"][device] = sorted(d["metrics"].keys())
+                state["dbirth_s"].setdefault(device, time.monotonic() - t0)
+                state["node_of"] = node
                 return
             if not d["born"]:
                 violation(f"{kind} {device} before its DBIRTH")
@@ -130,6 +139,9 @@ def main():
                 return
             state["ddata"] += 1
             ids = {m.name: m.long_value for m in p.metrics if m.name.endswith("/Alarm Id")}
+            for m in p.metrics:
+                if m.name == "Commands/Last Result":
+                    state["answers"].append({"device": device, "text": m.string_value, "t_s": time.monotonic() - t0})
             for m in p.metrics:
                 if m.name not in d["metrics"]:
                     violation(f"DDATA {device}: metric {m.name!r} not in its DBIRTH")
@@ -196,6 +208,21 @@ def main():
                 m.boolean_value = True
                 client.publish(f"spBv1.0/{a.group}/NCMD/{node}", p.SerializeToString(), qos=0)
             state["rebirth_sent"] = bool(nodes)
+        for spec in a.dcmd:
+            delay, device, metric = spec.split(":", 2)
+            with lock:
+                born_s = state["dbirth_s"].get(device)
+                node = state.get("node_of")
+            if born_s is None or spec in state["dcmd_sent"] or time.monotonic() - t0 < born_s + float(delay):
+                continue
+            p = spb.Payload()
+            p.timestamp = int(time.time() * 1000)
+            m = p.metrics.add()
+            m.name = metric
+            m.datatype = 11
+            m.boolean_value = True
+            client.publish(f"spBv1.0/{a.group}/DCMD/{node}/{device}", p.SerializeToString(), qos=0)
+            state["dcmd_sent"].append(spec)
         done.wait(0.05)
     client.loop_stop()
     client.disconnect()

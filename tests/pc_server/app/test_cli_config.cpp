@@ -149,3 +149,24 @@ TEST(Cli, TheCatalogIdIsTheServersNameOnlyInASharedCatalog) {
   EXPECT_EQ(catalogServerId(c), host);
   EXPECT_EQ(cliError({"--server-id", std::string(65, 'x')}), "--server-id: must be 1 to 64 characters (as server_id)");
 }
+
+TEST(ServerConfig, SparkplugSettingsAreCheckedAndTheBrokerFlagTurnsItOn) {
+  // docs/sparkplug.md "Configuration": off by default, every key checked and named.
+  EXPECT_FALSE(loadServerConfigFile(inspect::test::srcPath("config/server.yaml")).sparkplug.enabled);
+  EXPECT_EQ(configError("sparkplug:\n  group_id: a/b\n"),
+            "server.yaml: sparkplug.group_id: 'a/b' must be non-empty without '/', '+' or '#'");
+  EXPECT_EQ(configError("sparkplug:\n  edge_node_id: 'x#'\n").find("server.yaml: sparkplug.edge_node_id:"), 0u);
+  EXPECT_EQ(configError("sparkplug:\n  qos: 2\n"), "server.yaml: sparkplug.qos: 2 is out of range [0, 1]");
+  EXPECT_EQ(configError("sparkplug:\n  cert: c.pem\n"), "server.yaml: sparkplug.key: cert and key go together");
+  EXPECT_EQ(configError("sparkplug:\n  cert: c.pem\n  key: k.pem\n"),
+            "server.yaml: sparkplug.ca: must be set with a client certificate (TLS)");
+  EXPECT_EQ(configError("sparkplug:\n  password: x\n"),
+            "server.yaml: sparkplug.password: unknown key (misspelt, or not used by this program)")
+      << "a password goes in credentials_file, never in server.yaml";
+  EXPECT_EQ(configError("sparkplug:\n  deadbands:\n    gas_fraction: 2\n"),
+            "server.yaml: sparkplug.deadbands.gas_fraction: 2 is out of range [0, 1]");
+  EXPECT_EQ(parseCli({"--sparkplug-broker", "10.0.0.5:8883"}).sparkplug_broker, "10.0.0.5:8883");
+  for (const char* bad : {"broker", "broker:", ":1883", "broker:99999", "broker:18x3"})
+    EXPECT_NE(cliError({"--sparkplug-broker", bad}).find("is not HOST:PORT"), std::string::npos) << bad;
+  EXPECT_NE(usageText().find("--sparkplug-broker"), std::string::npos);
+}

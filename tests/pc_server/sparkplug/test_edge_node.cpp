@@ -1,13 +1,16 @@
 // The Sparkplug B edge node's messages (pc_server/sparkplug/edge_node;
 // docs/sparkplug.md), decoded with the project's sparkplug_b.proto: births,
 // seq, bdSeq across sessions, deadbands, alarm events at their time,
-// deaths and the rebirth request.
+// deaths and the rebirth request; the broker's credentials file.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "pc_server/sparkplug/device_metrics.hpp"
 #include "pc_server/sparkplug/edge_node.hpp"
+#include "pc_server/sparkplug/sparkplug_credentials.hpp"
+#include "shared/config/config_node.hpp"
+#include "tests/support/process.hpp"
 
 using namespace inspect;
 using namespace inspect::server::sparkplug;
@@ -164,4 +167,22 @@ TEST(SparkplugEdgeNode, NullValuesAndTheRebirthRequest) {
   EXPECT_FALSE(validId("a/b"));
   EXPECT_FALSE(validId("#"));
   EXPECT_FALSE(validId(""));
+}
+
+TEST(SparkplugCredentials, ReadFromTheirFileWithErrorsNamed) {
+  inspect::test::TempDir d("spcred");
+  inspect::test::writeFile(d / "ok.yaml", "username: edge\npassword: \"p:w#1\"\n");
+  const auto c = loadCredentials(d / "ok.yaml");
+  EXPECT_EQ(c.username, "edge");
+  EXPECT_EQ(c.password, "p:w#1");
+  inspect::test::writeFile(d / "none.yaml", "password: x\n");
+  try {
+    loadCredentials(d / "none.yaml");
+    ADD_FAILURE() << "no username accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("none.yaml: username: must not be empty"), std::string::npos) << e.what();
+  }
+  inspect::test::writeFile(d / "typo.yaml", "user: edge\n");
+  EXPECT_THROW(loadCredentials(d / "typo.yaml"), config::ConfigError);
+  EXPECT_THROW(loadCredentials(d / "missing.yaml"), config::ConfigError);
 }

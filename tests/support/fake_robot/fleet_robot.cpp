@@ -306,6 +306,31 @@ void FleetRobot::sendEvent(const std::string& text) {
   });
 }
 
+void FleetRobot::sendAlarmTransition() {
+  asio::post(strand_, [self = shared_from_this()] {
+    const bool raise = !self->alarm_active_;
+    if (raise) ++self->alarm_id_;
+    self->alarm_active_ = raise;
+    v1::Envelope env;
+    auto* e = env.mutable_event();
+    const uint64_t now_us = monoNowUs();
+    e->set_kind(raise ? v1::Event::ALARM_RAISED : v1::Event::ALARM_CLEARED);
+    e->set_robot_time_us(now_us);
+    auto* a = e->mutable_gas_alarm();
+    a->set_id(self->alarm_id_);
+    a->set_channel(0);
+    a->set_channel_name("CH4");
+    a->set_level(v1::GasAlarm::LOW);
+    a->set_active(raise);
+    a->set_value(raise ? 12.0 : 8.0);
+    a->set_threshold(10.0);
+    a->set_unit("%LEL");
+    a->set_robot_time_us(now_us);
+    self->queue(env);
+    ++self->stats_.alarm_transitions_sent;
+  });
+}
+
 void FleetRobot::queue(v1::Envelope& env) {
   if (!up_) return;
   env.set_seq(++tx_seq_);

@@ -51,6 +51,7 @@ struct FleetRobotStats {
   std::atomic<uint64_t> heartbeats_received{0};
   std::atomic<uint64_t> commands_received{0};
   std::atomic<uint64_t> acks_sent{0};
+  std::atomic<uint64_t> alarm_transitions_sent{0};
   std::atomic<uint64_t> app_bytes_sent{0};   // delimited frames handed to TLS
   std::atomic<uint64_t> app_bytes_received{0};
   std::atomic<int64_t> max_heartbeat_gap_us{0};   // between server heartbeats, after the HelloReply
@@ -78,6 +79,10 @@ class FleetRobot : public std::enable_shared_from_this<FleetRobot> {
   /// Sends Event{INFO, text} (the console prints "[id] INFO: text" once the server
   /// has processed it, after everything this robot sent before: a drain marker).
   void sendEvent(const std::string& text);
+  /// A gas alarm transition: Event ALARM_RAISED / ALARM_CLEARED of CH4 LOW
+  /// (channel 0), raise and clear in turn, each raise a new alarm id (1, 2, ...),
+  /// robot_time_us = this machine's CLOCK_MONOTONIC (as its telemetry's).
+  void sendAlarmTransition();
   /// Closes the connection (TLS close_notify is not waited for).
   void close();
 
@@ -122,6 +127,8 @@ class FleetRobot : public std::enable_shared_from_this<FleetRobot> {
   bool writing_ = false;
   bool up_ = false;
   uint64_t tx_seq_ = 0;
+  bool alarm_active_ = false;  // sendAlarmTransition: the next is a clear
+  uint64_t alarm_id_ = 0;
   uint64_t tlm_generation_ = 0;
   bool telemetry_on_ = false;
   Clock::time_point flood_until_{};

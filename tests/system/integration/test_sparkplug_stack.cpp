@@ -16,6 +16,7 @@
 #include <regex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -36,22 +37,38 @@ int count(const std::string& s, const std::string& what) {
   for (auto p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
   return n;
 }
+
+/// The Python Sparkplug host as primary host `scada1` on `broker` (more
+/// arguments in `extra`), subscribed when this returns (its JSON at
+/// <dir>/host.json, its output <dir>/host.out), and the server's config
+/// pointing the edge node at the broker (<dir>/server.yaml, `more` appended
+/// under sparkplug:). An empty Process: it did not subscribe (a failure added).
+Process startHostAndConfig(Stack& s, const MosquittoBroker& broker, const std::vector<std::string>& extra,
+                           const std::string& more) {
+  const std::string ready = s.dir() / "host.ready";
+  std::vector<std::string> argv = {"/usr/bin/python3", srcPath("tests/tools/sparkplug_host.py"), "--port",
+                                   std::to_string(broker.port()), "--credentials", broker.credentialsFile(),
+                                   "--pb-dir", pythonProtoDir(), "--host-id", "scada1", "--until-ndeath", "--json",
+                                   s.dir() / "host.json", "--ready-file", ready};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  auto host = Process::spawn(argv, s.dir() / "host.out", s.dir() / "host.out");
+  if (!waitUntil([&] { return std::filesystem::exists(ready); }, 15.0)) {
+    ADD_FAILURE() << "the host did not subscribe: " << readFile(s.dir() / "host.out");
+    return {};
+  }
+  writeFile(s.dir() / "server.yaml", "video:\n  enabled: false\nsparkplug:\n  enabled: true\n  port: " +
+                                         std::to_string(broker.port()) + "\n  credentials_file: " +
+                                         broker.credentialsFile() + "\n  primary_host_id: scada1\n" + more);
+  return host;
+}
 }  // namespace
 
 TEST(SparkplugStack, AlarmsReachTheScadaHostOnceInOrderThroughABrokerOutage) {
   Stack s("sparkplug");
   MosquittoBroker broker(s.dir().path());
-  const std::string host_json = s.dir() / "host.json", ready = s.dir() / "host.ready";
-  auto host = Process::spawn({"/usr/bin/python3", srcPath("tests/tools/sparkplug_host.py"), "--port",
-                              std::to_string(broker.port()), "--credentials", broker.credentialsFile(), "--pb-dir",
-                              pythonProtoDir(), "--host-id", "scada1", "--seconds", "90", "--until-ndeath", "--json",
-                              host_json, "--ready-file", ready},
-                             s.dir() / "host.out", s.dir() / "host.out");
-  ASSERT_TRUE(waitUntil([&] { return std::filesystem::exists(ready); }, 15.0)) << readFile(s.dir() / "host.out");
-  writeFile(s.dir() / "server.yaml",
-            "video:\n  enabled: false\nsparkplug:\n  enabled: true\n  port: " + std::to_string(broker.port()) +
-                "\n  credentials_file: " + broker.credentialsFile() +
-                "\n  primary_host_id: scada1\n  min_period_s: 0.2\n  edge_node_id: ops1\n");
+  const std::string host_json = s.dir() / "host.json";
+  auto host = startHostAndConfig(s, broker, {"--seconds", "90"}, "  min_period_s: 0.2\n  edge_node_id: ops1\n");
+  ASSERT_GT(host.pid(), 0);
   ASSERT_TRUE(s.startServer("expect robots >= 1 within 20\n"
                             "drive 0.35 0\n"
                             "wait 24\n"
@@ -113,4 +130,41 @@ TEST(SparkplugStack, AlarmsReachTheScadaHostOnceInOrderThroughABrokerOutage) {
   EXPECT_EQ(host_out["alarms"].size(), 2 * alarms.size()) << json;
   std::printf("%zu alarms, %zu transitions at the host, %d of them historical (held through the outage)\n",
               alarms.size(), host_out["alarms"].size(), historical);
+}
+
+TEST(SparkplugStack, ScadaMayStopAndEStopARobotButNeverMoveIt) {
+  // docs/sparkplug.md "Commands": with sparkplug.commands on, the host's DCMD
+  // Commands/E-Stop e-stops the robot through an operator session of its own
+  // (which needs no control to stop); a metric that is not a command is
+  // refused; both are answered in DDATA (Commands/Last Result). The robot
+  // stays e-stopped: resuming is the operator's.
+  Stack s("sparkplug-dcmd");
+  MosquittoBroker broker(s.dir().path());
+  const std::string host_json = s.dir() / "host.json";
+  auto host = startHostAndConfig(s, broker,
+                                 {"--seconds", "60", "--dcmd", "1:robot1:Commands/Drive", "--dcmd", "2:robot1:Commands/E-Stop"},
+                                 "  commands: true\n  min_period_s: 0.2\n");
+  ASSERT_GT(host.pid(), 0);
+  ASSERT_TRUE(s.startServer("expect robots >= 1 within 20\n"
+                            "drive 0.2 0\n"
+                            "expect mode == ESTOP within 20\n"
+                            "wait 2\n"
+                            "expect mode == ESTOP\n"
+                            "expect v ~ 0 0.02\n",
+                            {"--config", s.dir() / "server.yaml", "--no-record"}))
+      << s.logs();
+  s.startRobot("robot1");
+  const auto rc = s.server().wait(60.0);
+  ASSERT_TRUE(rc.has_value()) << s.logs();
+  EXPECT_EQ(*rc, 0) << s.serverOutput() << s.logs();
+  ASSERT_EQ(host.wait(20.0), std::optional<int>(0)) << readFile(s.dir() / "host.out");
+  const auto out = nlohmann::json::parse(readFile(host_json));
+  std::printf("%s\n", out["answers"].dump(1).c_str());
+  EXPECT_TRUE(out["violations"].empty()) << out.dump(1);
+  ASSERT_EQ(out["answers"].size(), 2u) << out.dump(1);
+  EXPECT_NE(out["answers"][0]["text"].get<std::string>().find("refused: 'Commands/Drive' is not a command SCADA may give"),
+            std::string::npos)
+      << out["answers"][0];
+  EXPECT_EQ(out["answers"][1]["text"].get<std::string>(), "robot1: estop accepted") << out["answers"][1];
+  EXPECT_NE(readFile(s.dir() / "server.err").find("DCMD from SCADA: robot1 e-stop"), std::string::npos) << s.logs();
 }

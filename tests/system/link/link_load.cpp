@@ -31,6 +31,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -42,6 +43,8 @@
 
 #include "shared/util/cli_args.hpp"
 #include "shared/util/clock.hpp"
+#include "tests/support/mosquitto_broker.hpp"
+#include "tests/support/paths.hpp"
 #include "tests/support/process.hpp"
 #include "tests/system/link/server_harness.hpp"
 #include "tests/support/fake_robot/fleet_robot.hpp"
@@ -67,17 +70,22 @@ struct Options {
   bool commands = true;  // one `stop` per robot through the console (acked)
   std::string json;
   std::string config;  // pc_server --config ("" = config/server.yaml)
+  bool mqtt = false;   // the server a Sparkplug edge node on a mosquitto of its own, read by the Python host
+  double alarm_period_s = 2.0;  // --mqtt: each robot raises or clears an alarm this often
 };
 
 void usage(std::ostream& o) {
   o << "link_load [--robots 1,10,25,50] [--seconds 20] [--warmup 2] [--idle 2] [--hz 100] [--threads 1]\n"
-       "          [--no-commands] [--config FILE] [--json FILE]\n"
+       "          [--no-commands] [--config FILE] [--mqtt [--alarm-period S]] [--json FILE]\n"
        "  For each fleet size: one real pc_server (TLS, recording on), N simulated robots at --hz telemetry.\n"
        "  --robots   fleet sizes, comma separated (1-500 each)\n"
        "  --seconds  measurement window per fleet size (after --warmup seconds of telemetry)\n"
        "  --idle     server measured idle this long before the robots connect (its baseline)\n"
        "  --threads  generator io threads (robots spread over them)\n"
        "  --no-commands  no console `stop` to each robot (by default each robot gets one and acks it)\n"
+       "  --mqtt     pc_server also a Sparkplug B edge node (docs/sparkplug.md) on a mosquitto of its own,\n"
+       "             read by the Python Sparkplug host (tests/tools/sparkplug_host.py); each robot raises and\n"
+       "             clears a gas alarm every --alarm-period S (2): every transition must reach the host once\n"
        "  --json     write every figure to FILE\n"
        "  Exit status: 0 = no telemetry lost and every robot stayed connected; 1 = not; 2 = bad arguments.\n"
        "  KEEP_TEST_DIRS=1 keeps the server's directories (logs, runs) under $TMPDIR.\n";
@@ -109,6 +117,10 @@ void parse(int argc, char** argv, Options& o) {
       o.json = a.path();
     } else if (a.is("--config")) {
       o.config = a.path();
+    } else if (a.is("--mqtt")) {
+      o.mqtt = true;
+    } else if (a.is("--alarm-period")) {
+      o.alarm_period_s = a.number(0.25, 600);
     } else if (a.isHelp()) {
       usage(std::cout);
       std::exit(0);
@@ -158,7 +170,31 @@ struct Result {
   double drain_s = 0;  // from the end of telemetry until the server had processed all of it
   double load_avg = NAN;
   std::vector<nlohmann::json> per_robot;
+  // --mqtt: the Sparkplug host's view of the alarm transitions.
+  bool mqtt = false;
+  uint64_t alarms_sent = 0, alarms_at_host = 0, alarms_missing = 0, alarms_duplicated = 0, host_messages = 0;
+  uint64_t host_violations = 0, alarms_historical = 0;
+  double alarm_p50_ms = NAN, alarm_p99_ms = NAN, alarm_max_ms = NAN;
 };
+
+/// --mqtt: the source config with its sparkplug: block turned on for `broker` ("" and an error when it cannot).
+std::string sparkplugConfig(const std::string& source, const test::MosquittoBroker& broker, std::string& error) {
+  std::string yaml = test::readFile(source);
+  const auto at = yaml.find("\nsparkplug:");
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const auto p = at == std::string::npos ? std::string::npos : yaml.find(from, at);
+    if (p == std::string::npos) {
+      error = source + ": no '" + from + "' under sparkplug: to replace";
+      return;
+    }
+    yaml.replace(p, from.size(), to);
+  };
+  replace("  enabled: false", "  enabled: true");
+  replace("  port: 1883", "  port: " + std::to_string(broker.port()));
+  replace("  credentials_file: \"\"", "  credentials_file: " + broker.credentialsFile());
+  replace("  primary_host_id: \"\"", "  primary_host_id: loadhost");
+  return error.empty() ? yaml : "";
+}
 
 Result runOne(const Options& opt, int n) {
   Result r;
@@ -174,8 +210,38 @@ Result runOne(const Options& opt, int n) {
     return r;
   }
 
+  // --mqtt: a broker of its own, the Python Sparkplug host as the primary host, the server's config pointed at them.
+  std::unique_ptr<test::MosquittoBroker> broker;
+  test::Process host;
+  std::string config = opt.config;
+  const std::string host_json = dir / "sparkplug_host.json";
+  if (opt.mqtt) {
+    r.mqtt = true;
+    try {
+      broker = std::make_unique<test::MosquittoBroker>(dir.path());
+    } catch (const std::exception& e) {
+      r.error = e.what();
+      return r;
+    }
+    const std::string yaml = sparkplugConfig(opt.config.empty() ? test::srcPath("config/server.yaml") : opt.config,
+                                             *broker, r.error);
+    if (yaml.empty()) return r;
+    config = dir / "server.yaml";
+    test::writeFile(config, yaml);
+    const std::string ready = dir / "host.ready";
+    host = test::Process::spawn({"/usr/bin/python3", test::srcPath("tests/tools/sparkplug_host.py"), "--port",
+                                 std::to_string(broker->port()), "--credentials", broker->credentialsFile(), "--pb-dir",
+                                 test::binDir() + "/../python_proto", "--host-id", "loadhost", "--seconds", "3600",
+                                 "--until-ndeath", "--json", host_json, "--ready-file", ready},
+                                dir / "sparkplug_host.out", dir / "sparkplug_host.out");
+    if (!test::waitUntil([&] { return std::filesystem::exists(ready); }, 15.0)) {
+      r.error = "the Sparkplug host did not subscribe within 15 s: " + test::readFile(dir / "sparkplug_host.out");
+      return r;
+    }
+  }
+
   ServerUnderTest server;
-  if (!server.start({dir.path(), certs, opt.config, {}})) {
+  if (!server.start({dir.path(), certs, config, {}})) {
     r.error = "pc_server did not start: " + server.error();
     return r;
   }
@@ -275,8 +341,14 @@ Result runOne(const Options& opt, int n) {
   const auto s0 = sampleProc(server.pid());
   const double gcpu0 = cpuSecondsSelf();
   uint64_t peak_rss_kb = s0.rss_kb;
+  // --mqtt: each robot raises or clears its alarm every alarm_period_s, the fleet spread over the period.
+  const int alarm_ticks = std::max(1, static_cast<int>(std::lround(opt.alarm_period_s / 0.25)));
+  int tick = 0;
   while (Clock::now() - w0 < std::chrono::duration<double>(opt.seconds)) {
     test::sleepS(0.25);
+    for (std::size_t i = 0; opt.mqtt && i < robots.size(); ++i)
+      if ((tick + static_cast<int>(i)) % alarm_ticks == 0) robots[i]->sendAlarmTransition();
+    ++tick;
     const auto s = sampleProc(server.pid());
     if (!s.ok) break;  // the server died: reported below
     peak_rss_kb = std::max(peak_rss_kb, s.rss_kb);
@@ -329,6 +401,41 @@ Result runOne(const Options& opt, int n) {
   test::sleepS(0.3);
   stopGenerator();
   const auto exit_status = server.quit(15.0);
+  if (opt.mqtt) {
+    for (const auto& rb : robots) r.alarms_sent += rb->stats().alarm_transitions_sent;
+    // The server's clean stop publishes NDEATH; the host ends with it.
+    if (!host.wait(20.0)) {
+      r.error += "the Sparkplug host saw no NDEATH within 20 s; ";
+      host.terminate();
+    }
+    try {
+      const auto h = nlohmann::json::parse(test::readFile(host_json));
+      r.host_messages = h["messages"].get<uint64_t>();
+      r.host_violations = h["violations"].size();
+      std::map<std::pair<std::string, std::pair<uint64_t, bool>>, int> seen;
+      std::vector<int64_t> lat_ms;
+      for (const auto& a : h["alarms"]) {
+        ++seen[{a["device"].get<std::string>(), {a["id"].get<uint64_t>(), a["active"].get<bool>()}}];
+        if (a["historical"].get<bool>()) {
+          ++r.alarms_historical;
+          continue;
+        }
+        lat_ms.push_back(a["received_ms"].get<int64_t>() - a["timestamp_ms"].get<int64_t>());
+      }
+      r.alarms_at_host = h["alarms"].size();
+      for (const auto& [k, count] : seen) r.alarms_duplicated += static_cast<uint64_t>(count - 1);
+      const uint64_t distinct = seen.size();
+      r.alarms_missing = r.alarms_sent > distinct ? r.alarms_sent - distinct : 0;
+      if (!lat_ms.empty()) {
+        r.alarm_max_ms = static_cast<double>(*std::max_element(lat_ms.begin(), lat_ms.end()));
+        r.alarm_p50_ms = percentile(lat_ms, 0.50);
+        r.alarm_p99_ms = percentile(lat_ms, 0.99);
+      }
+      if (r.host_violations) r.error += h["violations"][0].get<std::string>() + "; ";
+    } catch (const std::exception& e) {
+      r.error += std::string("the Sparkplug host's JSON: ") + e.what() + "; ";
+    }
+  }
   if (!stopped) {
     r.error += "record stop not confirmed within 30 s";
     return r;
@@ -390,11 +497,15 @@ Result runOne(const Options& opt, int n) {
   }
   // robots_closed counts links that ended before we closed them ourselves.
   r.ok = drained && r.missing == 0 && r.duplicates == 0 && r.robots_closed == 0 &&
+         (!opt.mqtt || (r.alarms_missing == 0 && r.alarms_duplicated == 0 && r.host_violations == 0 && r.alarms_sent > 0)) &&
          (!opt.commands || r.acks >= static_cast<uint64_t>(n)) && exit_status.has_value();
   if (!r.ok) {
     std::ostringstream e;
     e << r.error << "missing " << r.missing << ", duplicates " << r.duplicates << ", robots closed early " << r.robots_closed
       << ", acks " << r.acks << "/" << n << (exit_status ? "" : ", pc_server did not quit within 15 s");
+    if (opt.mqtt)
+      e << ", alarm transitions sent " << r.alarms_sent << " at the host " << r.alarms_at_host << " missing "
+        << r.alarms_missing << " twice " << r.alarms_duplicated << ", Sparkplug violations " << r.host_violations;
     r.error = e.str();
   }
   return r;
@@ -434,6 +545,20 @@ void printTable(const std::vector<Result>& rs, const Options& o) {
                   "%.2f ms\n",
                   a.robots, b.robots, (b.server_cpu_pct - a.server_cpu_pct) / dn, (b.rss_end_mb - a.rss_end_mb) / dn,
                   a.lat_p99_ms, b.lat_p99_ms);
+  }
+  if (o.mqtt) {
+    std::printf("\nSparkplug B (--mqtt): every robot raises or clears a CH4 alarm every %.1f s; the Python host "
+                "(primary host) counts them\n%6s %9s %9s %8s %8s %8s %8s %8s %8s %9s %10s\n",
+                o.alarm_period_s, "robots", "srv CPU%", "sent", "at host", "missing", "twice", "p50 ms", "p99 ms",
+                "max ms", "host msgs", "violations");
+    for (const auto& r : rs)
+      std::printf("%6d %9.1f %9llu %8llu %8llu %8llu %8.0f %8.0f %8.0f %9llu %10llu\n", r.robots, r.server_cpu_pct,
+                  static_cast<unsigned long long>(r.alarms_sent), static_cast<unsigned long long>(r.alarms_at_host),
+                  static_cast<unsigned long long>(r.alarms_missing),
+                  static_cast<unsigned long long>(r.alarms_duplicated), r.alarm_p50_ms, r.alarm_p99_ms, r.alarm_max_ms,
+                  static_cast<unsigned long long>(r.host_messages), static_cast<unsigned long long>(r.host_violations));
+    std::printf("Alarm latency = the robot's time of the transition (its clock, as the server converts it) -> the "
+                "host's on_message, wall clock, ms.\n");
   }
   std::printf("CPU%% = of one core (utime+stime over the window); CPU%%/rob and MB/rob = above the idle server. "
               "peak MB = VmHWM.\nLatency = Envelope.send_time_us on the generator -> receive time in the server "
@@ -499,6 +624,12 @@ int main(int argc, char** argv) {
       e["drain_s"] = r.drain_s;
       e["load_average_1min"] = r.load_avg;
       e["per_robot"] = r.per_robot;
+      if (r.mqtt)
+        e["sparkplug"] = {{"alarm_period_s", opt.alarm_period_s}, {"transitions_sent", r.alarms_sent},
+                          {"at_host", r.alarms_at_host}, {"missing", r.alarms_missing},
+                          {"duplicated", r.alarms_duplicated}, {"historical", r.alarms_historical},
+                          {"latency_ms", {{"p50", r.alarm_p50_ms}, {"p99", r.alarm_p99_ms}, {"max", r.alarm_max_ms}}},
+                          {"host_messages", r.host_messages}, {"violations", r.host_violations}};
       j["runs"].push_back(e);
     }
     std::ofstream f(opt.json);
