@@ -1,5 +1,7 @@
 #include "pc_server/sparkplug/sparkplug_service.hpp"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -107,6 +109,7 @@ void SparkplugService::onEnvelope(const std::string& robot, const v1::Envelope& 
 }
 
 void SparkplugService::run() {
+  pthread_setname_np(pthread_self(), "sparkplug");  // top -H, link_load's per-thread CPU
   double backoff_s = 0.5;
   while (!stop_) {
     const uint32_t before = stats().sessions;
