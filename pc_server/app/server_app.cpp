@@ -450,9 +450,18 @@ int runServer(const CliOptions& options) {
   std::unique_ptr<sparkplug::SparkplugService> scada;
   if (config.sparkplug.enabled) {
     const auto& sc = config.sparkplug;
-    scada = std::make_unique<sparkplug::SparkplugService>(
-        sc, sc.edge_node_id.empty() ? config.server_id : sc.edge_node_id, registry,
-        [rec = recorder.get()](const std::string& robot) { return rec ? rec->activeRun(robot).value_or("") : ""; });
+    const std::string spool =
+        sc.spool_file.empty() ? (recorder ? recorder->config().dir : config.recording.dir) + "/sparkplug-spool.sqlite"
+                              : sc.spool_file;
+    try {
+      if (const auto dir = std::filesystem::path(spool).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+      scada = std::make_unique<sparkplug::SparkplugService>(
+          sc, sc.edge_node_id.empty() ? config.server_id : sc.edge_node_id, registry,
+          [rec = recorder.get()](const std::string& robot) { return rec ? rec->activeRun(robot).value_or("") : ""; },
+          spool);
+    } catch (const std::exception& e) {
+      throw util::StartupError(std::string("sparkplug.spool_file: ") + e.what());
+    }
     if (!sc.credentials_file.empty()) {
       const auto cred = sparkplug::loadCredentials(sc.credentials_file);
       scada->setCredentials(cred.username, cred.password);

@@ -108,6 +108,7 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   sc.keepalive_s = sp.number("keepalive_s", sc.keepalive_s, 1, 600);
   sc.min_period_s = sp.number("min_period_s", sc.min_period_s, 0.05, 60);
   sc.commands = sp.boolean("commands", sc.commands);
+  sc.spool_file = sp.string("spool_file", sc.spool_file);
   sc.queue_max = static_cast<std::size_t>(sp.integer("queue_max", static_cast<long>(sc.queue_max), 1, 10'000'000));
   const auto db = sp.optChild("deadbands");
   auto& d = sc.deadbands;

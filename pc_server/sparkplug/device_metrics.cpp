@@ -51,6 +51,11 @@ std::vector<Metric> deviceMetrics(const v1::Hello& hello, const v1::Telemetry& t
   return m;
 }
 
+std::vector<Metric> alarmOnlyMetrics(const v1::GasAlarm& a) {
+  const std::string name = alarmMetricName(a.channel_name(), a.level());
+  return {Metric::ofBool(name, false), Metric::ofUInt64(name + "/Alarm Id", 0), Metric::ofDouble(name + "/Reading", NAN)};
+}
+
 std::vector<Metric> alarmEventMetrics(const v1::GasAlarm& a, uint64_t time_ms, bool historical) {
   const std::string name = alarmMetricName(a.channel_name(), a.level());
   std::vector<Metric> m{Metric::ofBool(name, a.active()), Metric::ofUInt64(name + "/Alarm Id", a.id()),

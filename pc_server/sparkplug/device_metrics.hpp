@@ -23,6 +23,10 @@ inline constexpr const char* kCommandStop = "Commands/Stop";
 inline constexpr const char* kCommandEStop = "Commands/E-Stop";
 inline constexpr const char* kCommandResult = "Commands/Last Result";
 
+/// A robot this server has no telemetry of (an earlier process's, in the
+/// spool): the DBIRTH metrics of one alarm's level alone.
+std::vector<Metric> alarmOnlyMetrics(const v1::GasAlarm& a);
+
 /// The metric name of a channel's alarm level: "Gas/CH4/A1", ".../A2", ".../Sensor Fault".
 std::string alarmMetricName(const std::string& channel, v1::GasAlarm::Level level);
 

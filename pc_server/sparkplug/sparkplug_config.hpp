@@ -31,6 +31,7 @@ struct SparkplugConfig {
   double min_period_s = 0.5;             // a robot's DDATA at most this often (alarm events at once)
   bool commands = false;                 // DCMD stop / e-stop from SCADA (never motion)
   std::size_t queue_max = 10000;         // events kept across a broker outage
+  std::string spool_file;                // the file they are kept in ("" = <recording.dir>/sparkplug-spool.sqlite)
   Deadbands deadbands;
 };
 

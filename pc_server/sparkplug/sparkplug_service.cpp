@@ -20,8 +20,15 @@ constexpr int kStepMs = 20;  // the session's poll: an alarm transition waits at
 }  // namespace
 
 SparkplugService::SparkplugService(const SparkplugConfig& cfg, std::string edge_node_id, const RobotRegistry& registry,
-                                   std::function<std::string(const std::string&)> run_of)
+                                   std::function<std::string(const std::string&)> run_of, const std::string& spool_path)
     : cfg_(cfg), registry_(registry), run_of_(std::move(run_of)), node_(cfg.group_id, std::move(edge_node_id)) {
+  if (!spool_path.empty()) {
+    spool_ = std::make_unique<TransitionSpool>(spool_path);
+    for (auto& t : spool_->all())  // an earlier process's, not confirmed: first, and late
+      events_.push_back({std::move(t.device), std::move(t.alarm), t.time_ms, true, -1, t.seq});
+    if (!events_.empty())
+      log::info("sparkplug", events_.size(), " alarm transitions from ", spool_path, " not yet confirmed: sent first");
+  }
   mqtt_.client_id = "inspect-" + cfg_.group_id + "-" + node_.node();
   mqtt_.host = cfg_.host;
   mqtt_.port = cfg_.port;
@@ -103,8 +110,16 @@ void SparkplugService::onEnvelope(const std::string& robot, const v1::Envelope& 
   const auto& a = env.event().gas_alarm();
   // Late: stored by the robot, or it waits for the next session (it is not
   // the tags' current value when it arrives): historical data.
-  events_.push_back({robot, a, wallMs(robot, a.robot_time_us() ? a.robot_time_us() : env.event().robot_time_us()),
-                     !live_ || (env.event().has_stored() && env.event().stored().replayed()), -1});
+  QueuedEvent q{robot, a, wallMs(robot, a.robot_time_us() ? a.robot_time_us() : env.event().robot_time_us()),
+                !live_ || (env.event().has_stored() && env.event().stored().replayed()), -1, 0};
+  if (spool_) {
+    try {
+      q.spool_seq = spool_->append(q.device, q.alarm, q.time_ms, q.late);
+    } catch (const std::exception& e) {
+      log::warn("sparkplug", "alarm ", a.id(), " of ", robot, " kept in memory only: ", e.what());
+    }
+  }
+  events_.push_back(std::move(q));
   wake_.notify_all();
 }
 
@@ -130,8 +145,7 @@ void SparkplugService::session() {
                           std::lock_guard lk(mu_);
                           const auto it = std::find_if(events_.begin(), events_.end(), [&](const QueuedEvent& e) { return e.mid == mid; });
                           if (it == events_.end()) return;  // a birth or data
-                          events_.erase(it);
-                          ++stats_.events_sent;
+                          confirmedLocked(it);
                         },
                         [&](const std::string& topic_name, const std::string& payload) {
                           if (!cfg_.primary_host_id.empty() && topic_name == "spBv1.0/STATE/" + cfg_.primary_host_id) {
@@ -284,29 +298,46 @@ void SparkplugService::publishEvents(MqttSession& s) {
       e = *it;
     }
     const uint64_t now = nowMs();
+    const auto snap = registry_.snapshot(e.device, monoNowNs());
+    const bool connected = snap && snap->connected;
+    if (connected && !snap->has_telemetry) return;  // its first telemetry is on the way: born with it
     if (!node_.online(e.device)) {
-      // The robot is offline (it went during an outage): born from its last
-      // telemetry for its transitions, its death at the next data round.
-      const auto snap = registry_.snapshot(e.device, monoNowNs());
-      if (!snap || !snap->has_telemetry) return;  // no telemetry yet: wait for it
-      if (const auto b = node_.update(e.device, deviceMetrics(snap->hello, snap->telemetry, "", cfg_.deadbands), now))
+      // Offline (it went during an outage, or it is an earlier process's
+      // robot): born from its last telemetry, or with the alarm's metrics
+      // alone, for its transitions, and dead again right after them.
+      const auto metrics = snap && snap->has_telemetry ? deviceMetrics(snap->hello, snap->telemetry, "", cfg_.deadbands)
+                                                       : alarmOnlyMetrics(e.alarm);
+      if (const auto b = node_.update(e.device, metrics, now))
         if (!publish(s, *b)) return;
     }
     const auto m = node_.events(e.device, alarmEventMetrics(e.alarm, e.time_ms, e.late), now);
     if (!m) return;
     const int mid = s.publish(m->topic, m->payload, cfg_.qos);
     if (mid < 0) return;
+    if (!connected)
+      if (const auto d = node_.deviceOffline(e.device, now)) publish(s, *d);
     std::lock_guard lk(mu_);
     ++stats_.published;
     // The first not in flight is still `e` (only this thread sends; the link only appends).
     const auto it = std::find_if(events_.begin(), events_.end(), [](const QueuedEvent& q) { return q.mid < 0; });
     if (cfg_.qos == 0) {  // nothing will confirm it: sent is all there is
-      events_.erase(it);
-      ++stats_.events_sent;
+      confirmedLocked(it);
     } else {
       it->mid = mid;
     }
   }
+}
+
+void SparkplugService::confirmedLocked(std::deque<QueuedEvent>::iterator it) {
+  if (spool_ && it->spool_seq) {
+    try {
+      spool_->remove(it->spool_seq);
+    } catch (const std::exception& e) {
+      log::warn("sparkplug", "the spool: ", e.what(), " (alarm ", it->alarm.id(), " may be sent again at the next start)");
+    }
+  }
+  events_.erase(it);
+  ++stats_.events_sent;
 }
 
 bool SparkplugService::publish(MqttSession& s, const Message& m) {

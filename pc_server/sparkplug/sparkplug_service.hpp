@@ -14,6 +14,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -25,6 +26,7 @@
 #include "pc_server/sparkplug/edge_node.hpp"
 #include "pc_server/sparkplug/mqtt_session.hpp"
 #include "pc_server/sparkplug/sparkplug_config.hpp"
+#include "pc_server/sparkplug/transition_spool.hpp"
 
 namespace inspect::server::sparkplug {
 
@@ -47,8 +49,12 @@ struct ServiceStats {
 class SparkplugService {
  public:
   /// `run_of`: the run being recorded for a robot ("" = none); may be empty.
+  /// `spool_path`: the file the alarm transitions are kept in until the
+  /// broker confirms them ("" = memory only); what an earlier process left
+  /// there goes out first, as historical data. Throws catalog::CatalogError
+  /// when the file cannot be used.
   SparkplugService(const SparkplugConfig& cfg, std::string edge_node_id, const RobotRegistry& registry,
-                   std::function<std::string(const std::string&)> run_of = {});
+                   std::function<std::string(const std::string&)> run_of = {}, const std::string& spool_path = "");
   ~SparkplugService();
   SparkplugService(const SparkplugService&) = delete;
   SparkplugService& operator=(const SparkplugService&) = delete;
@@ -81,7 +87,10 @@ class SparkplugService {
     uint64_t time_ms = 0;
     bool late = false;  // stored by the robot, or held across an outage: historical
     int mid = -1;       // in flight under this message id
+    int64_t spool_seq = 0;  // its row in the spool (0 = none)
   };
+  /// The broker confirmed it (or QoS 0 sent it): out of the queue and the spool; mu_ held.
+  void confirmedLocked(std::deque<QueuedEvent>::iterator it);
   void run();
   void session();
   void onConnected(MqttSession& s, int rc);
@@ -117,6 +126,7 @@ class SparkplugService {
   mutable std::mutex mu_;  // what follows
   std::condition_variable wake_;
   std::deque<QueuedEvent> events_;
+  std::unique_ptr<TransitionSpool> spool_;  // null: memory only
   bool live_ = false;  // born on the broker now: a transition goes out at once
   std::map<std::string, int64_t> offsets_us_;  // per robot: server monotonic - robot clock (smallest seen)
   ServiceStats stats_;

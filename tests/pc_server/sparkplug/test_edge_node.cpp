@@ -9,6 +9,7 @@
 #include "pc_server/sparkplug/device_metrics.hpp"
 #include "pc_server/sparkplug/edge_node.hpp"
 #include "pc_server/sparkplug/sparkplug_credentials.hpp"
+#include "pc_server/sparkplug/transition_spool.hpp"
 #include "shared/config/config_node.hpp"
 #include "tests/support/process.hpp"
 
@@ -185,4 +186,45 @@ TEST(SparkplugCredentials, ReadFromTheirFileWithErrorsNamed) {
   inspect::test::writeFile(d / "typo.yaml", "user: edge\n");
   EXPECT_THROW(loadCredentials(d / "typo.yaml"), config::ConfigError);
   EXPECT_THROW(loadCredentials(d / "missing.yaml"), config::ConfigError);
+}
+
+TEST(SparkplugSpool, TransitionsStayInOrderUntilConfirmedAndOutliveTheProcess) {
+  inspect::test::TempDir d("spspool");
+  const std::string path = d / "sparkplug-spool.sqlite";
+  v1::GasAlarm a;
+  a.set_id(3);
+  a.set_channel(1);
+  a.set_channel_name("H2S");
+  a.set_level(v1::GasAlarm::HIGH);
+  a.set_active(true);
+  a.set_value(21.5);
+  a.set_robot_time_us(123);
+  int64_t first = 0;
+  {
+    TransitionSpool s(path);
+    first = s.append("robot1", a, 1000, false);
+    a.set_active(false);
+    a.set_value(NAN);
+    s.append("robot1", a, 2000, true);
+    a.set_id(4);
+    const int64_t third = s.append("robot2", a, 3000, false);
+    s.remove(third);
+  }
+  TransitionSpool again(path);  // a new process
+  const auto all = again.all();
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_EQ(all[0].seq, first);
+  EXPECT_EQ(all[0].device, "robot1");
+  EXPECT_EQ(all[0].alarm.id(), 3u);
+  EXPECT_EQ(all[0].alarm.channel_name(), "H2S");
+  EXPECT_EQ(all[0].alarm.level(), v1::GasAlarm::HIGH);
+  EXPECT_TRUE(all[0].alarm.active());
+  EXPECT_DOUBLE_EQ(all[0].alarm.value(), 21.5);
+  EXPECT_EQ(all[0].time_ms, 1000u);
+  EXPECT_FALSE(all[0].late);
+  EXPECT_FALSE(all[1].alarm.active());
+  EXPECT_TRUE(std::isnan(all[1].alarm.value())) << "no reading stays no reading";
+  EXPECT_TRUE(all[1].late);
+  inspect::test::writeFile(d / "not-a-db", "garbage garbage garbage garbage");
+  EXPECT_THROW(TransitionSpool(d / "not-a-db"), std::exception);
 }
