@@ -42,7 +42,7 @@ bool listening(uint16_t port) {
 }
 }  // namespace
 
-MosquittoBroker::MosquittoBroker(const std::string& dir) : dir_(dir) {
+MosquittoBroker::MosquittoBroker(const std::string& dir, const BrokerTls& tls) : dir_(dir) {
   const std::string pwfile = dir_ + "/mosquitto.passwd";
   if (std::system(("mosquitto_passwd -b -c '" + pwfile + "' scada 'sc4da-test' >/dev/null 2>&1").c_str()) != 0)
     throw std::runtime_error("mosquitto_passwd failed (Debian package mosquitto; scripts/setup.sh)");
@@ -56,7 +56,10 @@ MosquittoBroker::MosquittoBroker(const std::string& dir) : dir_(dir) {
   // mosquitto, who cannot read the test's directory).
   const passwd* pw = ::getpwuid(::getuid());
   writeFile(conf_, "listener " + std::to_string(port_) + " 127.0.0.1\nallow_anonymous false\npassword_file " + pwfile +
-                       "\npersistence false\nlog_dest stderr\nuser " + (pw ? pw->pw_name : "root") + "\n");
+                       "\npersistence false\nlog_dest stderr\nuser " + (pw ? pw->pw_name : "root") + "\n" +
+                       (tls.ca.empty() ? std::string()
+                                       : "cafile " + tls.ca + "\ncertfile " + tls.cert + "\nkeyfile " + tls.key +
+                                             "\nrequire_certificate true\ntls_version tlsv1.2\n"));
   start();
 }
 

@@ -10,10 +10,16 @@
 
 namespace inspect::test {
 
+/// TLS on the broker's listener: its CA, certificate and key; clients must
+/// show a certificate of that CA too (and still log in with the password).
+struct BrokerTls {
+  std::string ca, cert, key;
+};
+
 class MosquittoBroker {
  public:
   /// Starts it with its files in `dir`; throws std::runtime_error when it does not listen within 5 s.
-  explicit MosquittoBroker(const std::string& dir);
+  explicit MosquittoBroker(const std::string& dir, const BrokerTls& tls = {});
   ~MosquittoBroker();
   uint16_t port() const { return port_; }
   /// A credentials file for clients (`username:` / `password:`, mode 0600).

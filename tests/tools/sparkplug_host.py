@@ -32,6 +32,7 @@ def main():
     ap.add_argument("--port", type=int, required=True)
     ap.add_argument("--credentials", help="a file of 'username: U' and 'password: P' lines")
     ap.add_argument("--group", default="inspection")
+    ap.add_argument("--tls", nargs=3, metavar=("CA", "CERT", "KEY"), help="TLS with the broker's CA and a client certificate")
     ap.add_argument("--pb-dir", required=True, help="where sparkplug_b/sparkplug_b_pb2.py is")
     ap.add_argument("--seconds", type=float, default=30.0, help="the most it runs")
     ap.add_argument("--until-ndeath", action="store_true", help="end at the first NDEATH")
@@ -177,6 +178,8 @@ def main():
                     k, v = line.split(":", 1)
                     creds[k.strip()] = v.strip().strip('"')
         client.username_pw_set(creds.get("username"), creds.get("password"))
+    if a.tls:
+        client.tls_set(ca_certs=a.tls[0], certfile=a.tls[1], keyfile=a.tls[2])
     if a.host_id:
         client.will_set(f"spBv1.0/STATE/{a.host_id}", json.dumps({"online": False, "timestamp": int(time.time() * 1000)}),
                         qos=1, retain=True)

@@ -23,6 +23,7 @@
 #include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/paths.hpp"
 #include "tests/support/stack.hpp"
+#include "tests/support/test_certs.hpp"
 
 using namespace inspect::test;
 
@@ -132,18 +133,23 @@ TEST(SparkplugStack, AlarmsReachTheScadaHostOnceInOrderThroughABrokerOutage) {
               alarms.size(), host_out["alarms"].size(), historical);
 }
 
-TEST(SparkplugStack, ScadaMayStopAndEStopARobotButNeverMoveIt) {
+TEST(SparkplugStack, ScadaMayStopAndEStopARobotButNeverMoveItOverTls) {
   // docs/sparkplug.md "Commands": with sparkplug.commands on, the host's DCMD
   // Commands/E-Stop e-stops the robot through an operator session of its own
   // (which needs no control to stop); a metric that is not a command is
   // refused; both are answered in DDATA (Commands/Last Result). The robot
   // stays e-stopped: resuming is the operator's.
+  // Over TLS both ways: the broker's certificate of the test CA (127.0.0.1 in
+  // it) and a client certificate each for the edge node and the host.
   Stack s("sparkplug-dcmd");
-  MosquittoBroker broker(s.dir().path());
+  const std::string certs = testCertsDir({"robot1", "scada-edge", "scada-host"});
+  MosquittoBroker broker(s.dir().path(), {certs + "/ca.pem", certs + "/server.pem", certs + "/server.key"});
   const std::string host_json = s.dir() / "host.json";
   auto host = startHostAndConfig(s, broker,
-                                 {"--seconds", "60", "--dcmd", "1:robot1:Commands/Drive", "--dcmd", "2:robot1:Commands/E-Stop"},
-                                 "  commands: true\n  min_period_s: 0.2\n");
+                                 {"--seconds", "60", "--dcmd", "1:robot1:Commands/Drive", "--dcmd", "2:robot1:Commands/E-Stop",
+                                  "--tls", certs + "/ca.pem", certs + "/scada-host.pem", certs + "/scada-host.key"},
+                                 "  commands: true\n  min_period_s: 0.2\n  ca: " + certs + "/ca.pem\n  cert: " + certs +
+                                     "/scada-edge.pem\n  key: " + certs + "/scada-edge.key\n");
   ASSERT_GT(host.pid(), 0);
   ASSERT_TRUE(s.startServer("expect robots >= 1 within 20\n"
                             "drive 0.2 0\n"
