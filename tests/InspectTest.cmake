@@ -65,6 +65,7 @@ add_library(inspect_test_support STATIC
   ${PROJECT_SOURCE_DIR}/tests/support/process.cpp
   ${PROJECT_SOURCE_DIR}/tests/support/stack.cpp
   ${PROJECT_SOURCE_DIR}/tests/support/mosquitto_broker.cpp
+  ${PROJECT_SOURCE_DIR}/tests/support/sparkplug_host.cpp
   ${PROJECT_SOURCE_DIR}/tests/support/udp_relay.cpp)
 target_link_libraries(inspect_test_support PUBLIC inspect_test_paths Threads::Threads)
 target_compile_options(inspect_test_support PRIVATE ${INSPECT_TEST_COMPILE_OPTIONS})

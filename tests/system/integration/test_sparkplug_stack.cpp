@@ -3,10 +3,11 @@
 // password file), a robot driving through the gas lab's CH4 plume, and a
 // Sparkplug host written from the specification in Python
 // (tests/tools/sparkplug_host.py, python3-paho-mqtt and protoc's module of
-// the project's sparkplug_b.proto) as the primary host. The broker is killed
-// for 10 s mid-run: every alarm transition the console lists reaches the
-// host once, in order, with the robot's time; births, seq and bdSeq keep the
-// specification's rules throughout.
+// the project's sparkplug_b.proto) as the primary host, which asks for a
+// rebirth once. The broker is killed for 10 s mid-run: every alarm
+// transition the console lists reaches the host once, in order, with the
+// robot's time; births, seq and bdSeq keep the specification's rules
+// throughout.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -21,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/support/mosquitto_broker.hpp"
+#include "tests/support/sparkplug_host.hpp"
 #include "tests/support/paths.hpp"
 #include "tests/support/stack.hpp"
 #include "tests/support/test_certs.hpp"
@@ -28,11 +30,6 @@
 using namespace inspect::test;
 
 namespace {
-std::string pythonProtoDir() {
-  const char* d = std::getenv("INSPECT_PYTHON_PROTO");
-  return d ? d : binDir() + "/../python_proto";
-}
-
 int count(const std::string& s, const std::string& what) {
   int n = 0;
   for (auto p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
@@ -40,26 +37,13 @@ int count(const std::string& s, const std::string& what) {
 }
 
 /// The Python Sparkplug host as primary host `scada1` on `broker` (more
-/// arguments in `extra`), subscribed when this returns (its JSON at
-/// <dir>/host.json, its output <dir>/host.out), and the server's config
-/// pointing the edge node at the broker (<dir>/server.yaml, `more` appended
-/// under sparkplug:). An empty Process: it did not subscribe (a failure added).
-Process startHostAndConfig(Stack& s, const MosquittoBroker& broker, const std::vector<std::string>& extra,
-                           const std::string& more) {
-  const std::string ready = s.dir() / "host.ready";
-  std::vector<std::string> argv = {"/usr/bin/python3", srcPath("tests/tools/sparkplug_host.py"), "--port",
-                                   std::to_string(broker.port()), "--credentials", broker.credentialsFile(),
-                                   "--pb-dir", pythonProtoDir(), "--host-id", "scada1", "--until-ndeath", "--json",
-                                   s.dir() / "host.json", "--ready-file", ready};
-  argv.insert(argv.end(), extra.begin(), extra.end());
-  auto host = Process::spawn(argv, s.dir() / "host.out", s.dir() / "host.out");
-  if (!waitUntil([&] { return std::filesystem::exists(ready); }, 15.0)) {
-    ADD_FAILURE() << "the host did not subscribe: " << readFile(s.dir() / "host.out");
-    return {};
-  }
-  writeFile(s.dir() / "server.yaml", "video:\n  enabled: false\nsparkplug:\n  enabled: true\n  port: " +
-                                         std::to_string(broker.port()) + "\n  credentials_file: " +
-                                         broker.credentialsFile() + "\n  primary_host_id: scada1\n" + more);
+/// arguments in `extra`), subscribed, and <dir>/server.yaml: the shipped
+/// config with its sparkplug: block on that broker and `set`.
+Process startHostAndConfig(Stack& s, const MosquittoBroker& broker, std::vector<std::string> extra,
+                           const std::vector<std::pair<std::string, std::string>>& set) {
+  extra.push_back("--until-ndeath");
+  auto host = startSparkplugHost(broker, s.dir().path(), "scada1", extra);
+  writeFile(s.dir() / "server.yaml", sparkplugServerConfig(srcPath("config/server.yaml"), broker, "scada1", set));
   return host;
 }
 }  // namespace
@@ -67,9 +51,10 @@ Process startHostAndConfig(Stack& s, const MosquittoBroker& broker, const std::v
 TEST(SparkplugStack, AlarmsReachTheScadaHostOnceInOrderThroughABrokerOutage) {
   Stack s("sparkplug");
   MosquittoBroker broker(s.dir().path());
-  const std::string host_json = s.dir() / "host.json";
-  auto host = startHostAndConfig(s, broker, {"--seconds", "90"}, "  min_period_s: 0.2\n  edge_node_id: ops1\n");
-  ASSERT_GT(host.pid(), 0);
+  const std::string host_json = sparkplugHostJson(s.dir().path());
+  // The host asks for a rebirth (NCMD Node Control/Rebirth) 4 s in, before the outage.
+  auto host = startHostAndConfig(s, broker, {"--seconds", "90", "--rebirth-after", "4"},
+                                 {{"min_period_s", "0.2"}, {"edge_node_id", "ops1"}});
   ASSERT_TRUE(s.startServer("expect robots >= 1 within 20\n"
                             "drive 0.35 0\n"
                             "wait 24\n"
@@ -88,12 +73,14 @@ TEST(SparkplugStack, AlarmsReachTheScadaHostOnceInOrderThroughABrokerOutage) {
   const auto rc = s.server().wait(60.0);
   ASSERT_TRUE(rc.has_value()) << s.logs();
   const auto host_rc = host.wait(20.0);
-  ASSERT_EQ(host_rc, std::optional<int>(0)) << readFile(s.dir() / "host.out");
+  ASSERT_EQ(host_rc, std::optional<int>(0)) << readFile(s.dir() / "sparkplug_host.out");
   const std::string out = s.serverOutput(), json = readFile(host_json);
-  std::printf("%s\n%s\n", readFile(s.dir() / "host.out").c_str(), json.c_str());
+  std::printf("%s\n%s\n", readFile(s.dir() / "sparkplug_host.out").c_str(), json.c_str());
   const auto host_out = nlohmann::json::parse(json);
   EXPECT_TRUE(host_out["violations"].empty()) << json;
-  EXPECT_GE(host_out["node_births"].get<int>(), 2) << "born again after the outage: " << json;
+  EXPECT_EQ(host_out["node_births"].get<int>(), 3) << "the first, the rebirth asked, after the outage: " << json;
+  EXPECT_NE(readFile(s.dir() / "server.err").find("NCMD Node Control/Rebirth: the births again"), std::string::npos)
+      << s.logs();
   EXPECT_EQ(host_out["ndeaths"].get<int>(), 1) << "the clean NDEATH at the end";
 
   // The console's alarm book: "#1 robot1 CH4 LOW ... raised 14.5 s ago, cleared after 12.0 s".
@@ -144,13 +131,13 @@ TEST(SparkplugStack, ScadaMayStopAndEStopARobotButNeverMoveItOverTls) {
   Stack s("sparkplug-dcmd");
   const std::string certs = testCertsDir({"robot1", "scada-edge", "scada-host"});
   MosquittoBroker broker(s.dir().path(), {certs + "/ca.pem", certs + "/server.pem", certs + "/server.key"});
-  const std::string host_json = s.dir() / "host.json";
-  auto host = startHostAndConfig(s, broker,
-                                 {"--seconds", "60", "--dcmd", "1:robot1:Commands/Drive", "--dcmd", "2:robot1:Commands/E-Stop",
-                                  "--tls", certs + "/ca.pem", certs + "/scada-host.pem", certs + "/scada-host.key"},
-                                 "  commands: true\n  min_period_s: 0.2\n  ca: " + certs + "/ca.pem\n  cert: " + certs +
-                                     "/scada-edge.pem\n  key: " + certs + "/scada-edge.key\n");
-  ASSERT_GT(host.pid(), 0);
+  const std::string host_json = sparkplugHostJson(s.dir().path());
+  auto host = startHostAndConfig(
+      s, broker,
+      {"--seconds", "60", "--dcmd", "1:robot1:Commands/Drive", "--dcmd", "2:robot1:Commands/E-Stop", "--tls",
+       certs + "/ca.pem", certs + "/scada-host.pem", certs + "/scada-host.key"},
+      {{"commands", "true"}, {"min_period_s", "0.2"}, {"ca", certs + "/ca.pem"}, {"cert", certs + "/scada-edge.pem"},
+       {"key", certs + "/scada-edge.key"}});
   ASSERT_TRUE(s.startServer("expect robots >= 1 within 20\n"
                             "drive 0.2 0\n"
                             "expect mode == ESTOP within 20\n"
@@ -163,7 +150,7 @@ TEST(SparkplugStack, ScadaMayStopAndEStopARobotButNeverMoveItOverTls) {
   const auto rc = s.server().wait(60.0);
   ASSERT_TRUE(rc.has_value()) << s.logs();
   EXPECT_EQ(*rc, 0) << s.serverOutput() << s.logs();
-  ASSERT_EQ(host.wait(20.0), std::optional<int>(0)) << readFile(s.dir() / "host.out");
+  ASSERT_EQ(host.wait(20.0), std::optional<int>(0)) << readFile(s.dir() / "sparkplug_host.out");
   const auto out = nlohmann::json::parse(readFile(host_json));
   std::printf("%s\n", out["answers"].dump(1).c_str());
   EXPECT_TRUE(out["violations"].empty()) << out.dump(1);

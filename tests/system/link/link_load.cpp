@@ -46,6 +46,7 @@
 #include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/paths.hpp"
 #include "tests/support/process.hpp"
+#include "tests/support/sparkplug_host.hpp"
 #include "tests/system/link/server_harness.hpp"
 #include "tests/support/fake_robot/fleet_robot.hpp"
 #include "tests/support/test_certs.hpp"
@@ -178,25 +179,6 @@ struct Result {
   double sparkplug_thread_cpu_pct = 0;  // the edge node's own thread, of one core
 };
 
-/// --mqtt: the source config with its sparkplug: block turned on for `broker` ("" and an error when it cannot).
-std::string sparkplugConfig(const std::string& source, const test::MosquittoBroker& broker, std::string& error) {
-  std::string yaml = test::readFile(source);
-  const auto at = yaml.find("\nsparkplug:");
-  const auto replace = [&](const std::string& from, const std::string& to) {
-    const auto p = at == std::string::npos ? std::string::npos : yaml.find(from, at);
-    if (p == std::string::npos) {
-      error = source + ": no '" + from + "' under sparkplug: to replace";
-      return;
-    }
-    yaml.replace(p, from.size(), to);
-  };
-  replace("  enabled: false", "  enabled: true");
-  replace("  port: 1883", "  port: " + std::to_string(broker.port()));
-  replace("  credentials_file: \"\"", "  credentials_file: " + broker.credentialsFile());
-  replace("  primary_host_id: \"\"", "  primary_host_id: loadhost");
-  return error.empty() ? yaml : "";
-}
-
 Result runOne(const Options& opt, int n) {
   Result r;
   r.robots = n;
@@ -215,28 +197,17 @@ Result runOne(const Options& opt, int n) {
   std::unique_ptr<test::MosquittoBroker> broker;
   test::Process host;
   std::string config = opt.config;
-  const std::string host_json = dir / "sparkplug_host.json";
+  const std::string host_json = test::sparkplugHostJson(dir.path());
   if (opt.mqtt) {
     r.mqtt = true;
     try {
       broker = std::make_unique<test::MosquittoBroker>(dir.path());
+      config = dir / "server.yaml";
+      test::writeFile(config, test::sparkplugServerConfig(
+                                  opt.config.empty() ? test::srcPath("config/server.yaml") : opt.config, *broker, "loadhost"));
+      host = test::startSparkplugHost(*broker, dir.path(), "loadhost", {"--seconds", "3600", "--until-ndeath"});
     } catch (const std::exception& e) {
       r.error = e.what();
-      return r;
-    }
-    const std::string yaml = sparkplugConfig(opt.config.empty() ? test::srcPath("config/server.yaml") : opt.config,
-                                             *broker, r.error);
-    if (yaml.empty()) return r;
-    config = dir / "server.yaml";
-    test::writeFile(config, yaml);
-    const std::string ready = dir / "host.ready";
-    host = test::Process::spawn({"/usr/bin/python3", test::srcPath("tests/tools/sparkplug_host.py"), "--port",
-                                 std::to_string(broker->port()), "--credentials", broker->credentialsFile(), "--pb-dir",
-                                 test::binDir() + "/../python_proto", "--host-id", "loadhost", "--seconds", "3600",
-                                 "--until-ndeath", "--json", host_json, "--ready-file", ready},
-                                dir / "sparkplug_host.out", dir / "sparkplug_host.out");
-    if (!test::waitUntil([&] { return std::filesystem::exists(ready); }, 15.0)) {
-      r.error = "the Sparkplug host did not subscribe within 15 s: " + test::readFile(dir / "sparkplug_host.out");
       return r;
     }
   }
