@@ -5,7 +5,7 @@
 # recorded gas inspection round, alarms, report), then prints what happened.
 #
 #   scripts/run_demo.sh [--interactive|--batch] [--port N] [--foxglove-port N] [--tuning] [--out DIR]
-#                       [--client-config FILE] [--rate F] [--firmware [--elf FILE]]
+#                       [--client-config FILE] [--server-config FILE] [--rate F] [--firmware [--elf FILE]]
 #
 # --tuning runs the fuzzy-PID tuning job instead (scripts/demo/tuning.console
 # on config/worlds/tuning_floor.yaml, whose robot has worn, slower motors):
@@ -27,7 +27,9 @@
 # 8765; --foxglove-port N sets the bridge's alone). --out DIR keeps the logs, ground truth, runs and
 # video there (default: a new folder under $TMPDIR); the demo's test reads them.
 # --client-config FILE gives robot_client other settings than config/client.yaml
-# (the demo's test: a sensor timeout for a shared test host, docs/testing.md).
+# (the demo's test: a sensor timeout for a shared test host, docs/testing.md);
+# --server-config FILE pc_server other settings than config/server.yaml (the
+# demo's test: the Sparkplug edge node on a broker of its own, docs/sparkplug.md).
 # --rate F runs the simulated world F times faster than real time (mcu_sim
 # --rate; the robot's loop runs on the MCU's clock, so it controls the same):
 # the demo's test takes 2 to check the same round in less time.
@@ -45,6 +47,7 @@ MODE=auto
 JOB=gas
 OUT=
 CLIENT_CONFIG=config/client.yaml
+SERVER_CONFIG=
 RATE=
 FIRMWARE=0
 ELF=
@@ -58,11 +61,13 @@ while [ $# -gt 0 ]; do
     --out) OUT=${2:?--out needs a folder}; shift ;;
     --client-config)  # relative to where the script was called from
       CLIENT_CONFIG=${2:?--client-config needs a file}; [ "${CLIENT_CONFIG#/}" != "$CLIENT_CONFIG" ] || CLIENT_CONFIG=$OLDPWD/$CLIENT_CONFIG; shift ;;
+    --server-config)  # relative to where the script was called from
+      SERVER_CONFIG=${2:?--server-config needs a file}; [ "${SERVER_CONFIG#/}" != "$SERVER_CONFIG" ] || SERVER_CONFIG=$OLDPWD/$SERVER_CONFIG; shift ;;
     --rate) RATE=${2:?--rate needs a factor}; shift ;;
     --firmware) FIRMWARE=1 ;;
     --elf)  # relative to where the script was called from
       ELF=${2:?--elf needs a file}; [ "${ELF#/}" != "$ELF" ] || ELF=$OLDPWD/$ELF; shift ;;
-    -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,40p' "$0"; exit 0 ;;
     *) echo "run_demo: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -132,7 +137,7 @@ CLIENT=$!
 PIDS+=("$CLIENT")
 
 # Video on an ephemeral UDP port (5600 may be taken); SDP and snapshots in $OUT/video.
-ARGS=(--config config/server.yaml --bind 127.0.0.1 --port "$PORT" --port-file "$OUT/port"
+ARGS=(--config "${SERVER_CONFIG:-config/server.yaml}" --bind 127.0.0.1 --port "$PORT" --port-file "$OUT/port"
       --video-port 0 --video-port-file "$OUT/video_port" --video-dir "$OUT/video" --runs-dir "$OUT/runs"
       --operator-socket "$OUT/operator.sock" --script "$SCRIPT"
       --foxglove-port "$FOX_PORT" --foxglove-port-file "$OUT/foxglove_port" --foxglove-token-file "$OUT/foxglove.token")

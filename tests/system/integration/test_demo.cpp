@@ -13,19 +13,24 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <nlohmann/json.hpp>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <regex>
 #include <set>
 
 #include "shared/config/gas_config.hpp"
 #include "shared/record/mcap_reader.hpp"
 #include "shared/util/clock.hpp"
+#include "tests/support/mosquitto_broker.hpp"
 #include "tests/support/paths.hpp"
+#include "tests/support/sparkplug_host.hpp"
 #include "tests/support/stack.hpp"
 
 using namespace inspect::test;
@@ -80,14 +85,55 @@ int countLines(const std::string& out, const std::string& text) {
 }
 
 
+// The Sparkplug host saw every alarm transition the console printed, each
+// once, under its level's metric, with no rule of the specification broken.
+void checkScada(const std::string& console, Process& host, const std::string& dir) {
+  ASSERT_EQ(host.wait(30.0), std::optional<int>(0)) << "the host saw no NDEATH: " << readFile(dir + "/sparkplug_host.out");
+  const auto h = nlohmann::json::parse(readFile(sparkplugHostJson(dir)));
+  EXPECT_TRUE(h["violations"].empty()) << h["violations"].dump(1);
+  std::map<std::pair<std::string, bool>, int> at_host;
+  std::map<std::pair<uint64_t, bool>, int> by_id;
+  for (const auto& a : h["alarms"]) {
+    ++at_host[{a["metric"].get<std::string>(), a["active"].get<bool>()}];
+    ++by_id[{a["id"].get<uint64_t>(), a["active"].get<bool>()}];
+  }
+  for (const auto& [k, n] : by_id) EXPECT_EQ(n, 1) << "alarm " << k.first << (k.second ? " raised" : " cleared") << " twice";
+  for (const std::string gas : {"CH4", "H2S"})
+    for (const auto& [level, suffix] : {std::pair{"LOW", "A1"}, std::pair{"HIGH", "A2"}}) {
+      const std::string metric = "Gas/" + gas + "/" + suffix;
+      EXPECT_EQ((at_host[{metric, true}]), countLines(console, "ALARM_RAISED: gas " + gas + " " + level + " alarm raised"))
+          << metric;
+      EXPECT_EQ((at_host[{metric, false}]), countLines(console, "ALARM_CLEARED: gas " + gas + " " + level + " alarm cleared"))
+          << metric;
+    }
+  EXPECT_EQ((at_host[{"Gas/CO/Sensor Fault", true}]), countLines(console, "ALARM_RAISED: gas sensor CO fault raised"));
+  EXPECT_EQ((at_host[{"Gas/CO/Sensor Fault", false}]), countLines(console, "ALARM_CLEARED: gas sensor CO fault"));
+  const int console_transitions = countLines(console, "ALARM_RAISED: gas ") + countLines(console, "ALARM_CLEARED: gas ");
+  EXPECT_EQ(static_cast<int>(h["alarms"].size()), console_transitions) << h["alarms"].dump(1);
+  std::printf("SCADA: %zu alarm transitions at the Sparkplug host (the console printed %d), %zu messages, %zu violations\n",
+              h["alarms"].size(), console_transitions, h["messages"].get<std::size_t>(), h["violations"].size());
+}
+
 // run_demo.sh --batch with `mode` (its world's rate, or the firmware) and
 // every check of the round; `timeout_s` for the whole demo.
-void checkGasRound(const std::vector<std::string>& mode, double timeout_s) {
+// `scada`: the server also a Sparkplug edge node (docs/sparkplug.md) on a
+// mosquitto of the test's own, read by the Python Sparkplug host as the
+// primary host: every alarm transition of the round must reach it once.
+void checkGasRound(const std::vector<std::string>& mode, double timeout_s, bool scada = false) {
   TempDir dir("demo");
   ::setenv("BUILD_DIR", (binDir() + "/..").c_str(), 1);
   std::vector<std::string> argv{"/bin/bash", srcPath("scripts/run_demo.sh"), "--batch", "--port", "0", "--out",
                                 dir.path(), "--client-config", sharedHostClientConfig(dir)};
   argv.insert(argv.end(), mode.begin(), mode.end());
+  std::unique_ptr<MosquittoBroker> broker;
+  Process host;
+  if (scada) {
+    broker = std::make_unique<MosquittoBroker>(dir.path());
+    host = startSparkplugHost(*broker, dir.path(), "scada1",
+                              {"--until-ndeath", "--seconds", std::to_string(static_cast<int>(timeout_s) + 30)});
+    writeFile(dir / "server.yaml", sparkplugServerConfig(srcPath("config/server.yaml"), *broker, "scada1"));
+    argv.insert(argv.end(), {"--server-config", dir / "server.yaml"});
+  }
   Process demo = Process::spawn(argv, dir / "demo.out", dir / "demo.err");
   const auto rc = demo.wait(timeout_s);
   // CLOCK_MONOTONIC -> Unix time, for the truth log against the catalog.
@@ -119,6 +165,7 @@ void checkGasRound(const std::vector<std::string>& mode, double timeout_s) {
   EXPECT_EQ(countLines(out, "ALARM_RAISED: gas CO "), 0);
   // The scripted stuck CO sensor (from 30 s) is a sensor fault.
   EXPECT_EQ(countLines(out, "ALARM_RAISED: gas sensor CO fault raised: stuck"), 1) << out;
+  if (scada) checkScada(out, host, dir.path());
 
   // Map peaks and source estimates (world frame: the route names its map).
   const Truth truth = readTruth(dir / "truth.csv");
@@ -230,7 +277,8 @@ void checkGasRound(const std::vector<std::string>& mode, double timeout_s) {
 TEST(Demo, GasInspectionRoundAsTheOperatorRunsIt) {
   // The world at three times real time (the robot's loop runs on the MCU
   // clock): the same round, alarms, holds and report; 41 s alone, 54 s at twice.
-  checkGasRound({"--rate", "3"}, 240);
+  // The plant's SCADA (a Sparkplug host on MQTT) gets every alarm transition.
+  checkGasRound({"--rate", "3"}, 240, /*scada=*/true);
 }
 
 // The same round and checks with the robot's real firmware on the line (its
