@@ -17,10 +17,11 @@ Credentials loadCredentials(const std::string& path) {
   c.password = root.string("password", "");
   root.checkKnown();
   struct stat st{};
-  if (::stat(path.c_str(), &st) == 0 && (st.st_mode & 077) != 0) {
+  // Others than the owner and the group (the service's: root:inspect 0640 is the packaged way).
+  if (::stat(path.c_str(), &st) == 0 && (st.st_mode & 007) != 0) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%03o", static_cast<unsigned>(st.st_mode & 0777));
-    log::warn("sparkplug", path, " has mode ", mode, ": other users may read the broker's password; chmod 600 it");
+    log::warn("sparkplug", path, " has mode ", mode, ": any user may read the broker's password; chmod o-rwx it");
   }
   return c;
 }

@@ -11,7 +11,7 @@ struct Credentials {
 };
 
 /// Reads `path`; throws config::ConfigError naming the file and the key
-/// (missing username, unknown key). Warns when others may read the file.
+/// (missing username, unknown key). Warns when any user may read the file.
 Credentials loadCredentials(const std::string& path);
 
 }  // namespace inspect::server::sparkplug
