@@ -191,6 +191,41 @@ std::unique_ptr<Recorder> startRecorder(const ServerConfig& config, LinkServer& 
   return recorder;
 }
 
+/// The Sparkplug B edge node (docs/sparkplug.md), started: its spool beside
+/// the runs unless sparkplug.spool_file names one, its broker credentials,
+/// and with sparkplug.commands an operator service of its own in `ops`.
+std::unique_ptr<sparkplug::SparkplugService> startScada(const ServerConfig& config, Recorder* recorder,
+                                                        RobotRegistry& registry, LinkServer& link, ControlArbiter& control,
+                                                        const Console::Options& copt,
+                                                        std::optional<OperatorService>& ops) {
+  const auto& sc = config.sparkplug;
+  const std::string node = sc.edge_node_id.empty() ? config.server_id : sc.edge_node_id;
+  const std::string spool =
+      sc.spool_file.empty() ? (recorder ? recorder->config().dir : config.recording.dir) + "/sparkplug-spool.sqlite"
+                            : sc.spool_file;
+  std::unique_ptr<sparkplug::SparkplugService> scada;
+  try {
+    if (const auto dir = std::filesystem::path(spool).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+    scada = std::make_unique<sparkplug::SparkplugService>(
+        sc, node, registry,
+        [recorder](const std::string& robot) { return recorder ? recorder->activeRun(robot).value_or("") : ""; }, spool);
+  } catch (const std::exception& e) {
+    throw util::StartupError(std::string("sparkplug.spool_file: ") + e.what());
+  }
+  if (!sc.credentials_file.empty()) {
+    const auto cred = sparkplug::loadCredentials(sc.credentials_file);
+    scada->setCredentials(cred.username, cred.password);
+  }
+  if (sc.commands) {
+    ops.emplace(registry, link, &control, OperatorService::Options{copt.ack_timeout_s, copt.max_v_m_s, copt.max_w_rad_s});
+    scada->setCommands(&*ops, control.openSession("scada@" + sc.host));
+  }
+  scada->start();
+  std::cout << "pc_server: Sparkplug B edge node " << sc.group_id << "/" << node << " on mqtt" << (sc.ca.empty() ? "" : "s")
+            << "://" << sc.host << ":" << sc.port << std::endl;
+  return scada;
+}
+
 /// The video hub: telemetry from the link (clock offsets), access units to the recorder and the bridge.
 std::unique_ptr<VideoHub> startVideo(const ServerConfig& config, const CliOptions& options, LinkServer& link,
                                      Recorder* recorder, std::atomic<foxglove::FoxgloveBridge*>& bridge_ptr) {
@@ -449,32 +484,8 @@ int runServer(const CliOptions& options) {
   std::optional<OperatorService> scada_ops;  // SCADA's operator session: stop and e-stop only (DCMD); outlives scada
   std::unique_ptr<sparkplug::SparkplugService> scada;
   if (config.sparkplug.enabled) {
-    const auto& sc = config.sparkplug;
-    const std::string spool =
-        sc.spool_file.empty() ? (recorder ? recorder->config().dir : config.recording.dir) + "/sparkplug-spool.sqlite"
-                              : sc.spool_file;
-    try {
-      if (const auto dir = std::filesystem::path(spool).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
-      scada = std::make_unique<sparkplug::SparkplugService>(
-          sc, sc.edge_node_id.empty() ? config.server_id : sc.edge_node_id, registry,
-          [rec = recorder.get()](const std::string& robot) { return rec ? rec->activeRun(robot).value_or("") : ""; },
-          spool);
-    } catch (const std::exception& e) {
-      throw util::StartupError(std::string("sparkplug.spool_file: ") + e.what());
-    }
-    if (!sc.credentials_file.empty()) {
-      const auto cred = sparkplug::loadCredentials(sc.credentials_file);
-      scada->setCredentials(cred.username, cred.password);
-    }
-    if (sc.commands) {
-      scada_ops.emplace(registry, link, &control, OperatorService::Options{copt.ack_timeout_s, copt.max_v_m_s, copt.max_w_rad_s});
-      scada->setCommands(&*scada_ops, control.openSession("scada@" + sc.host));
-    }
+    scada = startScada(config, recorder.get(), registry, link, control, copt, scada_ops);
     scada_ptr = scada.get();
-    scada->start();
-    std::cout << "pc_server: Sparkplug B edge node " << sc.group_id << "/"
-              << (sc.edge_node_id.empty() ? config.server_id : sc.edge_node_id) << " on mqtt" << (sc.ca.empty() ? "" : "s")
-              << "://" << sc.host << ":" << sc.port << std::endl;
   }
 
   StopFlag stop;

@@ -82,6 +82,7 @@ std::string SparkplugService::report() const {
 }
 
 uint64_t SparkplugService::wallMs(const std::string& robot, uint64_t robot_us) const {
+  std::lock_guard lk(offsets_mu_);
   const auto it = offsets_us_.find(robot);
   if (it == offsets_us_.end()) return nowMs();
   return monoUsToWallNs(static_cast<uint64_t>(static_cast<int64_t>(robot_us) + it->second)) / 1'000'000;
@@ -89,29 +90,33 @@ uint64_t SparkplugService::wallMs(const std::string& robot, uint64_t robot_us) c
 
 void SparkplugService::onEnvelope(const std::string& robot, const v1::Envelope& env, bool inbound, uint64_t time_us) {
   if (!inbound) return;
-  std::lock_guard lk(mu_);
   // The robot's clock (its telemetry's and its events' robot_time_us, from
   // its start) to the server's: the smallest (receive - robot time) seen is
-  // the offset plus the shortest one-way delay.
+  // the offset plus the shortest one-way delay. Every telemetry message of
+  // every robot passes here, on the link's threads: a lock of its own, never
+  // held across the spool's file.
   if (env.has_telemetry() && env.telemetry().robot_time_us()) {
     const int64_t o = static_cast<int64_t>(time_us) - static_cast<int64_t>(env.telemetry().robot_time_us());
+    std::lock_guard lk(offsets_mu_);
     auto [it, fresh] = offsets_us_.try_emplace(robot, o);
     if (!fresh) it->second = std::min(it->second, o);
+    return;
   }
   if (!env.has_event() || !env.event().has_gas_alarm()) return;
   const auto kind = env.event().kind();
   if (kind != v1::Event::ALARM_RAISED && kind != v1::Event::ALARM_CLEARED) return;
+  const auto& a = env.event().gas_alarm();
+  const uint64_t time_ms = wallMs(robot, a.robot_time_us() ? a.robot_time_us() : env.event().robot_time_us());
+  std::lock_guard lk(mu_);
   if (events_.size() >= cfg_.queue_max) {
     ++stats_.dropped;
     log::warn("sparkplug", "event queue full (", cfg_.queue_max, "): alarm ", env.event().gas_alarm().id(), " of ",
               robot, " not sent");
     return;
   }
-  const auto& a = env.event().gas_alarm();
   // Late: stored by the robot, or it waits for the next session (it is not
   // the tags' current value when it arrives): historical data.
-  QueuedEvent q{robot, a, wallMs(robot, a.robot_time_us() ? a.robot_time_us() : env.event().robot_time_us()),
-                !live_ || (env.event().has_stored() && env.event().stored().replayed()), -1, 0};
+  QueuedEvent q{robot, a, time_ms, !live_ || (env.event().has_stored() && env.event().stored().replayed()), -1, 0};
   if (spool_) {
     try {
       q.spool_seq = spool_->append(q.device, q.alarm, q.time_ms, q.late);
@@ -187,14 +192,7 @@ void SparkplugService::session() {
     // A clean end: the robots' deaths and the node's (the broker drops the Will).
     for (const auto& snap : registry_.snapshots(monoNowNs()))
       if (const auto m = node_.deviceOffline(snap.id, nowMs())) publish(s, *m);
-    // NDEATH, then its PUBACK read (and so every earlier one) before the
-    // DISCONNECT: a socket closed with a PUBACK unread is reset, and a broker
-    // that sees the reset before the DISCONNECT publishes the Will as well.
-    const Message death = node_.death(nowMs());
-    const int mid = s.publish(death.topic, death.payload, 1);
-    for (int i = 0; mid >= 0 && i < 100 && last_delivered_mid_ != mid && s.step(kStepMs); ++i) {
-    }
-    s.disconnect();
+    leave(s);
     if (!s.error().empty()) log::warn("sparkplug", "stopping: ", s.error());
   }
   const bool was_born = node_.born();
@@ -259,9 +257,19 @@ void SparkplugService::onHostState(MqttSession& s, const std::string& payload) {
   } else if (!online && node_.born()) {
     // The primary host went away: end this session (NDEATH) and start again, to be born when it is back.
     log::info("sparkplug", "the primary host ", cfg_.primary_host_id, " is offline: the edge node leaves the broker");
-    publish(s, node_.death(nowMs()));
-    s.disconnect();
+    leave(s);
   }
+}
+
+void SparkplugService::leave(MqttSession& s) {
+  // NDEATH, then its PUBACK read (and so every earlier one) before the
+  // DISCONNECT: a socket closed with a PUBACK unread is reset, and a broker
+  // that sees the reset before the DISCONNECT publishes the Will as well.
+  const Message death = node_.death(nowMs());
+  const int mid = s.publish(death.topic, death.payload, 1);
+  for (int i = 0; mid >= 0 && i < 100 && last_delivered_mid_ != mid && s.step(kStepMs); ++i) {
+  }
+  s.disconnect();
 }
 
 void SparkplugService::publishDevices(MqttSession& s, bool birth) {
@@ -346,10 +354,6 @@ bool SparkplugService::publish(MqttSession& s, const Message& m) {
   ++stats_.published;
   return true;
 }
-
-}  // namespace inspect::server::sparkplug
-
-namespace inspect::server::sparkplug {
 
 void SparkplugService::answer(MqttSession& s, const std::string& device, const std::string& text) {
   const uint64_t now = nowMs();

@@ -96,6 +96,8 @@ class SparkplugService {
   void onConnected(MqttSession& s, int rc);
   /// NBIRTH and the robots' DBIRTH.
   void birth(MqttSession& s);
+  /// NDEATH and a clean DISCONNECT (the broker drops the Will).
+  void leave(MqttSession& s);
   /// The primary host's STATE message: born when online, the session ended when offline.
   void onHostState(MqttSession& s, const std::string& payload);
   /// Every robot's data beyond the deadbands, and DDEATH of those gone;
@@ -123,13 +125,15 @@ class SparkplugService {
   std::thread thread_;
   std::atomic<bool> stop_{false};
 
-  mutable std::mutex mu_;  // what follows
+  mutable std::mutex mu_;  // what follows, up to offsets_mu_
   std::condition_variable wake_;
   std::deque<QueuedEvent> events_;
   std::unique_ptr<TransitionSpool> spool_;  // null: memory only
   bool live_ = false;  // born on the broker now: a transition goes out at once
-  std::map<std::string, int64_t> offsets_us_;  // per robot: server monotonic - robot clock (smallest seen)
   ServiceStats stats_;
+
+  mutable std::mutex offsets_mu_;  // offsets_us_ alone: taken for every telemetry message
+  std::map<std::string, int64_t> offsets_us_;  // per robot: server monotonic - robot clock (smallest seen)
 };
 
 }  // namespace inspect::server::sparkplug
