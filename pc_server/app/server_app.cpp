@@ -32,6 +32,7 @@
 #include "pc_server/link/link_server.hpp"
 #include "pc_server/terminal/operator_socket.hpp"
 #include "pc_server/link/robot_registry.hpp"
+#include "pc_server/link/session_threads.hpp"
 #include "shared/catalog/sql_backend.hpp"
 #include "shared/util/startup_error.hpp"
 #include "pc_server/operator/stop_flag.hpp"
@@ -56,11 +57,14 @@ constexpr std::chrono::milliseconds kConsoleWatchdog{300};
 
 enum class ConsoleMode { kNone, kScript, kInteractive, kStream };
 
-/// The io_context's threads; stopped and joined on every way out of runServer().
+/// The io_context's threads and the robot sessions' threads; stopped and
+/// joined on every way out of runServer(), before what their handlers call.
 struct IoThreads {
   asio::io_context& ioc;
+  SessionThreads& sessions;
   std::vector<std::thread> threads;
   ~IoThreads() {
+    sessions.stop();
     ioc.stop();
     for (auto& t : threads)
       if (t.joinable()) t.join();
@@ -424,8 +428,9 @@ int runServer(const CliOptions& options) {
   site_maps.setDefault(config.site_map);
 
   asio::io_context ioc;
+  SessionThreads session_threads(kIoThreads);  // started with the io threads, at the end
   RobotRegistry registry;
-  LinkServer link(ioc, config, registry);
+  LinkServer link(ioc, config, registry, &session_threads);
   link.setLogEvents(mode == ConsoleMode::kNone);
   if (mode != ConsoleMode::kNone) link.setConsoleWatchdog(kConsoleWatchdog);
   // The Foxglove bridge (made once the recorder and the video exist) sees every envelope.
@@ -495,7 +500,8 @@ int runServer(const CliOptions& options) {
   if (recorder) tickRecorder(record_timer, *recorder);
 
   auto work = asio::make_work_guard(ioc);
-  IoThreads io{ioc, {}};
+  IoThreads io{ioc, session_threads, {}};
+  session_threads.start();
   for (int i = 0; i < kIoThreads; ++i) io.threads.emplace_back([&ioc] { ioc.run(); });
 
   const int status = runConsoles(mode, script, options, config, registry, link, control, copt, configure, stop);

@@ -4,6 +4,7 @@
 #include <boost/asio/strand.hpp>
 
 #include "pc_server/link/robot_session.hpp"
+#include "pc_server/link/session_threads.hpp"
 #include "shared/util/startup_error.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
@@ -14,11 +15,10 @@ namespace asio = boost::asio;
 using asio::ip::tcp;
 using boost::system::error_code;
 
-namespace {
-}
-
-LinkServer::LinkServer(asio::io_context& ioc, const LinkConfig& config, RobotRegistry& registry)
+LinkServer::LinkServer(asio::io_context& ioc, const LinkConfig& config, RobotRegistry& registry,
+                       SessionThreads* sessions)
     : ioc_(ioc),
+      session_threads_(sessions),
       config_(config),
       registry_(registry),
       acceptor_(asio::make_strand(ioc)),
@@ -52,7 +52,7 @@ tcp::endpoint LinkServer::listen() {
 }
 
 void LinkServer::doAccept() {
-  auto strand = asio::make_strand(ioc_);
+  auto strand = asio::make_strand(session_threads_ ? session_threads_->next() : ioc_);
   acceptor_.async_accept(strand, [this, strand](const error_code& ec, tcp::socket socket) {
     if (ec == asio::error::operation_aborted || !acceptor_.is_open()) return;
     if (ec) {

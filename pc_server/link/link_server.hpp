@@ -26,10 +26,15 @@ namespace inspect::server {
 
 class RobotRegistry;
 class RobotSession;
+class SessionThreads;
 
 class LinkServer : public CommandSink {
  public:
-  LinkServer(boost::asio::io_context& ioc, const LinkConfig& config, RobotRegistry& registry);
+  /// The acceptor runs on `ioc`; the sessions on `sessions`' threads, or on
+  /// `ioc` too when null. Both must outlive the LinkServer, and their threads
+  /// must be stopped before anything an observer calls is destroyed.
+  LinkServer(boost::asio::io_context& ioc, const LinkConfig& config, RobotRegistry& registry,
+             SessionThreads* sessions = nullptr);
   ~LinkServer() override;
   LinkServer(const LinkServer&) = delete;
   LinkServer& operator=(const LinkServer&) = delete;
@@ -88,6 +93,7 @@ class LinkServer : public CommandSink {
   std::shared_ptr<RobotSession> find(const std::string& robot_id) const;
 
   boost::asio::io_context& ioc_;
+  SessionThreads* session_threads_;
   const LinkConfig config_;
   std::shared_ptr<boost::asio::ssl::context> tls_;  // null: plaintext
   std::string cert_info_;

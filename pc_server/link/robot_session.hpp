@@ -14,6 +14,7 @@
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
+#include <google/protobuf/arena.h>
 
 #include "inspect_robot/v1/link.pb.h"
 #include "pc_server/link/link_config.hpp"
@@ -115,6 +116,12 @@ class RobotSession : public std::enable_shared_from_this<RobotSession> {
   } throttle_;
 
   net::DelimitedDecoder decoder_;
+  /// Each received frame is parsed onto this arena and the arena reset once
+  /// it is handled: a telemetry message's dozen sub-messages cost no malloc
+  /// and free (docs/load.md). Its first block is kept across resets.
+  static constexpr std::size_t kRxArenaBlock = 16 * 1024;
+  std::unique_ptr<char[]> rx_arena_block_;
+  std::unique_ptr<google::protobuf::Arena> rx_arena_;
   std::array<char, 16 * 1024> rx_buf_{};
   struct Outbox {
     std::deque<std::string> queue;

@@ -216,10 +216,14 @@ struct Summary {
   uint64_t messages = 0, start_time = 0, end_time = 0;
 
   void countMessage(uint16_t channel, uint64_t log_time) {
+    countTime(log_time);
+    ++channel_counts[channel];
+  }
+  /// countMessage without channel_counts (the writer keeps those per channel id).
+  void countTime(uint64_t log_time) {
     if (messages == 0 || log_time < start_time) start_time = log_time;
     if (messages == 0 || log_time > end_time) end_time = log_time;
     ++messages;
-    ++channel_counts[channel];
   }
 
   // DataEnd, summary, summary offsets, footer and magic after a data section
