@@ -1,5 +1,6 @@
 #pragma once
-// A LinkServer on 127.0.0.1, ephemeral port, its io_context run by 2 threads.
+// A LinkServer on 127.0.0.1, ephemeral port, as pc_server runs it: the
+// acceptor on an io_context run by 2 threads, the sessions on 2 session threads.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -12,6 +13,7 @@
 
 #include "pc_server/link/link_server.hpp"
 #include "pc_server/link/robot_registry.hpp"
+#include "pc_server/link/session_threads.hpp"
 #include "shared/util/clock.hpp"
 #include "tests/support/fake_robot/scripted_robot.hpp"
 
@@ -33,9 +35,10 @@ inline server::ServerConfig testConfig() {
 class ServerFixture : public ::testing::Test {
  protected:
   void startServer(server::ServerConfig config = testConfig()) {
-    link_ = std::make_unique<server::LinkServer>(ioc_, config, registry_);
+    link_ = std::make_unique<server::LinkServer>(ioc_, config, registry_, &sessions_);
     port_ = link_->listen().port();
     work_.emplace(ioc_.get_executor());
+    sessions_.start();
     for (int i = 0; i < 2; ++i) threads_.emplace_back([this] { ioc_.run(); });
   }
 
@@ -44,6 +47,7 @@ class ServerFixture : public ::testing::Test {
       link_->stop();
       link_->waitAllClosed(std::chrono::seconds(1));
     }
+    sessions_.stop();
     work_.reset();
     ioc_.stop();
     for (auto& t : threads_) t.join();
@@ -67,6 +71,7 @@ class ServerFixture : public ::testing::Test {
   }
 
   boost::asio::io_context ioc_;
+  server::SessionThreads sessions_{2};
   server::RobotRegistry registry_;
   std::unique_ptr<server::LinkServer> link_;
   std::optional<boost::asio::executor_work_guard<boost::asio::io_context::executor_type>> work_;
