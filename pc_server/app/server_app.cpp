@@ -427,8 +427,10 @@ int runServer(const CliOptions& options) {
   scene::SiteMaps site_maps;
   site_maps.setDefault(config.site_map);
 
-  asio::io_context ioc;
+  // Declared first, destroyed last: an accept still pending on `ioc` holds a
+  // socket of one of the sessions' io_contexts.
   SessionThreads session_threads(kIoThreads);  // started with the io threads, at the end
+  asio::io_context ioc;
   RobotRegistry registry;
   LinkServer link(ioc, config, registry, &session_threads);
   link.setLogEvents(mode == ConsoleMode::kNone);

@@ -31,8 +31,10 @@ class SessionThreads;
 class LinkServer : public CommandSink {
  public:
   /// The acceptor runs on `ioc`; the sessions on `sessions`' threads, or on
-  /// `ioc` too when null. Both must outlive the LinkServer, and their threads
-  /// must be stopped before anything an observer calls is destroyed.
+  /// `ioc` too when null. Both must outlive the LinkServer, `sessions` must
+  /// outlive `ioc` too (an accept pending there holds a socket of one of its
+  /// io_contexts), and their threads must be stopped before anything an
+  /// observer calls is destroyed.
   LinkServer(boost::asio::io_context& ioc, const LinkConfig& config, RobotRegistry& registry,
              SessionThreads* sessions = nullptr);
   ~LinkServer() override;

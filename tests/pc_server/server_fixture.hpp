@@ -70,8 +70,8 @@ class ServerFixture : public ::testing::Test {
     return s && s->connected;
   }
 
+  server::SessionThreads sessions_{2};  // outlives ioc_: a pending accept holds a socket of its io_contexts
   boost::asio::io_context ioc_;
-  server::SessionThreads sessions_{2};
   server::RobotRegistry registry_;
   std::unique_ptr<server::LinkServer> link_;
   std::optional<boost::asio::executor_work_guard<boost::asio::io_context::executor_type>> work_;
