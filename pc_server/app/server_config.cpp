@@ -105,7 +105,7 @@ ServerConfig loadServerConfig(const config::ConfigNode& root) {
   if (sc.cert.empty() != sc.key.empty()) sp.fail(sc.cert.empty() ? "cert" : "key", "cert and key go together");
   if (!sc.cert.empty() && sc.ca.empty()) sp.fail("ca", "must be set with a client certificate (TLS)");
   sc.qos = static_cast<int>(sp.integer("qos", sc.qos, 0, 1));
-  sc.keepalive_s = sp.number("keepalive_s", sc.keepalive_s, 1, 600);
+  sc.keepalive_s = sp.number("keepalive_s", sc.keepalive_s, 5, 600);  // libmosquitto refuses 1-4
   sc.min_period_s = sp.number("min_period_s", sc.min_period_s, 0.05, 60);
   sc.commands = sp.boolean("commands", sc.commands);
   sc.spool_file = sp.string("spool_file", sc.spool_file);

@@ -2,6 +2,8 @@
 
 #include <mosquitto.h>
 
+#include <cerrno>
+#include <cstring>
 #include <mutex>
 
 namespace inspect::server::sparkplug {
@@ -28,13 +30,15 @@ MqttSession::MqttSession(const MqttOptions& o, Callbacks cb) : cb_(std::move(cb)
     if (rc != 0) {
       s->lost_ = true;
       s->error_ = std::string("the broker refused the connection: ") + mosquitto_connack_string(rc);
+    } else {
+      s->connected_ = true;
     }
     if (s->cb_.connected) s->cb_.connected(rc);
   });
   mosquitto_disconnect_callback_set(mosq_, [](struct mosquitto*, void* self, int rc) {
     auto* s = static_cast<MqttSession*>(self);
     s->lost_ = true;
-    if (s->error_.empty()) s->error_ = rc == 0 ? "disconnected" : "connection lost: " + errorText(rc);
+    if (s->error_.empty()) s->error_ = rc == 0 ? "disconnected" : s->lostText(rc);
   });
   mosquitto_publish_callback_set(mosq_, [](struct mosquitto*, void* self, int mid) {
     auto* s = static_cast<MqttSession*>(self);
@@ -62,14 +66,28 @@ std::string MqttSession::connect(const std::string& will_topic, const std::strin
   if (rc == MOSQ_ERR_SUCCESS)
     rc = mosquitto_will_set(mosq_, will_topic.c_str(), static_cast<int>(will_payload.size()), will_payload.data(), 1, false);
   if (rc == MOSQ_ERR_SUCCESS) mosquitto_int_option(mosq_, MOSQ_OPT_TCP_NODELAY, 1);
-  if (rc == MOSQ_ERR_SUCCESS) rc = mosquitto_connect(mosq_, opts_.host.c_str(), opts_.port, opts_.keepalive_s);
+  // Not blocking: a broker whose host drops the SYN would hold this thread
+  // (and stop()) for the kernel's connect timeout, about 2 minutes; step()
+  // finishes the connection, and the owner gives up on a CONNACK that is late.
+  if (rc == MOSQ_ERR_SUCCESS) rc = mosquitto_connect_async(mosq_, opts_.host.c_str(), opts_.port, opts_.keepalive_s);
   if (rc != MOSQ_ERR_SUCCESS) {
     lost_ = true;
-    error_ = rc == MOSQ_ERR_ERRNO ? std::string("cannot connect to ") + opts_.host + ":" + std::to_string(opts_.port)
-                                  : errorText(rc);
+    error_ = lostText(rc);
     return error_;
   }
   return "";
+}
+
+std::string MqttSession::noAnswerText() const {
+  return "no answer (CONNACK) from " + opts_.host + ":" + std::to_string(opts_.port) + " within " +
+         std::to_string(opts_.keepalive_s) + " s (keepalive_s)";
+}
+
+std::string MqttSession::lostText(int rc) const {
+  if (!connected_ && rc == MOSQ_ERR_KEEPALIVE) return noAnswerText();  // libmosquitto's own text is "Unknown error."
+  const std::string why = rc == MOSQ_ERR_ERRNO ? std::string(std::strerror(errno)) : errorText(rc);
+  return connected_ ? "connection lost: " + why
+                    : "cannot connect to " + opts_.host + ":" + std::to_string(opts_.port) + ": " + why;
 }
 
 bool MqttSession::step(int timeout_ms) {
@@ -77,7 +95,7 @@ bool MqttSession::step(int timeout_ms) {
   const int rc = mosquitto_loop(mosq_, timeout_ms, 1);
   if (rc != MOSQ_ERR_SUCCESS && !lost_) {
     lost_ = true;
-    error_ = "connection lost: " + errorText(rc);
+    error_ = lostText(rc);
   }
   return !lost_;
 }

@@ -33,7 +33,8 @@ class MqttSession {
   MqttSession(const MqttSession&) = delete;
   MqttSession& operator=(const MqttSession&) = delete;
 
-  /// Starts connecting with the Will (QoS 1, not retained); "" or why not.
+  /// Starts connecting with the Will (QoS 1, not retained), without
+  /// blocking: step() completes it; "" or why not.
   std::string connect(const std::string& will_topic, const std::string& will_payload);
   /// Runs the network for up to `timeout_ms`: callbacks fire here. False once the session is lost.
   bool step(int timeout_ms);
@@ -43,6 +44,11 @@ class MqttSession {
   /// Disconnects cleanly (the broker then drops the Will).
   void disconnect();
   bool lost() const { return lost_; }
+  /// The broker accepted the session (CONNACK 0).
+  bool connected() const { return connected_; }
+  /// "no answer (CONNACK) from host:port within N s (keepalive_s)": a
+  /// broker that never answered; the owner gives up after the keep-alive.
+  std::string noAnswerText() const;
   const std::string& error() const { return error_; }
 
   /// libmosquitto's text of an error number.
@@ -53,7 +59,11 @@ class MqttSession {
   Callbacks cb_;
   MqttOptions opts_;
   bool lost_ = false;
+  bool connected_ = false;
   std::string error_;
+  /// Why the session ended with libmosquitto's `rc`: "cannot connect to
+  /// host:port: ..." before the CONNACK, "connection lost: ..." after.
+  std::string lostText(int rc) const;
 };
 
 }  // namespace inspect::server::sparkplug

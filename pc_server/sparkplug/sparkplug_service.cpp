@@ -32,7 +32,7 @@ SparkplugService::SparkplugService(const SparkplugConfig& cfg, std::string edge_
   mqtt_.client_id = "inspect-" + cfg_.group_id + "-" + node_.node();
   mqtt_.host = cfg_.host;
   mqtt_.port = cfg_.port;
-  mqtt_.keepalive_s = std::max(1, static_cast<int>(cfg_.keepalive_s));
+  mqtt_.keepalive_s = std::max(5, static_cast<int>(cfg_.keepalive_s));  // libmosquitto refuses 1-4 (config: [5, 600])
   mqtt_.ca = cfg_.ca;
   mqtt_.cert = cfg_.cert;
   mqtt_.key = cfg_.key;
@@ -179,7 +179,15 @@ void SparkplugService::session() {
   auto next_data = std::chrono::steady_clock::now();
   const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(std::max(0.02, cfg_.min_period_s)));
+  // A broker that never answers (its host drops the SYN, or it accepts the
+  // TCP connection and says nothing) is given up after the keep-alive.
+  const auto connack_by = std::chrono::steady_clock::now() + std::chrono::seconds(mqtt_.keepalive_s);
+  std::string no_session;  // why this attempt never got a session
   while (!stop_ && s.step(kStepMs)) {
+    if (!s.connected() && std::chrono::steady_clock::now() >= connack_by) {
+      no_session = s.noAnswerText();
+      break;
+    }
     if (!node_.born()) continue;
     publishEvents(s);
     settleCommands(s);
@@ -195,9 +203,14 @@ void SparkplugService::session() {
     leave(s);
     if (!s.error().empty()) log::warn("sparkplug", "stopping: ", s.error());
   }
+  if (no_session.empty() && !s.connected() && !stop_) no_session = s.error();
   const bool was_born = node_.born();
   node_.sessionEnded();
   std::lock_guard lk(mu_);
+  if (!no_session.empty()) {
+    if (stats_.error != no_session) log::warn("sparkplug", "broker ", stats_.broker, ": ", no_session);
+    stats_.error = no_session;
+  }
   live_ = false;
   for (auto& e : events_) {
     if (e.mid >= 0) e.late = true;  // the broker may not have it: again after the rebirth
