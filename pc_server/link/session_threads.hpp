@@ -6,11 +6,20 @@
 // a session's handlers hop between threads; at 100 robots that was a fifth
 // of the server's CPU in futex and scheduler time (docs/load.md). Here the
 // thread that waits for a socket runs its handlers, and nothing else wakes.
+// A thread runs everything ready, then sleeps kBatch before it waits again:
+// one wake-up then takes the frames of several robots (about 5 at 100
+// robots at 100 Hz) instead of one, for at most kBatch more latency (the
+// median 0.13 -> 0.7-1.0 ms; heartbeats every 50 ms, the robot's link
+// timeout 250 ms).
+#include <pthread.h>
+
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -21,6 +30,8 @@ namespace inspect::server {
 
 class SessionThreads {
  public:
+  static constexpr std::chrono::microseconds kBatch{1000};
+
   explicit SessionThreads(std::size_t threads) {
     for (std::size_t i = 0; i < std::max<std::size_t>(threads, 1); ++i) {
       auto& c = contexts_.emplace_back(std::make_unique<Context>());
@@ -31,15 +42,16 @@ class SessionThreads {
   SessionThreads(const SessionThreads&) = delete;
   SessionThreads& operator=(const SessionThreads&) = delete;
 
-  /// Starts one thread per io_context (once).
+  /// Starts one thread per io_context (once), named link0, link1, ... (top -H).
   void start() {
-    for (auto& c : contexts_)
-      if (!c->thread.joinable()) c->thread = std::thread([ctx = c.get()] {
+    for (std::size_t i = 0; i < contexts_.size(); ++i)
+      if (auto& c = contexts_[i]; !c->thread.joinable()) c->thread = std::thread([ctx = c.get(), i] {
+        pthread_setname_np(pthread_self(), ("link" + std::to_string(i)).c_str());
         for (;;) {
           if (ctx->ioc.run_one() == 0) return;  // stopped
           ctx->ioc.poll();
           if (ctx->ioc.stopped()) return;
-          std::this_thread::sleep_for(std::chrono::microseconds(1000));
+          std::this_thread::sleep_for(kBatch);  // let more frames arrive: one wake-up for several
         }
       });
   }
