@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include <nlohmann/json.hpp>
+
 #include "pc_server/sparkplug/device_metrics.hpp"
 #include "shared/util/clock.hpp"
 #include "shared/util/log.hpp"
@@ -12,10 +14,7 @@
 namespace inspect::server::sparkplug {
 
 namespace {
-uint64_t nowMs() {
-  return static_cast<uint64_t>(
-      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
-}
+uint64_t nowMs() { return wallNowNs() / 1'000'000; }  // Sparkplug's timestamps: UTC ms
 constexpr int kStepMs = 20;  // the session's poll: an alarm transition waits at most this before it goes out
 }  // namespace
 
@@ -177,8 +176,7 @@ void SparkplugService::session() {
     return;
   }
   auto next_data = std::chrono::steady_clock::now();
-  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(std::max(0.02, cfg_.min_period_s)));
+  const auto period = steadyDuration(std::max(0.02, cfg_.min_period_s));
   // A broker that never answers (its host drops the SYN, or it accepts the
   // TCP connection and says nothing) is given up after the keep-alive.
   const auto connack_by = std::chrono::steady_clock::now() + std::chrono::seconds(mqtt_.keepalive_s);
@@ -260,11 +258,14 @@ void SparkplugService::birth(MqttSession& s) {
 }
 
 void SparkplugService::onHostState(MqttSession& s, const std::string& payload) {
-  // {"online": true|false, "timestamp": ms} (section 7.4.1); spaces allowed.
-  std::string compact;
-  for (const char c : payload)
-    if (c != ' ' && c != '\t' && c != '\n' && c != '\r') compact += c;
-  const bool online = compact.find("\"online\":true") != std::string::npos;
+  // {"online": true|false, "timestamp": ms} (section 7.4.1).
+  const auto j = nlohmann::json::parse(payload, nullptr, false);
+  if (!j.is_object() || !j.contains("online") || !j["online"].is_boolean()) {
+    log::warn("sparkplug", "STATE of the primary host ", cfg_.primary_host_id,
+              " ignored: not JSON with a Boolean \"online\": ", payload.substr(0, 80));
+    return;
+  }
+  const bool online = j["online"].get<bool>();
   if (online && !node_.born()) {
     birth(s);
   } else if (!online && node_.born()) {
