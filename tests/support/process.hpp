@@ -4,6 +4,7 @@
 #include <sys/types.h>
 
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,6 +52,9 @@ class TempDir {
 };
 
 std::string readFile(const std::string& path);
+/// utime + stime (clock ticks, sysconf(_SC_CLK_TCK)) of every thread of
+/// process `pid`, summed per thread name (/proc/<pid>/task/*/comm).
+std::map<std::string, double> threadCpuTicks(pid_t pid);
 void writeFile(const std::string& path, const std::string& text);
 bool exists(const std::string& path);
 /// stdout and stderr of a shell command, bounded by `timeout timeout_s`.

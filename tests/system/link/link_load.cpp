@@ -311,7 +311,7 @@ Result runOne(const Options& opt, int n) {
   const uint64_t t0_us = monoNowUs();
   const auto w0 = Clock::now();
   const auto s0 = sampleProc(server.pid());
-  const uint64_t spark0 = opt.mqtt ? threadCpuTicks(server.pid(), "sparkplug") : 0;
+  const double spark0 = opt.mqtt ? test::threadCpuTicks(server.pid())["sparkplug"] : 0;
   const double gcpu0 = cpuSecondsSelf();
   uint64_t peak_rss_kb = s0.rss_kb;
   // --mqtt: each robot raises or clears its alarm every alarm_period_s, the fleet spread over the period.
@@ -327,7 +327,7 @@ Result runOne(const Options& opt, int n) {
     peak_rss_kb = std::max(peak_rss_kb, s.rss_kb);
   }
   const auto s1 = sampleProc(server.pid());
-  const uint64_t spark1 = opt.mqtt ? threadCpuTicks(server.pid(), "sparkplug") : 0;
+  const double spark1 = opt.mqtt ? test::threadCpuTicks(server.pid())["sparkplug"] : 0;
   const double gcpu1 = cpuSecondsSelf();
   const uint64_t t1_us = monoNowUs();
   r.window_s = std::chrono::duration<double>(Clock::now() - w0).count();
@@ -345,7 +345,7 @@ Result runOne(const Options& opt, int n) {
   }
   r.server_cpu_pct = 100.0 * static_cast<double>(s1.cpu_ticks - s0.cpu_ticks) / tck / r.window_s;
   r.gen_cpu_pct = 100.0 * (gcpu1 - gcpu0) / r.window_s;
-  r.sparkplug_thread_cpu_pct = 100.0 * static_cast<double>(spark1 - spark0) / tck / r.window_s;
+  r.sparkplug_thread_cpu_pct = 100.0 * (spark1 - spark0) / tck / r.window_s;
   r.rss_end_mb = static_cast<double>(s1.rss_kb) / 1024.0;
   r.rss_peak_mb = static_cast<double>(std::max(peak_rss_kb, s1.rss_kb)) / 1024.0;
   r.hwm_mb = static_cast<double>(s1.hwm_kb) / 1024.0;

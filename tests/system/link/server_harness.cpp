@@ -30,27 +30,6 @@ std::size_t countOf(const std::string& text, const std::string& needle) {
 
 double clockTicksPerSecond() { return static_cast<double>(::sysconf(_SC_CLK_TCK)); }
 
-uint64_t threadCpuTicks(pid_t pid, const std::string& name) {
-  uint64_t ticks = 0;
-  std::error_code ec;
-  for (const auto& t : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) {
-    std::ifstream c(t.path() / "comm");
-    std::string comm;
-    if (!std::getline(c, comm) || comm != name) continue;
-    std::ifstream f(t.path() / "stat");
-    std::string line;
-    if (!std::getline(f, line)) continue;
-    const auto close = line.rfind(')');
-    if (close == std::string::npos) continue;
-    std::istringstream in(line.substr(close + 2));
-    std::vector<std::string> w;
-    std::string x;
-    while (in >> x) w.push_back(x);
-    if (w.size() >= 13) ticks += std::stoull(w[11]) + std::stoull(w[12]);
-  }
-  return ticks;
-}
-
 ProcSample sampleProc(pid_t pid) {
   ProcSample s;
   const std::string base = "/proc/" + std::to_string(pid);

@@ -35,8 +35,6 @@ struct ProcSample {
   uint64_t rchar = 0, wchar = 0;  // /proc/<pid>/io: bytes through read/write calls (sockets and files)
 };
 ProcSample sampleProc(pid_t pid);
-/// utime + stime (clock ticks) of the process's threads named `name` (/proc/<pid>/task/*/comm); 0 when none.
-uint64_t threadCpuTicks(pid_t pid, const std::string& name);
 double clockTicksPerSecond();
 
 class ServerUnderTest {

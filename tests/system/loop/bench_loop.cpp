@@ -70,29 +70,6 @@ struct ThreadCpu {
   double percent = 0;  // of one core over the window
 };
 
-// utime + stime (clock ticks) of every thread of `pid`, summed per name.
-std::map<std::string, double> threadTicks(pid_t pid) {
-  std::map<std::string, double> out;
-  const std::string task = "/proc/" + std::to_string(pid) + "/task";
-  std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(task, ec)) {
-    std::string name = readFile(e.path() / "comm");
-    while (!name.empty() && (name.back() == '\n' || name.back() == ' ')) name.pop_back();
-    const std::string stat = readFile(e.path() / "stat");
-    const auto close = stat.rfind(')');
-    if (close == std::string::npos) continue;
-    std::istringstream in(stat.substr(close + 2));
-    std::string f;
-    double utime = 0, stime = 0;
-    for (int i = 3; i <= 15 && in >> f; ++i) {
-      if (i == 14) utime = std::atof(f.c_str());
-      if (i == 15) stime = std::atof(f.c_str());
-    }
-    out[name] += utime + stime;
-  }
-  return out;
-}
-
 // The numbers on the line after `label` in `text`.
 std::vector<double> numbersAfter(const std::string& text, const std::string& label) {
   std::vector<double> v;
@@ -243,7 +220,7 @@ int main(int argc, char** argv) {
   // The window starts here: robot_client logs its figures so far and counts anew.
   ::kill(robot.client.pid(), SIGUSR1);
   const long hz = ::sysconf(_SC_CLK_TCK);
-  const auto cpu0 = threadTicks(robot.client.pid());
+  const auto cpu0 = threadCpuTicks(robot.client.pid());
   const double steal0 = stealS();
   const int64_t t0 = inspect::monoNowNs();
   std::atomic<bool> stop_ref{false};
@@ -253,7 +230,7 @@ int main(int argc, char** argv) {
   sleepS(o.seconds);
   stop_ref = true;
   ref_thread.join();
-  const auto cpu1 = threadTicks(robot.client.pid());
+  const auto cpu1 = threadCpuTicks(robot.client.pid());
   const double wall_s = static_cast<double>(inspect::monoNowNs() - t0) * 1e-9;
   const double steal_pct = 100.0 * (stealS() - steal0) / wall_s / ncpu;
   const auto rc = s.server().wait(30.0);
